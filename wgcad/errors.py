@@ -1,0 +1,34 @@
+"""The error hierarchy of wgcad: one base class, subclasses that also inherit the builtin they resemble."""
+
+__all__ = ["WgcadError", "DesignError", "InputFileError", "OutputError", "GeometryError"]
+
+
+class WgcadError(Exception):
+    """Base class of every error wgcad raises on purpose."""
+
+    #: exit code the CLI uses for this kind of error
+    exit_code = 2
+
+
+class DesignError(WgcadError, ValueError):
+    """A design parameter (or a geometry derived from it) breaks a rule.
+
+    The message names the field (``table.key``) and the rule.
+    """
+
+    def __init__(self, field: str, rule: str):
+        self.field = field
+        self.rule = rule
+        super().__init__(f"{field}: {rule}")
+
+
+class InputFileError(WgcadError, OSError):
+    """An input file is missing, unreadable or not valid TOML."""
+
+
+class OutputError(WgcadError, OSError):
+    """An output folder or file cannot be written."""
+
+
+class GeometryError(WgcadError, ArithmeticError):
+    """A geometric construction failed although the design passed validation."""
