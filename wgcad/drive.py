@@ -1,0 +1,134 @@
+"""A design turned into geometry: both gears, the neutral line and the deformation law."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from math import pi
+
+import numpy as np
+
+from . import constants
+from .deformation import Law, coned_w0, make_law
+from .design import Design
+from .errors import DesignError
+from .profiles.gear import Gear, ToothSpec, make_gear
+
+__all__ = ["Drive", "build_drive", "tooth_spec"]
+
+
+def tooth_spec(design: Design, which: str) -> ToothSpec:
+    """The :class:`ToothSpec` of ``which`` (``"flexspline"`` or ``"rigid"``) of a design.
+
+    Internal deformation: external-toothed flexspline, internal rigid gear;
+    external deformation the other way round (theory.md 1). The flexspline's
+    tooth 0 is centred on +x, the rigid gear's space is (reference position).
+    """
+    d = design
+    gs = getattr(d, which)
+    flex = which == "flexspline"
+    z = d.drive.z_flex if flex else d.drive.z_rigid
+    internal = (not flex) if not d.external else flex
+    return ToothSpec(
+        z=z,
+        module=d.drive.module,
+        internal=internal,
+        form=d.tooth.form,
+        alpha=float(np.deg2rad(d.tooth.pressure_angle_deg)),
+        addendum_coef=d.tooth.addendum_coef,
+        clearance_coef=d.c_star,
+        shift=gs.shift,
+        tip_radius=gs.tip_radius,
+        root_radius=gs.root_radius,
+        thinning=gs.thinning,
+        fillet_coef=gs.fillet_coef,
+        field=which,
+        phase=0.0 if flex else pi / z,
+    )
+
+
+@dataclass(frozen=True)
+class Drive:
+    """Geometry of a whole drive, undeformed, plus its deformation law.
+
+    Attributes
+    ----------
+    design : Design
+    flex, rigid : Gear
+    law : Law
+        Deformation of the flexspline's neutral line at the generator's
+        centre section (``W0`` of the design).
+    r_m : float
+        Neutral-line radius of the flexspline rim, mm: the middle of the rim
+        under the teeth (theory.md 1).
+    flex_rim_radius, rigid_rim_radius : float
+        The other boundary of each gear body, mm (flexspline bore or outer
+        surface; rigid gear outer surface or bore).
+    """
+
+    design: Design
+    flex: Gear
+    rigid: Gear
+    law: Law
+    r_m: float
+    flex_rim_radius: float
+    rigid_rim_radius: float
+    tol: float
+
+    @property
+    def external(self) -> bool:
+        return self.design.external
+
+    @property
+    def coned(self) -> bool:
+        return self.design.generator.cone_length is not None
+
+    def law_at(self, z: float) -> Law:
+        """The deformation law of the cross-section at axial position ``z`` (mm from the open end), theory.md 3.1."""
+        g = self.design.generator
+        if g.cone_length is None:
+            return self.law
+        w0 = float(coned_w0(self.law.w0, np.atleast_1d(float(z)), length=g.cone_length, z_h=g.generator_z)[0])
+        return self.law.with_w0(w0)
+
+    def sections(self, k: int) -> np.ndarray:
+        """Axial positions of ``k`` cross-sections spread over the face width (ends included for k >= 2), mm."""
+        bw = self.design.drive.face_width
+        return np.array([0.5 * bw]) if k <= 1 else np.linspace(0.0, bw, k)
+
+
+def build_drive(design: Design, tol: float = constants.CHORD_TOL) -> Drive:
+    """Build both gears and the deformation law, checking the derived geometry.
+
+    Raises
+    ------
+    DesignError
+        A derived-geometry rule is broken (names the field to change).
+    """
+    if not tol > 0:
+        raise DesignError("chord_tol", f"must be > 0, got {tol:g}")
+    flex = make_gear(tooth_spec(design, "flexspline"), tol)
+    rigid = make_gear(tooth_spec(design, "rigid"), tol)
+    h1 = design.flexspline.rim_thickness
+    if design.external:
+        # internal-toothed flexspline: rim outside its root circle
+        r_m = flex.r_f + 0.5 * h1
+        flex_rim = flex.r_f + h1
+        rigid_rim = rigid.r_f - design.rigid.rim_thickness
+        if rigid_rim <= 0:
+            raise DesignError("rigid.rim_thickness", f"{design.rigid.rim_thickness:g} mm leaves no bore inside the root circle {rigid.r_f:.4f} mm")
+    else:
+        r_m = flex.r_f - 0.5 * h1
+        flex_rim = flex.r_f - h1
+        rigid_rim = rigid.r_f + design.rigid.rim_thickness
+        if flex_rim <= 0:
+            raise DesignError("flexspline.rim_thickness", f"{h1:g} mm leaves no bore inside the root circle {flex.r_f:.4f} mm")
+    g = design.generator
+    law = make_law(
+        g.law,
+        w0=design.w0,
+        r_m=r_m,
+        n_waves=design.drive.waves,
+        beta=None if g.beta_deg is None else float(np.deg2rad(g.beta_deg)),
+        offset=g.offset,
+    )
+    return Drive(design, flex, rigid, law, float(r_m), float(flex_rim), float(rigid_rim), tol)

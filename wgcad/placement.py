@@ -1,0 +1,150 @@
+"""Flexspline teeth placed as rigid bodies on the deformed neutral line (theory.md 3.1)."""
+
+from __future__ import annotations
+
+from math import pi
+
+import numpy as np
+
+from .deformation import Law
+from .kinematics import flex_rotation
+
+__all__ = [
+    "tooth_angles",
+    "tooth_frames",
+    "place_points",
+    "place_points_first_order",
+    "place_flex_teeth",
+    "deformed_curve",
+]
+
+
+def tooth_angles(z_flex: int, z_rigid: int, phi_h: float, teeth=None) -> tuple[np.ndarray, np.ndarray]:
+    """Angles of flexspline teeth for generator angle ``phi_h`` (rigid-gear frame).
+
+    The flexspline turns by ``phi_h / u_hg`` (theory.md 1, rigid gear as the
+    reference frame: with the flexspline fixed the relative motion is the
+    same, only the frame that is drawn turns).
+
+    Returns
+    -------
+    material : (K,) float
+        Angle of each tooth's centre line in the rigid-gear frame if the
+        rim were undeformed, rad.
+    phi : (K,) float
+        Angle of each tooth from the generator's major axis, rad.
+    """
+    k = np.arange(z_flex) if teeth is None else np.asarray(teeth)
+    material = 2.0 * pi * k / z_flex + flex_rotation(phi_h, z_flex, z_rigid)
+    return material, material - phi_h
+
+
+def tooth_frames(law: Law, phi, r_m: float):
+    """Origin and orientation of the rim cross-section carrying each tooth.
+
+    ``P = (r_m + w) e_r(phi) + v e_t(phi)`` with the tooth turned by
+    ``theta`` (theory.md 3.1), in the generator frame (major axis on +x).
+
+    Returns
+    -------
+    origin : (K, 2) float
+        Deformed position of the neutral-line point.
+    angle : (K,) float
+        ``phi + theta``: direction of the cross-section's normal.
+    """
+    phi = np.asarray(phi, dtype=float)
+    st = law.state(phi)
+    c, s = np.cos(phi), np.sin(phi)
+    rad = r_m + st.w
+    origin = np.stack([rad * c - st.v * s, rad * s + st.v * c], axis=-1)
+    return origin, phi + st.theta
+
+
+def place_points(local: np.ndarray, law: Law, phi, r_m: float, frame_angle=0.0) -> np.ndarray:
+    """Exact placement: each tooth outline turned with its rim cross-section (theory.md 3.1).
+
+    Parameters
+    ----------
+    local : (N, 2) float
+        The undeformed tooth, centred on +x (tooth frame).
+    phi : (K,) float
+        Angles of the teeth from the major axis.
+    frame_angle : float or (K,) float
+        Added to every rotation: the generator's angle in the output frame.
+
+    Returns
+    -------
+    (K, N, 2) float
+    """
+    phi = np.atleast_1d(np.asarray(phi, dtype=float))
+    origin, ang = tooth_frames(law, phi, r_m)
+    # tooth point = neutral point + (d, s) turned by phi + theta, with d = x - r_m, s = y
+    d = local[:, 0] - r_m
+    s = local[:, 1]
+    c, sn = np.cos(ang)[:, None], np.sin(ang)[:, None]
+    px = origin[:, 0:1] + d * c - s * sn
+    py = origin[:, 1:2] + d * sn + s * c
+    out = np.stack([px, py], axis=-1)
+    fa = np.broadcast_to(np.asarray(frame_angle, dtype=float), phi.shape)
+    if np.any(fa != 0):
+        cf, sf = np.cos(fa)[:, None], np.sin(fa)[:, None]
+        out = np.stack([cf * out[..., 0] - sf * out[..., 1], sf * out[..., 0] + cf * out[..., 1]], axis=-1)
+    return out
+
+
+def place_points_first_order(local: np.ndarray, law: Law, phi, r_m: float, centreline: bool = False) -> np.ndarray:
+    """First-order placement: the tooth's rigid-body motion linearised in ``theta``.
+
+    A point at height ``d`` above the neutral line and tangential offset
+    ``s`` moves radially by ``w - s theta`` and tangentially by
+    ``v + d theta``. On the tooth's centre line (``s = 0``) this is the form
+    of [S3 eq. 15] (radial ``w``, tangential ``v + d theta``); with
+    ``centreline=True`` that form is applied to every point, as if each
+    point lay on the centre line - it then drops ``-s theta``, which is
+    first order in ``theta`` (tens of um on a flank). Kept as a cross-check
+    of :func:`place_points`: the linearised form differs from the exact one
+    by ``O(theta^2)`` times the tooth size, i.e. ``O(W0^2 / r_m)`` for teeth
+    of size ~ m ~ W0 (theory.md 3.1). Generator frame, ``(K, N, 2)``.
+    """
+    phi = np.atleast_1d(np.asarray(phi, dtype=float))
+    st = law.state(phi)
+    d = local[:, 0] - r_m
+    s_off = local[:, 1]
+    x = local[:, 0][None, :] + st.w[:, None]
+    if not centreline:
+        x = x - s_off[None, :] * st.theta[:, None]
+    y = s_off[None, :] + st.v[:, None] + d[None, :] * st.theta[:, None]
+    c, s = np.cos(phi)[:, None], np.sin(phi)[:, None]
+    return np.stack([x * c - y * s, x * s + y * c], axis=-1)
+
+
+def place_flex_teeth(drive, phi_h: float, local: np.ndarray | None = None, teeth=None, z: float | None = None) -> np.ndarray:
+    """Deformed flexspline teeth in the rigid-gear frame at generator angle ``phi_h``.
+
+    Parameters
+    ----------
+    drive : wgcad.drive.Drive
+    phi_h : float
+        Generator angle relative to the rigid gear, rad.
+    local : (N, 2) float, optional
+        Tooth outline in the tooth frame; default one pitch of the flexspline
+        boundary (``drive.flex.period``).
+    teeth : (K,) int, optional
+        Which teeth (default all).
+    z : float, optional
+        Axial section (coning); default the generator's centre section.
+
+    Returns
+    -------
+    (K, N, 2) float
+    """
+    law = drive.law if z is None else drive.law_at(z)
+    local = drive.flex.period if local is None else local
+    _, phi = tooth_angles(drive.design.drive.z_flex, drive.design.drive.z_rigid, phi_h, teeth)
+    return place_points(local, law, phi, drive.r_m, frame_angle=phi_h)
+
+
+def deformed_curve(law: Law, r_m: float, d: float, phi) -> np.ndarray:
+    """Points ``(K, 2)`` of the rim line at height ``d`` above the neutral line (``d = 0``: neutral line), generator frame."""
+    origin, ang = tooth_frames(law, phi, r_m)
+    return origin + d * np.stack([np.cos(ang), np.sin(ang)], axis=-1)

@@ -1,0 +1,179 @@
+"""Derived figures of a drive as data (units in the key names) and as a readable summary."""
+
+from __future__ import annotations
+
+from math import pi
+
+import numpy as np
+
+from . import __version__
+from .kinematics import gear_ratios
+from .placement import place_points, place_points_first_order, tooth_angles
+from .profiles import cycloid as cy
+
+__all__ = ["gear_figures", "mesh_figures", "drive_report", "format_summary"]
+
+
+def _r(x, nd=6):
+    return None if x is None else round(float(x), nd)
+
+
+def cycloid_rack_error(gear, n: int = 2001) -> float:
+    """Largest difference, mm, between the rack-approximation and the exact cycloidal tooth thickness (theory.md 2.2)."""
+    r, rho, internal = gear.r, gear.rho, gear.spec.internal
+    lo, hi = sorted((gear.r_a, gear.r_f))
+    R = np.linspace(lo, hi, n)
+    exact = cy.exact_half_angle(r, rho, R, internal)
+    rack = cy.rack_half_angle(r, rho, R, internal)
+    return float(np.max(np.abs(2.0 * R * (exact - rack))))
+
+
+def gear_figures(gear, rim_radius: float) -> dict:
+    """Radii and thicknesses of one gear (theory.md 2)."""
+    sp = gear.spec
+    out = {
+        "teeth": sp.z,
+        "internal_teeth": sp.internal,
+        "form": sp.form,
+        "shift": sp.shift,
+        "pitch_radius_mm": _r(gear.r),
+        "tip_radius_mm": _r(gear.r_a),
+        "root_radius_mm": _r(gear.r_f),
+        "base_radius_mm": _r(gear.r_base),
+        "rim_radius_mm": _r(rim_radius),
+        "tooth_thickness_pitch_mm": _r(gear.tooth_thickness(gear.r)),
+        "space_width_pitch_mm": _r(gear.space_width(gear.r)),
+        "tip_thickness_mm": _r(gear.tip_thickness),
+        "fillet_radius_mm": _r(sp.fillet_coef * sp.module) if sp.form == "involute" else None,
+        "outline_vertices": int(len(gear.outline)),
+        "outline_area_mm2": _r(gear.area(), 4),
+    }
+    if sp.form == "cycloidal":
+        out["cycloid_rack_vs_exact_um"] = _r(1e3 * cycloid_rack_error(gear), 4)
+    return out
+
+
+def mesh_figures(drive, law=None) -> dict:
+    """Depth of engagement and radial clearances at the major and minor axes (theory.md 2.1, 3).
+
+    Teeth on the major axis (phi = 0) and the minor axis (phi = pi/n_w) are
+    carried radially by ``w`` alone (``v = theta = 0`` there by symmetry), so
+    these are exact radial figures of the placed teeth.
+    """
+    law = drive.law if law is None else law
+    f, b = drive.flex, drive.rigid
+    n_w = drive.design.drive.waves
+    w_major = float(law.state(np.array([0.0])).w[0])
+    w_minor = float(law.state(np.array([pi / n_w])).w[0])
+    sgn = -1.0 if drive.external else 1.0  # +: flexspline teeth point outward
+    return {
+        "w_major_mm": _r(w_major),
+        "w_minor_mm": _r(w_minor),
+        "depth_of_engagement_mm": _r(sgn * ((f.r_a + w_major) - b.r_a)),
+        "clearance_flex_tip_major_um": _r(1e3 * sgn * (b.r_f - (f.r_a + w_major)), 3),
+        "clearance_rigid_tip_major_um": _r(1e3 * sgn * (b.r_a - (f.r_f + w_major)), 3),
+        "tip_gap_minor_um": _r(1e3 * sgn * (b.r_a - (f.r_a + w_minor)), 3),
+    }
+
+
+def placement_check(drive) -> dict:
+    """Largest distance between exact and first-order tooth placement over all teeth at phi_h = 0, um (theory.md 3.1)."""
+    d = drive.design.drive
+    _, phi = tooth_angles(d.z_flex, d.z_rigid, 0.0)
+    exact = place_points(drive.flex.period, drive.law, phi, drive.r_m)
+    first = place_points_first_order(drive.flex.period, drive.law, phi, drive.r_m)
+    centre = place_points_first_order(drive.flex.period, drive.law, phi, drive.r_m, centreline=True)
+
+    def worst(a, b):
+        return float(np.max(np.hypot(*(a - b).transpose(2, 0, 1))))
+
+    return {
+        "exact_vs_first_order_um": _r(1e3 * worst(exact, first), 4),
+        "exact_vs_centreline_form_um": _r(1e3 * worst(exact, centre), 4),
+        "w0_squared_over_r_m_um": _r(1e3 * drive.law.w0**2 / drive.r_m, 4),
+    }
+
+
+def drive_report(drive) -> dict:
+    """Everything ``wgcad generate`` reports, as JSON-ready data."""
+    des = drive.design
+    d = des.drive
+    ratios = gear_ratios(d.z_flex, d.z_rigid)
+    rep = {
+        "wgcad_version": __version__,
+        "design": d.name,
+        "source": des.source,
+        "chord_tol_um": _r(drive.tol * 1e3, 6),
+        "drive": {
+            "module_mm": d.module,
+            "z_flex": d.z_flex,
+            "z_rigid": d.z_rigid,
+            "waves": d.waves,
+            "deformation": d.deformation,
+            "fixed": d.fixed,
+            "face_width_mm": d.face_width,
+            "ratio_rigid_fixed": _r(ratios["u_hg"], 9),
+            "ratio_flexspline_fixed": _r(ratios["u_hb"], 9),
+            "law": des.generator.law,
+            "beta_deg": des.generator.beta_deg,
+            "w0_mm": _r(des.w0),
+            "neutral_radius_mm": _r(drive.r_m),
+        },
+        "flexspline": gear_figures(drive.flex, drive.flex_rim_radius),
+        "rigid": gear_figures(drive.rigid, drive.rigid_rim_radius),
+        "mesh": mesh_figures(drive),
+        "placement": placement_check(drive),
+    }
+    if drive.coned:
+        secs = {}
+        for z in (0.0, d.face_width):
+            secs[f"z_{z:g}_mm"] = mesh_figures(drive, drive.law_at(z))
+        rep["mesh_at_face_ends"] = secs
+    return rep
+
+
+def format_summary(rep: dict) -> str:
+    """A readable multi-line summary of :func:`drive_report`."""
+    d, f, b, m = rep["drive"], rep["flexspline"], rep["rigid"], rep["mesh"]
+    lines = [
+        f"{rep['design']}  ({rep['source']})",
+        f"  module {d['module_mm']} mm, z_flex {d['z_flex']}, z_rigid {d['z_rigid']}, {d['waves']} waves, "
+        f"{d['deformation']} deformation, {d['law']} law, W0 {d['w0_mm']} mm",
+        f"  ratio u_hg (rigid fixed) {d['ratio_rigid_fixed']:g}, u_hb (flexspline fixed) {d['ratio_flexspline_fixed']:g}",
+        "",
+        f"  {'':28s}{'flexspline':>14s}{'rigid':>14s}",
+    ]
+    rows = [
+        ("pitch radius, mm", "pitch_radius_mm"),
+        ("tip radius, mm", "tip_radius_mm"),
+        ("root radius, mm", "root_radius_mm"),
+        ("base radius, mm", "base_radius_mm"),
+        ("rim radius, mm", "rim_radius_mm"),
+        ("tooth thickness @pitch, mm", "tooth_thickness_pitch_mm"),
+        ("space width @pitch, mm", "space_width_pitch_mm"),
+        ("tip thickness, mm", "tip_thickness_mm"),
+        ("outline vertices", "outline_vertices"),
+    ]
+    if "cycloid_rack_vs_exact_um" in f:
+        rows.append(("rack vs exact cycloid, um", "cycloid_rack_vs_exact_um"))
+    for label, key in rows:
+        fv, bv = f.get(key), b.get(key)
+        fs = "-" if fv is None else f"{fv:.4f}" if isinstance(fv, float) else str(fv)
+        bs = "-" if bv is None else f"{bv:.4f}" if isinstance(bv, float) else str(bv)
+        lines.append(f"  {label:28s}{fs:>14s}{bs:>14s}")
+    lines += [
+        "",
+        f"  depth of engagement on the major axis: {m['depth_of_engagement_mm']:.4f} mm (w = {m['w_major_mm']:.4f} mm)",
+        f"  radial clearance, major axis: flexspline tip {m['clearance_flex_tip_major_um']:.1f} um, "
+        f"rigid tip {m['clearance_rigid_tip_major_um']:.1f} um",
+        f"  radial tip gap, minor axis: {m['tip_gap_minor_um']:.1f} um (w = {m['w_minor_mm']:.4f} mm)",
+        f"  exact vs first-order placement: {rep['placement']['exact_vs_first_order_um']:.3f} um "
+        f"(W0^2/r_m = {rep['placement']['w0_squared_over_r_m_um']:.3f} um); "
+        f"centre-line form [S3 eq. 15] on whole teeth: {rep['placement']['exact_vs_centreline_form_um']:.1f} um",
+    ]
+    for key, sec in rep.get("mesh_at_face_ends", {}).items():
+        lines.append(
+            f"  coning, section {key}: depth {sec['depth_of_engagement_mm']:.4f} mm, "
+            f"flex tip clearance {sec['clearance_flex_tip_major_um']:.1f} um, minor tip gap {sec['tip_gap_minor_um']:.1f} um"
+        )
+    return "\n".join(lines)
