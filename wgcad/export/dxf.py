@@ -1,0 +1,303 @@
+"""DXF export and read-back of 2D outlines: one closed LWPOLYLINE per outline, circles as CIRCLE, in mm."""
+
+from __future__ import annotations
+
+import contextlib
+import math
+import os
+from dataclasses import dataclass, field
+
+import ezdxf
+import numpy as np
+from ezdxf.lldxf.validator import is_valid_layer_name
+
+from wgcad.errors import InputFileError
+from wgcad.export.atomic import atomic_writer
+
+__all__ = ["DxfLayer", "build_dxf", "write_dxf", "read_dxf", "audit_dxf", "clean_outline"]
+
+#: Consecutive vertices closer than this (mm) are one vertex. 1 pm is six
+#: orders below the 1 um chord tolerance of outlines and far above the
+#: ~1e-14 mm rounding noise of float64 coordinates near 100 mm, so it removes
+#: exact and round-off duplicates and nothing else.
+DUPLICATE_TOL = 1e-9
+
+#: DXF version written: R2010 (AC1024), read by every current CAD program.
+DXF_VERSION = "R2010"
+
+#: ``$INSUNITS`` code for millimetres.
+INSUNITS_MM = 4
+
+#: ``$MEASUREMENT`` 1 = metric.
+MEASUREMENT_METRIC = 1
+
+
+def clean_outline(outline, tol: float = DUPLICATE_TOL) -> np.ndarray:
+    """Remove consecutive duplicate vertices and a repeated closing vertex.
+
+    Parameters
+    ----------
+    outline : (N, 2) float array_like
+        Closed polygon, closing edge implicit or explicit.
+    tol : float
+        Vertices closer than this (mm) to the previous kept vertex are dropped.
+
+    Returns
+    -------
+    (M, 2) float64 ndarray
+        ``M <= N``; the last vertex differs from the first.
+
+    Raises
+    ------
+    ValueError
+        If the input is not (N, 2) finite or fewer than 3 vertices remain.
+
+    Examples
+    --------
+    >>> clean_outline([[0, 0], [1, 0], [1, 0], [0, 1], [0, 0]]).tolist()
+    [[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]]
+    """
+    pts = np.asarray(outline, dtype=np.float64)
+    if pts.ndim != 2 or pts.shape[1] != 2:
+        raise ValueError(f"outline must be an (N, 2) array, got shape {pts.shape}")
+    if not np.all(np.isfinite(pts)):
+        raise ValueError("outline has non-finite coordinates")
+    if len(pts) > 1:
+        step = np.hypot(*np.diff(pts, axis=0).T)
+        pts = pts[np.concatenate(([True], step > tol))]
+    while len(pts) > 1 and math.hypot(*(pts[-1] - pts[0])) <= tol:
+        pts = pts[:-1]
+    if len(pts) < 3:
+        raise ValueError(f"outline has {len(pts)} distinct vertices, needs at least 3")
+    return pts
+
+
+def _readonly(a: np.ndarray) -> np.ndarray:
+    a = np.array(a, dtype=np.float64)  # own copy, so the caller's array stays writable
+    a.setflags(write=False)
+    return a
+
+
+@dataclass(frozen=True)
+class DxfLayer:
+    """One DXF layer: closed outlines and circles, in mm.
+
+    Parameters
+    ----------
+    name : str
+        Layer name (DXF rules: no ``<>/\\":;?*|=`` characters).
+    outlines : tuple of (N, 2) float64 arrays
+        Closed polygons (closing edge implicit), counter-clockwise by wgcad
+        convention (not enforced: DXF does not care). Stored read-only.
+    circles : tuple of (cx, cy, r) float tuples
+        Circle centres and radii, ``r > 0``.
+    color : int
+        AutoCAD Color Index of the layer, 1..255 (7 = white/black).
+    """
+
+    name: str
+    outlines: tuple = field(default=())
+    circles: tuple = field(default=())
+    color: int = 7
+
+    def __post_init__(self):
+        if not isinstance(self.name, str) or not is_valid_layer_name(self.name):
+            raise ValueError(f"DXF layer name {self.name!r} is not valid")
+        if not (isinstance(self.color, (int, np.integer)) and 1 <= self.color <= 255):
+            raise ValueError(f"layer {self.name}: color must be an ACI number 1..255, got {self.color!r}")
+        outlines = []
+        for k, o in enumerate(self.outlines):
+            a = np.asarray(o, dtype=np.float64)
+            if a.ndim != 2 or a.shape[1] != 2:
+                raise ValueError(f"layer {self.name}: outline {k} must be (N, 2), got shape {a.shape}")
+            outlines.append(_readonly(a))
+        circles = []
+        for k, c in enumerate(self.circles):
+            cx, cy, r = (float(v) for v in c)
+            if not (math.isfinite(cx) and math.isfinite(cy) and math.isfinite(r) and r > 0):
+                raise ValueError(f"layer {self.name}: circle {k} must have finite centre and r > 0, got {c!r}")
+            circles.append((cx, cy, r))
+        object.__setattr__(self, "outlines", tuple(outlines))
+        object.__setattr__(self, "circles", tuple(circles))
+        object.__setattr__(self, "color", int(self.color))
+
+
+def build_dxf(layers) -> "ezdxf.document.Drawing":
+    """Build an in-memory DXF R2010 drawing of the layers.
+
+    Each outline becomes one closed LWPOLYLINE (after :func:`clean_outline`),
+    each circle one CIRCLE; entities take their layer's colour (BYLAYER).
+    The header says millimetres (``$INSUNITS`` 4, ``$MEASUREMENT`` 1) and
+    ``$EXTMIN``/``$EXTMAX`` hold the drawing's bounding box so viewers can
+    zoom to it.
+
+    Parameters
+    ----------
+    layers : iterable of DxfLayer
+        Layer names must be unique (case-insensitive, as in DXF).
+
+    Returns
+    -------
+    ezdxf.document.Drawing
+
+    Raises
+    ------
+    ValueError
+        On a duplicate layer name or an outline with fewer than 3 distinct
+        vertices.
+    """
+    with _fixed_metadata():
+        doc = ezdxf.new(DXF_VERSION)
+    doc.header["$INSUNITS"] = INSUNITS_MM
+    doc.header["$MEASUREMENT"] = MEASUREMENT_METRIC
+    msp = doc.modelspace()
+    lo = np.array([np.inf, np.inf])
+    hi = -lo
+    seen = set()
+    for layer in layers:
+        if layer.name.lower() in seen:
+            raise ValueError(f"DXF layer name {layer.name!r} is used twice")
+        seen.add(layer.name.lower())
+        if layer.name.lower() not in ("0", "defpoints"):
+            doc.layers.add(layer.name, color=layer.color)
+        else:
+            doc.layers.get(layer.name).color = layer.color
+        attribs = {"layer": layer.name}
+        for k, outline in enumerate(layer.outlines):
+            try:
+                pts = clean_outline(outline)
+            except ValueError as exc:
+                raise ValueError(f"layer {layer.name}: outline {k}: {exc}") from None
+            # add_lwpolyline(points) appends vertex by vertex with
+            # np.concatenate: quadratic, seconds for 40k points. Set the
+            # (n, 5) x, y, start width, end width, bulge array in one go.
+            e = msp.add_lwpolyline([], close=True, dxfattribs=attribs)
+            e.lwpoints.set(np.column_stack([pts, np.zeros((len(pts), 3))]))
+            lo = np.minimum(lo, pts.min(axis=0))
+            hi = np.maximum(hi, pts.max(axis=0))
+        for cx, cy, r in layer.circles:
+            msp.add_circle((cx, cy), r, dxfattribs=attribs)
+            lo = np.minimum(lo, (cx - r, cy - r))
+            hi = np.maximum(hi, (cx + r, cy + r))
+    if np.all(lo <= hi):
+        # Document.update_extents copies these into $EXTMIN/$EXTMAX on write.
+        msp.dxf.extmin = (lo[0], lo[1], 0.0)
+        msp.dxf.extmax = (hi[0], hi[1], 0.0)
+    return doc
+
+
+@contextlib.contextmanager
+def _fixed_metadata():
+    """ezdxf stamps times and random GUIDs into new and written documents;
+    fixed values make the same design give byte-identical files."""
+    saved = ezdxf.options.write_fixed_meta_data_for_testing
+    ezdxf.options.write_fixed_meta_data_for_testing = True
+    try:
+        yield
+    finally:
+        ezdxf.options.write_fixed_meta_data_for_testing = saved
+
+
+def write_dxf(path: str | os.PathLike, layers) -> None:
+    """Write the layers to an ASCII DXF R2010 file, atomically.
+
+    Parameters
+    ----------
+    path : str or path-like
+        Output file; the folder is created if missing.
+    layers : iterable of DxfLayer
+        See :func:`build_dxf`.
+
+    Raises
+    ------
+    OutputError
+        When the file cannot be written (``path`` is then unchanged).
+    """
+    doc = build_dxf(layers)
+    with atomic_writer(path) as temp:
+        # doc.write to our own stream rather than doc.saveas(temp): saveas
+        # would set doc.filename to the temporary name. ezdxf stamps the
+        # time and random GUIDs into the header; fixed metadata makes the
+        # same design give byte-identical files (reproducible output).
+        with _fixed_metadata():
+            with open(temp, "wt", encoding=doc.output_encoding, errors="dxfreplace") as fp:
+                doc.write(fp)
+
+
+def _readfile(path) -> "ezdxf.document.Drawing":
+    try:
+        return ezdxf.readfile(path)
+    except OSError as exc:
+        raise InputFileError(f"{path}: cannot read DXF file ({exc.strerror or exc})") from exc
+    except ezdxf.DXFError as exc:
+        raise InputFileError(f"{path}: not a valid DXF file ({exc})") from exc
+
+
+def read_dxf(path: str | os.PathLike) -> dict:
+    """Read back a DXF file written by :func:`write_dxf`.
+
+    Parameters
+    ----------
+    path : str or path-like
+        DXF file.
+
+    Returns
+    -------
+    dict
+        ``{layer_name: {"outlines": [(N, 2) float64 arrays], "circles":
+        [(cx, cy, r)]}}`` in file order, for every layer that holds an entity
+        and every layer of the layer table other than ``0`` and
+        ``Defpoints`` (so empty layers round-trip too).
+
+    Raises
+    ------
+    InputFileError
+        When the file cannot be read or holds something the writer never
+        writes (open polylines, bulges or widths, other entity types):
+        silently dropping such entities would hide a broken export.
+    """
+    doc = _readfile(path)
+    out: dict = {}
+    for layer in doc.layers:
+        if layer.dxf.name.lower() not in ("0", "defpoints"):
+            out[layer.dxf.name] = {"outlines": [], "circles": []}
+    for e in doc.modelspace():
+        kind = e.dxftype()
+        name = e.dxf.layer
+        where = f"{path}: {kind} #{e.dxf.handle} on layer {name}"
+        entry = out.setdefault(name, {"outlines": [], "circles": []})
+        if kind == "LWPOLYLINE":
+            values = e.lwpoints.values
+            if not e.closed:
+                raise InputFileError(f"{where} is not closed (outlines must be closed)")
+            if np.any(values[:, 2:] != 0):
+                raise InputFileError(f"{where} has widths or bulges (outlines must be straight segments)")
+            entry["outlines"].append(np.array(values[:, :2], dtype=np.float64))
+        elif kind == "CIRCLE":
+            c = e.dxf.center
+            entry["circles"].append((float(c.x), float(c.y), float(e.dxf.radius)))
+        else:
+            raise InputFileError(f"{where} is not supported (only closed LWPOLYLINE and CIRCLE)")
+    return out
+
+
+def audit_dxf(path: str | os.PathLike) -> int:
+    """Number of errors ezdxf's auditor finds in a DXF file.
+
+    Parameters
+    ----------
+    path : str or path-like
+        DXF file.
+
+    Returns
+    -------
+    int
+        ``len(doc.audit().errors)``; 0 for a clean file. (Problems the
+        auditor repaired itself are ``fixes``, not counted here.)
+
+    Raises
+    ------
+    InputFileError
+        When the file cannot be read or parsed at all.
+    """
+    return len(_readfile(path).audit().errors)
