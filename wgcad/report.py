@@ -41,6 +41,9 @@ def gear_figures(gear, rim_radius: float) -> dict:
         "root_radius_mm": _r(gear.r_f),
         "base_radius_mm": _r(gear.r_base),
         "rim_radius_mm": _r(rim_radius),
+        # with large profile shifts the pitch circle lies outside the teeth: the
+        # figures there are those of the extended involutes ("virtual")
+        "pitch_circle_within_teeth": bool(min(gear.r_a, gear.r_f) <= gear.r <= max(gear.r_a, gear.r_f)),
         "tooth_thickness_pitch_mm": _r(gear.tooth_thickness(gear.r)),
         "space_width_pitch_mm": _r(gear.space_width(gear.r)),
         "tip_thickness_mm": _r(gear.tip_thickness),
@@ -161,6 +164,9 @@ def format_summary(rep: dict) -> str:
         fs = "-" if fv is None else f"{fv:.4f}" if isinstance(fv, float) else str(fv)
         bs = "-" if bv is None else f"{bv:.4f}" if isinstance(bv, float) else str(bv)
         lines.append(f"  {label:28s}{fs:>14s}{bs:>14s}")
+    for key, g in (("flexspline", f), ("rigid", b)):
+        if not g["pitch_circle_within_teeth"]:
+            lines.append(f"  ({key}: the pitch circle lies outside the teeth; its thickness/space figures are virtual)")
     lines += [
         "",
         f"  depth of engagement on the major axis: {m['depth_of_engagement_mm']:.4f} mm (w = {m['w_major_mm']:.4f} mm)",
