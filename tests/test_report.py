@@ -37,14 +37,14 @@ def test_d1_minor_axis_tip_gap_by_hand():
 
 
 def test_d4_disc_law_by_hand():
-    # disc law (theory.md 3.3) at phi = pi/2, section II
-    m, beta, W0 = 0.4, np.deg2rad(30.0), 0.4
+    # disc law (theory.md 3.3) at phi = pi/2, section II; D4 template: m 0.4, x = 1, h_a* 0.75, W0 = 1.1 m
+    m, beta, W0, ha, c = 0.4, np.deg2rad(30.0), 1.1 * 0.4, 0.75, 0.25
     A = pi / 2 - sin(beta) * cos(beta) - beta
     B = -2 * sin(beta) + 4 * beta / pi * sin(beta) + 4 / pi * cos(beta)
     K = W0 / (A - B)
     w_minor = K * ((1 + sin(beta) ** 2) - 2 * sin(beta) - B)
-    r_ag, r_ab = 17.2 + m * 2.0, 17.6 + m * 0.0
-    r_fg, r_fb = 17.2 - m * 0.25, 17.6 + m * 2.25
+    r_ag, r_ab = 17.2 + m * (ha + 1.0), 17.6 + m * (1.0 - ha)
+    r_fg, r_fb = 17.2 - m * (ha + c - 1.0), 17.6 + m * (1.0 + ha + c)
     mf = mesh_figures(drive("d4_discrete"))
     assert mf["depth_of_engagement_mm"] == pytest.approx(r_ag + W0 - r_ab, abs=1e-9)
     assert mf["clearance_flex_tip_major_um"] == pytest.approx(1e3 * (r_fb - r_ag - W0), abs=1e-6)

@@ -1,4 +1,4 @@
-"""Command-line interface: ``wgcad generate`` and ``wgcad kinematics`` (heavy modules imported lazily)."""
+"""Command-line interface: ``wgcad generate``, ``audit`` and ``kinematics`` (heavy modules imported lazily)."""
 
 from __future__ import annotations
 
@@ -45,7 +45,10 @@ def _angles_deg(text: str) -> list[float]:
             raise argparse.ArgumentTypeError(f"'{part}' is not a number (degrees, comma separated)") from None
         if not -3600.0 <= val <= 3600.0:
             raise argparse.ArgumentTypeError(f"{val:g} deg is outside [-3600, 3600]")
-        out.append(val)
+        if val == 0.0:
+            val = 0.0  # -0 is 0
+        if val not in out:
+            out.append(val)
     return out
 
 
@@ -67,7 +70,11 @@ def _out_dir(args, design_path: str) -> Path:
 
 
 def _angle_tag(deg: float) -> str:
-    return f"{deg:+08.3f}".replace("+", "p").replace("-", "m").replace(".", "_")
+    # angles closer than the tag's 1e-3 deg resolution share a file name: keep 6 decimals then
+    tag = f"{deg:+08.3f}"
+    if abs(round(deg, 3) - deg) > 1e-9:
+        tag = f"{deg:+011.6f}"
+    return tag.replace("+", "p").replace("-", "m").replace(".", "_")
 
 
 def _circle(radius: float, tol: float):
@@ -84,7 +91,7 @@ def deformed_scene(drive, phi_h_abs: float) -> dict:
     import numpy as np
 
     from .kinematics import gear_ratios
-    from .placement import deformed_curve, place_flex_teeth, tooth_angles
+    from .placement import deformed_curve, join_teeth, place_flex_teeth, tooth_angles
 
     d = drive.design.drive
     ratios = gear_ratios(d.z_flex, d.z_rigid)
@@ -93,8 +100,7 @@ def deformed_scene(drive, phi_h_abs: float) -> dict:
     else:  # flexspline fixed: the rigid gear turns by phi_h / u_hb; draw in the flexspline's frame
         phi_b = phi_h_abs / ratios["u_hb"]
         phi_h, frame = phi_h_abs - phi_b, phi_b
-    local = drive.flex.period[:-1]
-    teeth = place_flex_teeth(drive, phi_h, local=local)
+    teeth = place_flex_teeth(drive, phi_h, local=drive.flex.period)
     _, phi = tooth_angles(d.z_flex, d.z_rigid, phi_h)
     n_rim = max(720, int(np.ceil(2 * np.pi / np.sqrt(8 * drive.tol / drive.r_m))))
     ph = np.linspace(0.0, 2 * np.pi, n_rim, endpoint=False)
@@ -106,10 +112,31 @@ def deformed_scene(drive, phi_h_abs: float) -> dict:
         return np.stack([c * p[..., 0] - s * p[..., 1], s * p[..., 0] + c * p[..., 1]], axis=-1)
 
     teeth = rot(teeth, frame)
+    outline = join_teeth(teeth)
+    import shapely
+
+    if not shapely.LinearRing(outline).is_simple:
+        from .errors import GeometryError
+
+        raise GeometryError(f"deformed flexspline outline at generator angle {np.rad2deg(phi_h_abs):g} deg is not simple")
+    # how far toward the minor axis the tips still overlap the rigid tip circle (close-up extent)
+    R = np.hypot(teeth[..., 0], teeth[..., 1])
+    over = (R.min(axis=1) < drive.rigid.r_a) if drive.external else (R.max(axis=1) > drive.rigid.r_a)
+    phw = (phi + np.pi) % (2 * np.pi) - np.pi
+    side = phw * (1.0 if d.rotation == "ccw" else -1.0)
+    reach = side[over & (side >= 0) & (side <= np.pi / d.waves)]
+    entry_deg = float(np.rad2deg(reach.max())) + 4.0 if reach.size else 45.0
+    st = drive.law.state(ph)
     return {
         "flex_teeth": teeth,
         "flex_phi": phi,
-        "flex_outline": teeth.reshape(-1, 2),
+        "flex_outline": outline,
+        "entry_deg": min(entry_deg, 180.0 / d.waves),
+        "neutral_phi": ph + phi_h + frame,
+        "neutral_w": st.w,
+        "r_m": drive.r_m,
+        "waves": d.waves,
+        "w0": drive.law.w0,
         "flex_rim": rot(rot(rim, phi_h), frame),
         "neutral": rot(rot(neutral, phi_h), frame),
         "rigid_outline": rot(drive.rigid.outline, frame),
@@ -119,7 +146,11 @@ def deformed_scene(drive, phi_h_abs: float) -> dict:
         "r_ref": drive.rigid.r,
         "module": d.module,
         "rigid_outward": not drive.external,
-        "y_range": tuple(np.array(sorted((drive.flex.r_f, drive.rigid.r_f))) - drive.rigid.r + [-0.3 * d.module, 0.3 * d.module]),
+        # radial window of the close-up: both gears' teeth, the flexspline's moved by up to +-1.2 W0
+        "y_range": (
+            min(drive.rigid.r_a, drive.rigid.r_f, drive.flex.r_a - 1.2 * drive.law.w0, drive.flex.r_f - 1.2 * drive.law.w0) - drive.rigid.r - 0.2 * d.module,
+            max(drive.rigid.r_a, drive.rigid.r_f, drive.flex.r_a + 1.2 * drive.law.w0, drive.flex.r_f + 1.2 * drive.law.w0) - drive.rigid.r + 0.2 * d.module,
+        ),
     }
 
 
@@ -180,7 +211,10 @@ def cmd_generate(args) -> int:
             path = out / f"{stem}_phi{tag}.dxf"
             write_dxf(batch.temp_path(path), dl)
             files.append(path)
-            png = assembly_png(scene, f"{design.drive.name}: generator at {deg:g} deg ({design.generator.law} law, W0 = {design.w0:.3f} mm)")
+            png = assembly_png(scene, f"{design.drive.name}: generator at {deg:g} deg counter-clockwise from +x "
+                                      f"({design.generator.law} law, W0 = {design.w0:.3f} mm"
+                                      + (", generator's centre section)" if drive.coned else ")"),
+                               entry_deg=scene["entry_deg"])
             path = out / f"{stem}_phi{tag}.png"
             Path(batch.temp_path(path)).write_bytes(png)
             files.append(path)
@@ -215,7 +249,9 @@ def cmd_kinematics(args) -> int:
     print(f"{d.name}")
     print(f"  rigid gear fixed:      u_hg = {r['u_hg']:g}  (flexspline turns {sense(r['u_hg'])})")
     print(f"  flexspline fixed:      u_hb = {r['u_hb']:g}  (rigid gear turns {sense(r['u_hb'])})")
-    print(f"  mesh period (perfect gears): {360.0 / d.z_rigid:.6g} deg of generator rotation")
+    z_ref = d.z_rigid if d.fixed == "rigid" else d.z_flex
+    print(f"  mesh period (perfect gears): {360.0 / z_ref:.6g} deg of generator rotation "
+          f"(the {'rigid' if d.fixed == 'rigid' else 'flexspline'} teeth pass one pitch)")
     if not design.external:
         return EXIT_OK
     from .export.atomic import atomic_batch, ensure_writable_dir
@@ -266,6 +302,174 @@ def cmd_kinematics(args) -> int:
     return EXIT_OK
 
 
+class _Progress:
+    """A one-line progress bar on stderr, only when stderr is a terminal (or forced)."""
+
+    def __init__(self, enabled: bool):
+        self.enabled = enabled
+
+    def __call__(self, done, total, stage):
+        if self.enabled:
+            n = int(30 * done / total)
+            sys.stderr.write(f"\r[{'#' * n}{'.' * (30 - n)}] {stage:<12s}")
+            sys.stderr.flush()
+            if done == total:
+                sys.stderr.write("\n")
+
+
+def _audit_summary(name: str, res: dict) -> str:
+    w = res["worst"]
+    where = f"tooth {w['tooth']} at generator angle {w['generator_angle_deg']:.3f} deg (tooth {w['tooth_angle_deg']:+.3f} deg from the major axis)"
+    if w["section_z_mm"] is not None:
+        where += f", section z = {w['section_z_mm']:g} mm"
+    lines = [f"{name}: clearance audit ({res['settings']['engine']} engine)"]
+    lines.append(f"  minimum clearance: {res['min_clearance_um']:.3f} um, {w['location']}, {where}")
+    if res["interference"]:
+        lines.append(f"  INTERFERENCE: penetration {-res['min_clearance_um']:.3f} um deeper than the tolerance "
+                     f"{res['interference_tol_um']:g} um (overlap area {w['overlap_area_um2']:.1f} um^2)")
+    elif res["min_clearance_um"] < res["interference_tol_um"]:
+        lines.append(f"  contact within the tolerance ({res['interference_tol_um']:g} um): no interference")
+    else:
+        lines.append("  no interference")
+    e = res["entry"]
+    if res["entry_gap_um"] is not None:
+        sec = "" if e["section_z_mm"] is None else f", section z = {e['section_z_mm']:g} mm"
+        lines.append(f"  entry gap: {res['entry_gap_um']:.3f} um at tooth angle {e['tooth_angle_deg']:+.3f} deg{sec} "
+                     "(flexspline tip crossing the rigid tip circle)")
+        psec = "" if e["pinch_section_z_mm"] is None else f", section z = {e['pinch_section_z_mm']:g} mm"
+        lines.append(f"  entry pinch: {e['pinch_um']:.3f} um at tooth angle {e['pinch_tooth_angle_deg']:+.3f} deg{psec}, {e['pinch_location']}"
+                     + ("  TIP-TO-TIP RISK" if e["tip_to_tip_risk"] else ""))
+    else:
+        lines.append("  entry gap: none (the tips never cross the rigid tip circle)")
+    b = res["backlash_at"]
+    if res["backlash_arcmin"] is None:
+        lines.append(f"  backlash: none, teeth interfere at generator angle {b['generator_angle_deg']:g} deg")
+    else:
+        lines.append(f"  backlash: {res['backlash_arcmin']:.4f} arcmin = {res['backlash_um_at_pitch']:.2f} um at the rigid pitch circle "
+                     f"(generator angle {b['generator_angle_deg']:g} deg)")
+    c = res["counts"]
+    lines.append(f"  computed {c['evaluated']} of {c['samples']} tooth samples exactly "
+                 f"({c['unique_tooth_angles']} distinct tooth angles, {c['culled']} culled by radius) in {res['elapsed_s']:.3f} s")
+    return "\n".join(lines)
+
+
+def cmd_audit(args) -> int:
+    from .audit import RunSettings, run_audit
+    from .export.atomic import atomic_batch, ensure_writable_dir
+    from .regression import baseline_figures, compare, format_drifts, load_baseline, make_baseline
+
+    base = load_baseline(args.baseline) if args.baseline else None
+    if base is not None:
+        st = base["settings"]
+        rs = RunSettings(step_deg=float(st["step_deg"]), sections=int(st["sections"]),
+                         chord_tol_um=float(st["chord_tol_um"]), interference_tol_um=float(st["interference_tol_um"]))
+    else:
+        step = 360.0 / args.angles if args.angles else args.step_deg
+        off = args.no_shortcuts
+        rs = RunSettings(step_deg=step, sections=args.sections, chord_tol_um=args.chord_tol_um,
+                         interference_tol_um=args.interference_tol_um,
+                         use_period=not (off or args.no_mesh_period), use_waves=not (off or args.no_wave_symmetry),
+                         use_mirror=not (off or args.no_mirror), cull=not (off or args.no_culling),
+                         bound=not (off or args.no_bound))
+    rs.check()
+    for path in (args.json, args.plot, args.write_baseline):
+        if path:
+            ensure_writable_dir(Path(path).parent if str(Path(path).parent) else Path("."))
+    drive, result = run_audit(args.design, rs, progress=_Progress(args.progress or sys.stderr.isatty()))
+    res = result.to_json()
+    res["design"] = drive.design.drive.name
+    res["source"] = drive.design.source
+    if args.engine in ("fcl", "both"):
+        from .clearance.fcl3d import verify_worst
+
+        res["fcl"] = verify_worst(drive, result)
+        if args.engine == "fcl":
+            res["settings"]["engine"] = "fcl (3D check of the pairs the 2D engine singles out)"
+        else:
+            res["settings"]["engine"] = "2d + fcl"
+    drifts = None
+    if base is not None:
+        drifts = compare(base, baseline_figures(drive, res))
+        res["baseline"] = {"path": str(args.baseline), "drifts": [d.__dict__ for d in drifts]}
+    with atomic_batch() as batch:
+        if args.json:
+            Path(batch.temp_path(args.json)).write_text(json.dumps(res, indent=2) + "\n")
+        if args.write_baseline:
+            doc = make_baseline(str(args.design), {k: v for k, v in rs.as_dict().items()
+                                                    if k in ("step_deg", "sections", "chord_tol_um", "interference_tol_um")},
+                                drive, res)
+            Path(batch.temp_path(args.write_baseline)).write_text(json.dumps(doc, indent=2) + "\n")
+        if args.plot:
+            for suffix, png in _audit_pngs(drive, result):
+                p = Path(args.plot)
+                Path(batch.temp_path(p.with_name(f"{p.stem}_{suffix}.png"))).write_bytes(png)
+    if not args.quiet:
+        print(_audit_summary(res["design"], res))
+        if "fcl" in res:
+            f = res["fcl"]
+            print(f"  FCL 3D check of the tightest pair: {f['summary']}")
+        if drifts is not None:
+            print(f"  baseline {args.baseline}: {format_drifts(drifts)}")
+    if drifts:
+        return EXIT_INTERFERENCE
+    return EXIT_INTERFERENCE if res["interference"] else EXIT_OK
+
+
+def _audit_pngs(drive, result):
+    import numpy as np
+    import shapely
+
+    from .clearance.engine import Scene, clearance_profile, clearance_vs_angle
+    from .export.figures import clearance_profile_png, clearance_vs_angle_png, tightest_spot_png
+    from .placement import tooth_pose, transform
+
+    scene = Scene(drive)
+    secs = [None] if not drive.coned else [s for s in result.settings["sections_z_mm"]]
+    prof = clearance_profile(scene, secs)
+    w = result.worst
+    e = result.entry
+    name = drive.design.drive.name
+    data = {
+        "phi_deg": np.rad2deg(prof["phi"]),
+        "sections": [{"z": s["z"], "working_um": 1e3 * s["working"], "nonworking_um": 1e3 * s["nonworking"]} for s in prof["sections"]],
+        "entry_deg": e["tooth_angle_deg"],
+        "entry_um": 1e3 * result.entry_gap,
+        "worst_deg": w["tooth_angle_deg"],
+        "worst_um": w["clearance_um"],
+        "tol_um": 1e3 * result.interference_tol,
+    }
+    yield "profile", clearance_profile_png(data, f"{name}: clearance of a flexspline tooth along its passage (every tooth follows it)")
+    mesh = 360.0 / drive.design.drive.z_rigid
+    ang = np.deg2rad(np.linspace(0.0, 3 * mesh, 601))
+    wv, nv = clearance_vs_angle(scene, prof, ang)
+    yield "vs_angle", clearance_vs_angle_png(np.rad2deg(ang), 1e3 * wv, 1e3 * nv, 1e3 * result.interference_tol,
+                                             f"{name}: smallest clearance over all teeth; periodic with the mesh period {mesh:.4f} deg (3 shown)")
+    # the teeth around the tightest spot, at the worst sample's generator angle and section
+    phi_h = np.deg2rad(w["generator_angle_deg"])
+    z = w["section_z_mm"]
+    d = drive.design.drive
+    k = (w["tooth"] + np.arange(-3, 4)) % d.z_flex
+    mat = 2 * np.pi * k / d.z_flex + phi_h / scene.ratios["u_hg"]
+    rot, shift = tooth_pose(scene.law(z), mat - phi_h, drive.r_m, frame_angle=phi_h)
+    teeth = transform(scene.flex_local, rot, shift)
+    lo, up, _ = scene.neighbours(shift, rot)
+    rig_idx = np.unique(np.concatenate([lo, up]))
+    rig = scene.rigid_pts[rig_idx]
+    overlaps = []
+    for t in teeth[3:4]:  # the worst tooth
+        a = shapely.Polygon(t)
+        for j in rig_idx:
+            inter = a.intersection(scene.rigid_geoms[j])
+            for g in getattr(inter, "geoms", [inter]):
+                if g.geom_type == "Polygon" and not g.is_empty:
+                    overlaps.append(np.asarray(g.exterior.coords))
+    labels = [f"{np.rad2deg(((p + np.pi) % (2 * np.pi)) - np.pi):.1f} deg" for p in (mat - phi_h)]
+    sec = "" if z is None else f", section z = {z:g} mm"
+    yield "tightest", tightest_spot_png(teeth, labels, rig, overlaps,
+                                        f"{name}: tightest spot, tooth {w['tooth']} at generator angle {w['generator_angle_deg']:g} deg{sec}: "
+                                        f"{w['clearance_um']:.2f} um ({w['location']})")
+
+
 def build_parser() -> argparse.ArgumentParser:
     p = _Parser(prog="wgcad", description="Geometry, deformation and clearance of harmonic (strain-wave) drives.",
                 epilog=EPILOG, formatter_class=argparse.RawDescriptionHelpFormatter)
@@ -284,6 +488,31 @@ def build_parser() -> argparse.ArgumentParser:
     g.add_argument("--json", action="store_true", help="print report.json to stdout instead of the summary")
     g.add_argument("--quiet", action="store_true", help="print nothing on success")
     g.set_defaults(func=cmd_generate)
+
+    a = sub.add_parser("audit", help="clearance and interference over the generator cycle; exit 1 on interference or baseline drift",
+                       epilog=EPILOG, formatter_class=argparse.RawDescriptionHelpFormatter)
+    a.add_argument("design")
+    grp = a.add_mutually_exclusive_group()
+    grp.add_argument("--angles", type=int, metavar="N", help="N generator angles over a full revolution")
+    grp.add_argument("--step-deg", type=_positive_float(0.0, 90.0, "deg"), default=0.5, help="generator-angle step, deg (default 0.5)")
+    a.add_argument("--sections", type=int, default=3, help="cross-sections over the face width when the flexspline is coned (default 3)")
+    a.add_argument("--engine", choices=("2d", "fcl", "both"), default="2d",
+                   help="2d (default); fcl/both: also check the tightest pairs with 3D solids in python-fcl")
+    a.add_argument("--chord-tol-um", type=_positive_float(0.0, 100.0, "um"), default=1.0)
+    a.add_argument("--interference-tol-um", type=float, default=1.0, help="penetration reported as contact, um (default 1)")
+    a.add_argument("--json", metavar="PATH", help="write the results as JSON")
+    a.add_argument("--plot", metavar="PATH", help="write PNGs PATH_profile.png, PATH_vs_angle.png, PATH_tightest.png (PATH without .png)")
+    a.add_argument("--write-baseline", metavar="BASE.json", help="record the key figures with their tolerances")
+    a.add_argument("--baseline", metavar="BASE.json", help="recompute with the baseline's settings; exit 1 on drift")
+    a.add_argument("--no-shortcuts", action="store_true", help="compute everything (no mesh period, symmetries, culling or bounding)")
+    a.add_argument("--no-mesh-period", action="store_true")
+    a.add_argument("--no-wave-symmetry", action="store_true")
+    a.add_argument("--no-mirror", action="store_true")
+    a.add_argument("--no-culling", action="store_true")
+    a.add_argument("--no-bound", action="store_true")
+    a.add_argument("--progress", action="store_true", help="progress bar on stderr even when it is not a terminal")
+    a.add_argument("--quiet", action="store_true")
+    a.set_defaults(func=cmd_audit)
 
     k = sub.add_parser("kinematics", help="gear ratios; velocities of the external ring generator (CSV + PNG)",
                        epilog=EPILOG, formatter_class=argparse.RawDescriptionHelpFormatter)

@@ -5,6 +5,7 @@ __all__ = [
     "MIN_TIP_THICKNESS_COEF",
     "ROOT_SPACE_MIN_COEF",
     "NEWTON_TOL",
+    "INTERFERENCE_TOL",
 ]
 
 #: Largest distance (mm) between a discretised outline and the exact curve.
@@ -25,3 +26,8 @@ ROOT_SPACE_MIN_COEF = 0.0
 #: Convergence of Newton iterations on angles and arc lengths (radians / mm).
 #: Far below the 1 nm discretisation error of any outline.
 NEWTON_TOL = 1e-13
+
+#: Penetration (mm) reported as contact rather than interference. Equal to the
+#: default chord tolerance: outlines are only known to within it, so a
+#: smaller overlap is not a finding about the design.
+INTERFERENCE_TOL = 1e-3

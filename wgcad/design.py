@@ -195,8 +195,9 @@ def validate(d: Design) -> Design:
         z = getattr(dr, key)
         if z < 8:
             raise DesignError(f"drive.{key}", f"must be at least 8 teeth, got {z}")
-    if dr.waves < 1:
-        raise DesignError("drive.waves", f"must be >= 1, got {dr.waves}")
+    if dr.waves < 2:
+        # one wave only shifts the rim off-centre; it does not deform it
+        raise DesignError("drive.waves", f"must be >= 2, got {dr.waves}")
     _positive("drive.face_width", dr.face_width)
     _choice("drive.deformation", dr.deformation, ("internal", "external"))
     _choice("drive.fixed", dr.fixed, ("rigid", "flexspline"))
@@ -235,6 +236,10 @@ def validate(d: Design) -> Design:
             raise DesignError("generator.beta_deg", f"must be in (0, 90) degrees, got {g.beta_deg:g}")
     if g.offset < 0:
         raise DesignError("generator.offset", f"must be >= 0, got {g.offset:g}")
+    if g.beta_deg is not None and g.law not in _BETA_LAWS:
+        raise DesignError("generator.beta_deg", f"is not used by the {g.law} law (only by {', '.join(_BETA_LAWS)}); remove it")
+    if g.offset != 0.0 and g.law != "ellipse":
+        raise DesignError("generator.offset", f"is used only by the ellipse law, not by {g.law}; remove it")
     if (g.cone_length is None) != (g.generator_z is None):
         raise DesignError("generator.cone_length", "cone_length and generator_z go together (both or neither)")
     if g.cone_length is not None:

@@ -12,10 +12,13 @@ from .kinematics import flex_rotation
 __all__ = [
     "tooth_angles",
     "tooth_frames",
+    "tooth_pose",
+    "transform",
     "place_points",
     "place_points_first_order",
     "place_flex_teeth",
     "deformed_curve",
+    "join_teeth",
 ]
 
 
@@ -60,6 +63,42 @@ def tooth_frames(law: Law, phi, r_m: float):
     return origin, phi + st.theta
 
 
+def transform(local: np.ndarray, rot, shift) -> np.ndarray:
+    """Rigid copies of a polygon: ``R(rot[k]) @ local + shift[k]``, ``(K, N, 2)``.
+
+    ``local`` is ``(N, 2)``, ``rot`` ``(K,)`` rad, ``shift`` ``(K, 2)`` mm.
+    """
+    rot = np.atleast_1d(np.asarray(rot, dtype=float))
+    shift = np.atleast_2d(np.asarray(shift, dtype=float))
+    c, s = np.cos(rot)[:, None], np.sin(rot)[:, None]
+    x = c * local[:, 0] - s * local[:, 1] + shift[:, 0:1]
+    y = s * local[:, 0] + c * local[:, 1] + shift[:, 1:2]
+    return np.stack([x, y], axis=-1)
+
+
+def tooth_pose(law: Law, phi, r_m: float, frame_angle=0.0):
+    """Rigid-body pose of each tooth: the tooth frame (tooth centred on +x) maps to ``R(rot) p + shift``.
+
+    A tooth point ``p`` sits at height ``d = p_x - r_m`` above the neutral
+    line and tangential offset ``s = p_y``; it goes to
+    ``R(fa) [origin + R(phi + theta) (d, s)]`` (theory.md 3.1), i.e.
+    ``rot = fa + phi + theta`` and ``shift = R(fa) origin - R(rot) (r_m, 0)``.
+
+    Returns
+    -------
+    rot : (K,) float
+    shift : (K, 2) float
+    """
+    phi = np.atleast_1d(np.asarray(phi, dtype=float))
+    origin, ang = tooth_frames(law, phi, r_m)
+    fa = np.broadcast_to(np.asarray(frame_angle, dtype=float), phi.shape)
+    rot = fa + ang
+    c, s = np.cos(fa), np.sin(fa)
+    ox = c * origin[:, 0] - s * origin[:, 1] - r_m * np.cos(rot)
+    oy = s * origin[:, 0] + c * origin[:, 1] - r_m * np.sin(rot)
+    return rot, np.stack([ox, oy], axis=-1)
+
+
 def place_points(local: np.ndarray, law: Law, phi, r_m: float, frame_angle=0.0) -> np.ndarray:
     """Exact placement: each tooth outline turned with its rim cross-section (theory.md 3.1).
 
@@ -76,20 +115,7 @@ def place_points(local: np.ndarray, law: Law, phi, r_m: float, frame_angle=0.0) 
     -------
     (K, N, 2) float
     """
-    phi = np.atleast_1d(np.asarray(phi, dtype=float))
-    origin, ang = tooth_frames(law, phi, r_m)
-    # tooth point = neutral point + (d, s) turned by phi + theta, with d = x - r_m, s = y
-    d = local[:, 0] - r_m
-    s = local[:, 1]
-    c, sn = np.cos(ang)[:, None], np.sin(ang)[:, None]
-    px = origin[:, 0:1] + d * c - s * sn
-    py = origin[:, 1:2] + d * sn + s * c
-    out = np.stack([px, py], axis=-1)
-    fa = np.broadcast_to(np.asarray(frame_angle, dtype=float), phi.shape)
-    if np.any(fa != 0):
-        cf, sf = np.cos(fa)[:, None], np.sin(fa)[:, None]
-        out = np.stack([cf * out[..., 0] - sf * out[..., 1], sf * out[..., 0] + cf * out[..., 1]], axis=-1)
-    return out
+    return transform(local, *tooth_pose(law, phi, r_m, frame_angle))
 
 
 def place_points_first_order(local: np.ndarray, law: Law, phi, r_m: float, centreline: bool = False) -> np.ndarray:
@@ -148,3 +174,59 @@ def deformed_curve(law: Law, r_m: float, d: float, phi) -> np.ndarray:
     """Points ``(K, 2)`` of the rim line at height ``d`` above the neutral line (``d = 0``: neutral line), generator frame."""
     origin, ang = tooth_frames(law, phi, r_m)
     return origin + d * np.stack([np.cos(ang), np.sin(ang)], axis=-1)
+
+
+def _crossing(tail: np.ndarray, head: np.ndarray):
+    """First crossing of polyline ``tail`` with polyline ``head``: (tail segment, head segment, point) or None."""
+    p0, p1 = tail[:-1, None, :], tail[1:, None, :]
+    q0, q1 = head[None, :-1, :], head[None, 1:, :]
+    r, sv = p1 - p0, q1 - q0
+    den = r[..., 0] * sv[..., 1] - r[..., 1] * sv[..., 0]
+    qp = q0 - p0
+    with np.errstate(divide="ignore", invalid="ignore"):
+        t = (qp[..., 0] * sv[..., 1] - qp[..., 1] * sv[..., 0]) / den
+        u = (qp[..., 0] * r[..., 1] - qp[..., 1] * r[..., 0]) / den
+    ok = (den != 0) & (t >= 0) & (t <= 1) & (u >= 0) & (u <= 1)
+    # a shared end point is a junction, not a crossing
+    ok &= ~((t == 1) & (u == 0))
+    if not ok.any():
+        return None
+    i, j = np.argwhere(ok)[0]
+    return int(i), int(j), (p0[i, 0] + t[i, j] * r[i, 0])
+
+
+def join_teeth(teeth: np.ndarray, m: int = 6) -> np.ndarray:
+    """One closed outline ``(M, 2)`` from placed pitches ``(K, N, 2)``, each from space centre to space centre.
+
+    Neighbouring teeth turn by slightly different angles, so their root ends
+    either leave a sub-micrometre gap (joined straight) or cross (pointed
+    cycloidal roots): there both are cut at the crossing, which keeps the
+    outline simple.
+    """
+    K, N, _ = teeth.shape
+    first = [0] * K  # first kept vertex index of each tooth
+    last = [N - 1] * K  # last kept vertex index
+    lead = [None] * K  # point that starts a tooth (a crossing)
+    trail = [None] * K  # point that ends a tooth
+    for k in range(K):
+        nk = (k + 1) % K
+        hit = _crossing(teeth[k][N - m :], teeth[nk][:m])
+        if hit is not None:
+            i, j, p = hit
+            last[k], trail[k] = N - m + i, p
+            first[nk], lead[nk] = j + 1, p
+    out = []
+    for k in range(K):
+        part = teeth[k][first[k] : last[k] + 1]
+        if lead[k] is not None:
+            part = np.vstack([lead[k], part])
+        if trail[k] is not None:
+            part = np.vstack([part, trail[k]])
+        out.append(part)
+    pts = np.vstack(out)
+    keep = np.ones(len(pts), dtype=bool)
+    keep[1:] = np.hypot(*np.diff(pts, axis=0).T) > 1e-9
+    pts = pts[keep]
+    if np.hypot(*(pts[-1] - pts[0])) <= 1e-9:
+        pts = pts[:-1]
+    return pts

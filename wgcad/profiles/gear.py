@@ -113,6 +113,23 @@ class Gear:
         radius = np.asarray(radius, dtype=float)
         return 2.0 * pi * radius / self.spec.z - self.tooth_thickness(radius)
 
+    def tooth_polygon(self, depth: float | None = None) -> np.ndarray:
+        """One tooth as a closed polygon ``(n, 2)``, tooth frame, counter-clockwise.
+
+        :attr:`period` (space centre to space centre across the tooth), closed
+        radially through the gear body ``depth`` beyond the root circle
+        (default half a module): a chord would cut the root arcs of an
+        internal gear.
+        """
+        depth = 0.5 * self.spec.module if depth is None else depth
+        r_body = self.r_f + depth if self.spec.internal else self.r_f - depth
+        a = pi / self.spec.z
+        ends = polar(r_body, np.array([a, -a]))
+        poly = np.concatenate([self.period, ends])
+        if self.spec.internal:
+            poly = poly[::-1]  # the period runs clockwise around an internal gear's tooth
+        return np.ascontiguousarray(poly)
+
     def area(self) -> float:
         """Area enclosed by :attr:`outline` (shoelace), mm^2."""
         x, y = self.outline[:, 0], self.outline[:, 1]

@@ -1,0 +1,69 @@
+"""Design file -> drive -> clearance audit, with the settings a run (or a baseline) names."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from .clearance.engine import AuditResult, AuditSettings, audit
+from .design import load_design
+from .drive import build_drive
+from .errors import DesignError
+
+__all__ = ["RunSettings", "run_audit"]
+
+
+@dataclass(frozen=True)
+class RunSettings:
+    """Settings of an audit run as a user gives them (units in the names)."""
+
+    step_deg: float = 0.5  # generator-angle step over one full revolution
+    sections: int = 3  # cross-sections over the face width (used when the flexspline is coned)
+    chord_tol_um: float = 1.0
+    interference_tol_um: float = 1.0
+    use_period: bool = True
+    use_waves: bool = True
+    use_mirror: bool = True
+    cull: bool = True
+    bound: bool = True
+
+    def as_dict(self) -> dict:
+        return dict(self.__dict__)
+
+    def check(self) -> "RunSettings":
+        if not 0.0 < self.step_deg <= 90.0:
+            raise DesignError("--step-deg", f"must be in (0, 90] degrees, got {self.step_deg:g}")
+        if not 1 <= self.sections <= 200:
+            raise DesignError("--sections", f"must be 1..200, got {self.sections}")
+        if not 0.0 < self.chord_tol_um <= 100.0:
+            raise DesignError("--chord-tol-um", f"must be in (0, 100] um, got {self.chord_tol_um:g}")
+        if not 0.0 <= self.interference_tol_um <= 1000.0:
+            raise DesignError("--interference-tol-um", f"must be in [0, 1000] um, got {self.interference_tol_um:g}")
+        return self
+
+
+def run_audit(design_path, rs: RunSettings, progress=None):
+    """Load, build and audit a design over a full generator revolution.
+
+    Returns
+    -------
+    drive : wgcad.drive.Drive
+    result : AuditResult
+    """
+    rs.check()
+    design = load_design(design_path)
+    drive = build_drive(design, tol=rs.chord_tol_um * 1e-3)
+    n = int(round(360.0 / rs.step_deg))
+    angles = np.deg2rad(np.arange(n) * (360.0 / n))
+    settings = AuditSettings(
+        angles=angles,
+        sections=drive.sections(rs.sections),
+        use_period=rs.use_period,
+        use_waves=rs.use_waves,
+        use_mirror=rs.use_mirror,
+        cull=rs.cull,
+        bound=rs.bound,
+        interference_tol=rs.interference_tol_um * 1e-3,
+    )
+    return drive, audit(drive, settings, progress=progress)

@@ -1,0 +1,667 @@
+"""The 2D clearance engine: every flexspline tooth against its nearest rigid teeth over generator angles and sections (theory.md 5, 7).
+
+Why it can skip work (each switchable, each tested against the full computation):
+
+* **mesh period** (theory.md 7): for perfect gears the state of a tooth
+  depends only on its angle ``phi`` from the generator's major axis. A tooth
+  at ``phi`` has its material angle at ``phi (z_b - z_g)/z_b`` modulo a rigid
+  pitch, so every (generator angle, tooth) sample is a sample of one
+  function ``c(phi)`` per section, and equal ``phi`` need one evaluation.
+* **identical waves**: ``c`` is periodic in ``2 pi / n_w`` (the law is, and
+  a wave shifts the rigid teeth by ``(z_b - z_g)/n_w`` whole pitches), so
+  ``phi`` folds into one wave. With tooth counts that are multiples of
+  ``n_w`` the folded samples coincide; with odd counts they interleave.
+* **mirror symmetry**: teeth are symmetric and every deformation law is
+  even in ``phi``, and a tooth at ``-phi`` sits at ``-phi (z_b - z_g)/z_b``
+  against the rigid teeth: the scene at ``-phi`` is the mirror image of the
+  one at ``phi``, so ``c(-phi) = c(phi)`` with the two flanks swapped.
+* **culling**: a tooth whose outermost point is inside the rigid tip circle
+  (internal deformation) is radially separated from all rigid material by
+  at least the gap between the two radii; it is evaluated only if that
+  bound is below the minimum found. The third-nearest rigid tooth is
+  evaluated only where ``2 R sin(dphi/2)`` does not already exceed the
+  clearance to the two bracketing teeth.
+* **branch and bound**: ``c`` is Lipschitz in ``phi`` (a rigid motion moves
+  the tooth by at most ``V dphi``, ``V`` the largest vertex speed), so a
+  sample between two evaluated ones is bounded below by
+  ``max(c_i - V |phi - phi_i|)``; only samples whose bound is below the
+  running minimum are evaluated, on successively finer strides.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field
+from math import pi
+
+import numpy as np
+import shapely
+from scipy.optimize import brentq
+
+from .. import constants
+from ..kinematics import gear_ratios
+from ..placement import tooth_frames, tooth_pose, transform
+from .distance import Template, signed_clearance
+
+__all__ = ["AuditSettings", "AuditResult", "Scene", "tooth_clearance", "audit", "brute_force_min"]
+
+
+@dataclass(frozen=True)
+class AuditSettings:
+    """What an audit computes.
+
+    Attributes
+    ----------
+    angles : (A,) float
+        Generator angles relative to the rigid gear, rad.
+    sections : (S,) float
+        Axial positions of the cross-sections, mm from the open end.
+    use_period, use_waves, use_mirror, cull, bound : bool
+        The work-skipping shortcuts (module docstring); all on by default.
+    interference_tol : float
+        Penetration (mm) reported as contact rather than interference.
+    """
+
+    angles: np.ndarray
+    sections: np.ndarray
+    use_period: bool = True
+    use_waves: bool = True
+    use_mirror: bool = True
+    cull: bool = True
+    bound: bool = True
+    interference_tol: float = constants.INTERFERENCE_TOL
+
+
+class Scene:
+    """Static data of a drive for clearance queries: tooth templates and rigid teeth (rigid-gear frame)."""
+
+    def __init__(self, drive):
+        self.drive = drive
+        d = drive.design.drive
+        self.z_g, self.z_b, self.n_w = d.z_flex, d.z_rigid, d.waves
+        self.gamma_b = 2.0 * pi / self.z_b
+        self.flex = Template(drive.flex.tooth_polygon())
+        self.flex_local = self.flex.local
+        # the vertices that can be a tooth's outermost (innermost, external deformation)
+        # point: enough for the radial bound, which is then exact for the polygon
+        R_loc = np.hypot(self.flex_local[:, 0], self.flex_local[:, 1])
+        g = drive.flex
+        near_tip = np.abs(R_loc - g.r_a) <= 0.5 * abs(g.r_a - g.r_f)
+        self.flex_tip_local = np.ascontiguousarray(self.flex_local[near_tip])
+        self.rigid = Template(drive.rigid.tooth_polygon())
+        self.rigid_rot = (np.arange(self.z_b) + 0.5) * self.gamma_b  # tooth centres: the space is on +x
+        self.rigid_shift = np.zeros((self.z_b, 2))
+        self.rigid_pts = transform(self.rigid.local, self.rigid_rot, self.rigid_shift)
+        self.rigid_pts.setflags(write=False)
+        self.rigid_geoms = shapely.polygons(self.rigid_pts)
+        shapely.prepare(self.rigid_geoms)
+        self.external = drive.external
+        self.r_tip_b = drive.rigid.r_a
+        self.ratios = gear_ratios(self.z_g, self.z_b)
+        rot = 1.0 if d.rotation == "ccw" else -1.0
+        # Relative motion of the flexspline against the rigid gear has the sign of
+        # rot / u_hg. The rigid teeth drive the flexspline (or are driven by it)
+        # through the flank that faces against that motion: the working flank.
+        rel = rot / self.ratios["u_hg"]
+        self.working = "upper" if rel < 0 else "lower"
+        self.entry_sign = rot  # teeth enter engagement on the side the generator turns toward
+        self._laws = {}
+
+    def law(self, z):
+        if z is None:
+            return self.drive.law
+        if z not in self._laws:
+            self._laws[z] = self.drive.law_at(z)
+        return self._laws[z]
+
+    def pose(self, phi: np.ndarray, z=None):
+        """Pose (rotation, shift) of a tooth at angle ``phi`` from the major axis, rigid frame.
+
+        The generator angle is the one that brings a tooth to ``phi`` with its
+        material angle at ``phi (z_b - z_g)/z_b``: by the mesh period every
+        tooth at ``phi`` is congruent to this one relative to the rigid teeth.
+        """
+        phi = np.atleast_1d(np.asarray(phi, dtype=float))
+        mat = phi * (self.z_b - self.z_g) / self.z_b
+        return tooth_pose(self.law(z), phi, self.drive.r_m, frame_angle=mat - phi)
+
+    def place(self, phi: np.ndarray, z=None, local=None) -> np.ndarray:
+        """Tooth polygons at tooth angles ``phi``, rigid frame, ``(K, N, 2)``."""
+        return transform(self.flex_local if local is None else local, *self.pose(phi, z))
+
+    def neighbours(self, shift: np.ndarray, rot: np.ndarray):
+        """Indices of the rigid teeth below and above each placed tooth (by the angle of its centre line), and the third nearest."""
+        c = self.drive.r_m  # a point on the tooth's centre line
+        x = shift[:, 0] + c * np.cos(rot)
+        y = shift[:, 1] + c * np.sin(rot)
+        a = np.arctan2(y, x)
+        f = a / self.gamma_b - 0.5
+        lo = np.floor(f).astype(int)
+        third = np.where(f - lo < 0.5, lo - 1, lo + 2)
+        return lo % self.z_b, (lo + 1) % self.z_b, third % self.z_b
+
+    def radial_bound(self, pts: np.ndarray) -> np.ndarray:
+        """Lower bound of the clearance from radii alone: > 0 when the tooth cannot reach rigid material."""
+        R = np.hypot(pts[..., 0], pts[..., 1])
+        return R.min(axis=1) - self.r_tip_b if self.external else self.r_tip_b - R.max(axis=1)
+
+    def clearance_to(self, rot, shift, j, area: bool = False):
+        """Signed clearance of flexspline teeth at poses ``(rot, shift)`` to rigid teeth ``j``."""
+        return signed_clearance(self.flex, rot, shift, self.rigid, self.rigid_rot[j], self.rigid_shift[j],
+                                b_geoms=self.rigid_geoms[j], area=area)
+
+
+def tooth_clearance(scene: Scene, phi, z=None, third: bool = True, area: bool = False) -> dict:
+    """Signed clearance of a tooth at angles ``phi`` to the rigid teeth below and above it (and the third nearest).
+
+    Returns
+    -------
+    dict of (K,) arrays: ``lower``, ``upper``, ``third`` (mm, negative =
+    penetration depth), ``min``, ``lo``/``up`` rigid tooth indices, and with
+    ``area`` the overlap areas ``lower_area``, ``upper_area``.
+    """
+    phi = np.atleast_1d(np.asarray(phi, dtype=float))
+    rot, shift = scene.pose(phi, z)
+    lo, up, th = scene.neighbours(shift, rot)
+    out = {}
+    for key, idx in (("lower", lo), ("upper", up)):
+        res = scene.clearance_to(rot, shift, idx, area=area)
+        if area:
+            out[key], out[f"{key}_area"] = res
+        else:
+            out[key] = res
+    best = np.minimum(out["lower"], out["upper"])
+    out["third"] = np.full(len(phi), np.inf)
+    if third:
+        # the third tooth lies beyond a bracketing one: 2 R sin(dphi/2) bounds its distance,
+        # with dphi the angular gap between the tooth and the third tooth's flank extent
+        pts = transform(scene.flex_local, rot, shift)
+        R = np.hypot(pts[..., 0], pts[..., 1])
+        ang = np.arctan2(pts[..., 1], pts[..., 0])
+        tc = scene.rigid_rot[th]
+        gap = np.abs((ang - tc[:, None] + pi) % (2 * pi) - pi).min(axis=1) - pi / scene.z_b
+        r_lo = np.minimum(R.min(axis=1), scene.drive.rigid.r_a if not scene.external else scene.drive.rigid.r_f)
+        lb = 2.0 * r_lo * np.sin(np.clip(gap, 0.0, None) / 2.0)
+        need = np.nonzero(lb < best)[0]
+        if need.size:
+            out["third"][need] = scene.clearance_to(rot[need], shift[need], th[need])
+    out["min"] = np.minimum(best, out["third"])
+    out["lo"], out["up"] = lo, up
+    return out
+
+
+def _sample_phi(scene: Scene, angles: np.ndarray) -> np.ndarray:
+    """Tooth angles from the major axis for every (generator angle, tooth): ``(A, z_g)``, rad."""
+    k = np.arange(scene.z_g)
+    mat = 2 * pi * k[None, :] / scene.z_g + angles[:, None] / scene.ratios["u_hg"]
+    return mat - angles[:, None]
+
+
+def _fold(phi: np.ndarray, period: float) -> np.ndarray:
+    return (phi + 0.5 * period) % period - 0.5 * period
+
+
+class _SectionSearch:
+    """Branch and bound for the smallest sampled clearance of one section (module docstring)."""
+
+    def __init__(self, scene: Scene, phi_u: np.ndarray, z, settings: AuditSettings):
+        self.scene, self.phi, self.z, self.settings = scene, phi_u, z, settings
+        n = len(phi_u)
+        self.value = np.full(n, np.nan)
+        self.evaluated = np.zeros(n, dtype=bool)
+        self.radial = scene.radial_bound(scene.place(phi_u, z, local=scene.flex_tip_local))
+        self.lower = self.radial.copy()
+        zone = self.radial <= 0.0 if settings.cull else np.ones(n, dtype=bool)
+        self.zone_mask = zone
+        self.zone = np.nonzero(zone)[0]
+        self.culled = 0
+        self.V = 0.0
+        # bounding pays only when there are many samples: below ~1000 one batch is cheaper
+        if settings.bound and self.zone.size >= 64:
+            # largest vertex speed per unit phi (rigid frame): central differences of
+            # the placed tooth at every 8th zone sample; margin 1.5 covers the speed
+            # varying between them (it changes by a few % over 8 samples)
+            ps = phi_u[self.zone][::8]
+            h = 1e-6
+            dp = (scene.place(ps + h, z) - scene.place(ps - h, z)) / (2 * h)
+            self.V = 1.5 * float(np.hypot(dp[..., 0], dp[..., 1]).max())
+
+    def best(self) -> float:
+        return float(np.nanmin(self.value)) if self.evaluated.any() else np.inf
+
+    def evaluate(self, ix: np.ndarray) -> None:
+        if ix.size == 0:
+            return
+        res = tooth_clearance(self.scene, self.phi[ix], self.z)
+        self.value[ix] = res["min"]
+        self.lower[ix] = res["min"]
+        self.evaluated[ix] = True
+
+    def start(self) -> None:
+        """Coarse pass: every sample when bounding is off or the zone is small, else every ``stride``-th."""
+        self.stride = max(1, min(256, self.zone.size // 16))
+        if not self.settings.bound or self.V == 0.0:
+            self.evaluate(self.zone)
+        else:
+            self.evaluate(self.zone[:: self.stride])
+
+    def _bounds(self, cand: np.ndarray) -> np.ndarray:
+        zi, pz = self.zone, self.phi[self.zone]
+        ev = np.nonzero(self.evaluated[zi])[0]
+        pos = np.searchsorted(ev, cand)
+        left = ev[np.clip(pos - 1, 0, len(ev) - 1)]
+        right = ev[np.clip(pos, 0, len(ev) - 1)]
+        vl = self.value[zi[left]] - self.V * np.abs(pz[cand] - pz[left])
+        vr = self.value[zi[right]] - self.V * np.abs(pz[right] - pz[cand])
+        lb = np.maximum(np.maximum(vl, vr), self.lower[zi[cand]])
+        self.lower[zi[cand]] = lb
+        return lb
+
+    def refine(self, stride: int, best: float) -> float:
+        """Evaluate the samples on this stride whose bound is below ``best``; return the new best."""
+        if self.V == 0.0 or stride >= self.stride:
+            return min(best, self.best())
+        cand = np.arange(0, self.zone.size, stride)
+        cand = cand[~self.evaluated[self.zone[cand]]]
+        if cand.size == 0:
+            return min(best, self.best())
+        lb = self._bounds(cand)
+        order = np.argsort(lb)  # most promising first, so the running minimum prunes the rest
+        cand, lb = cand[order], lb[order]
+        for start in range(0, len(cand), 256):
+            best = min(best, self.best())
+            chunk = cand[start : start + 256][lb[start : start + 256] < best]
+            if chunk.size == 0:
+                break
+            self.evaluate(self.zone[chunk])
+        return min(best, self.best())
+
+    def finish(self, best: float) -> float:
+        """Culled samples: evaluate any whose radial bound does not clear ``best``."""
+        out = np.nonzero(~self.zone_mask)[0]
+        need = out[self.radial[out] < best]
+        self.evaluate(need)
+        self.culled = int(out.size - need.size)
+        return min(best, self.best())
+
+
+@dataclass
+class AuditResult:
+    """Figures of an audit (lengths mm, angles rad inside; :meth:`to_json` converts at the edge)."""
+
+    settings: dict
+    min_clearance: float
+    worst: dict
+    entry_gap: float
+    entry: dict
+    backlash: float
+    backlash_range: dict
+    interference: bool
+    interference_tol: float
+    counts: dict
+    settings_angles: np.ndarray = field(default_factory=lambda: np.zeros(0), repr=False)
+    elapsed_s: float = 0.0
+
+    def to_json(self) -> dict:
+        r_b = self.settings["rigid_pitch_radius_mm"]
+        return {
+            "min_clearance_um": round(1e3 * self.min_clearance, 4),
+            "entry_gap_um": round(1e3 * self.entry_gap, 4) if np.isfinite(self.entry_gap) else None,
+            "backlash_arcmin": None if not np.isfinite(self.backlash) else round(float(np.rad2deg(self.backlash) * 60.0), 5),
+            "backlash_um_at_pitch": None if not np.isfinite(self.backlash) else round(1e3 * self.backlash * r_b, 4),
+            "backlash_at": self.backlash_range,
+            "interference": bool(self.interference),
+            "interference_tol_um": round(1e3 * self.interference_tol, 4),
+            "worst": self.worst,
+            "entry": self.entry,
+            "settings": self.settings,
+            "counts": self.counts,
+            "elapsed_s": round(self.elapsed_s, 4),
+        }
+
+
+def _classify(scene: Scene, pts: np.ndarray, rigid_idx: int, phi: float, z) -> str:
+    """Where on the flexspline tooth the closest approach lies: tip, working/non-working flank, root."""
+    a = shapely.Polygon(pts)
+    b = scene.rigid_geoms[rigid_idx]
+    if a.intersects(b):
+        inter = a.intersection(b)
+        p = np.asarray(inter.representative_point().coords[0]) if not inter.is_empty else np.asarray(pts[0])
+    else:
+        p = np.asarray(shapely.shortest_line(a, b).coords[0])
+    # back to the tooth frame: undo the frame rotation, the tooth rotation and translation
+    law = scene.law(z)
+    mat = phi * (scene.z_b - scene.z_g) / scene.z_b
+    origin, ang = tooth_frames(law, np.array([phi]), scene.drive.r_m)
+    fr = mat - phi
+    c, s = np.cos(-fr), np.sin(-fr)
+    q = np.array([c * p[0] - s * p[1], s * p[0] + c * p[1]]) - origin[0]
+    c, s = np.cos(-ang[0]), np.sin(-ang[0])
+    loc = np.array([c * q[0] - s * q[1], s * q[0] + c * q[1]]) + [scene.drive.r_m, 0.0]
+    R = float(np.hypot(*loc))
+    g = scene.drive.flex
+    m = g.spec.module
+    tip_zone = abs(R - g.r_a) < 0.05 * m
+    root_zone = abs(R - g.r_f) < (g.spec.fillet_coef + 0.05) * m if g.spec.form == "involute" else abs(R - g.r_f) < 0.05 * m
+    if tip_zone:
+        return "tip"
+    if root_zone:
+        return "root"
+    side = "upper" if loc[1] > 0 else "lower"
+    return "working flank" if side == scene.working else "non-working flank"
+
+
+def entry_gap(scene: Scene, z) -> tuple[float, float]:
+    """Entry gap (theory.md 5): clearance when the tooth's tip crosses the rigid tip circle on the entry side.
+
+    Returns ``(gap mm, phi rad)``; the crossing is solved to 1e-13 rad.
+    """
+    sgn = scene.entry_sign
+    half = pi / scene.n_w
+
+    tip = scene.flex_tip_local
+
+    def f(p):
+        return scene.radial_bound(scene.place(sgn * p, z, local=tip))
+
+    # radial overlap near the major axis (f <= 0), separation toward the minor axis
+    # (f > 0): bracket the first crossing on a grid, then shrink the bracket by
+    # vectorised grids (x180 per level) to below 1e-12 rad
+    lo_, hi_ = 0.0, half
+    grid = np.linspace(lo_, hi_, 181)
+    vals = f(grid)
+    cross = np.nonzero((vals[:-1] <= 0) & (vals[1:] > 0))[0]
+    if cross.size == 0:
+        return float("nan"), float("nan")
+    lo_, hi_ = grid[cross[0]], grid[cross[0] + 1]
+    while hi_ - lo_ > 1e-12:
+        grid = np.linspace(lo_, hi_, 181)
+        vals = f(grid)
+        i = int(np.nonzero(vals > 0)[0][0])
+        lo_, hi_ = grid[max(i - 1, 0)], grid[i]
+    p_star = 0.5 * (lo_ + hi_)
+    gap = tooth_clearance(scene, np.array([sgn * p_star]), z)["min"][0]
+    return float(gap), float(sgn * p_star)
+
+
+def entry_pinch(scene: Scene, phi_star: float, z, window_deg: float = 6.0) -> tuple[float, float, str]:
+    """Smallest clearance near the entry crossing (theory.md 5: the pinch), its tooth angle and where on the tooth.
+
+    Searched over ``phi_star +- window`` on a 0.05 deg grid (a pinch is a
+    V about a degree wide), then refined by bounded minimisation between the
+    grid neighbours of the best point (to 1e-10 rad).
+    """
+    from scipy.optimize import minimize_scalar
+
+    w = np.deg2rad(window_deg)
+    grid = np.linspace(phi_star - w, phi_star + w, int(2 * window_deg / 0.05) + 1)
+    c = tooth_clearance(scene, grid, z)["min"]
+    i = int(np.argmin(c))
+    lo_, hi_ = grid[max(i - 1, 0)], grid[min(i + 1, len(grid) - 1)]
+    res = minimize_scalar(lambda p: float(tooth_clearance(scene, np.array([p]), z)["min"][0]),
+                          bounds=(lo_, hi_), method="bounded", options={"xatol": 1e-10})
+    p_min, c_min = (float(res.x), float(res.fun)) if res.fun < c[i] else (float(grid[i]), float(c[i]))
+    det = tooth_clearance(scene, np.array([p_min]), z)
+    side = "lower" if det["lower"][0] <= det["upper"][0] else "upper"
+    rot, shift = scene.pose(np.array([p_min]), z)
+    pts = transform(scene.flex_local, rot, shift)[0]
+    loc = _classify(scene, pts, int(det["lo" if side == "lower" else "up"][0]), p_min, z)
+    return c_min, p_min, loc
+
+
+def backlash(scene: Scene, phi_h: float, z=None) -> float:
+    """Dead travel at generator angle ``phi_h`` (rad): rigid-body rotation of the flexspline between contact on either side, rad.
+
+    NaN when teeth interfere at this angle (there is no dead travel).
+    Only teeth in radial overlap with the rigid teeth can touch, and a tooth
+    whose clearance ``d`` exceeds ``R_max * delta_best`` cannot touch before
+    the best found (a rotation ``delta`` moves no point further than
+    ``R_max delta``): those are skipped. One wave is enough when the waves
+    are identical.
+    """
+    k = np.arange(scene.z_g)
+    mat = 2 * pi * k / scene.z_g + phi_h / scene.ratios["u_hg"]
+    phi = mat - phi_h
+    if scene.z_g % scene.n_w == 0 and scene.z_b % scene.n_w == 0:
+        keep = np.abs(_fold(phi, 2 * pi)) <= pi / scene.n_w + 1e-12
+        phi, mat = phi[keep], mat[keep]
+    rot0, shift0 = tooth_pose(scene.law(z), phi, scene.drive.r_m, frame_angle=phi_h)
+    live = np.nonzero(scene.radial_bound(transform(scene.flex_tip_local, rot0, shift0)) <= 0.0)[0]
+    if live.size == 0:
+        return float("inf")
+    rot0, shift0 = rot0[live], shift0[live]
+    lo, up, _ = scene.neighbours(shift0, rot0)
+    r_max = float(np.hypot(*transform(scene.flex_local, rot0, shift0).reshape(-1, 2).T).max())
+
+    def turned(i, d):
+        # the tooth turned by d about the gear axis
+        c, s = np.cos(d), np.sin(d)
+        sh = shift0[i]
+        return rot0[i] + d, np.array([[c * sh[0] - s * sh[1], s * sh[0] + c * sh[1]]])
+
+    def contact_angle(i, j, direction):
+        # rotation of tooth i (in `direction`) that brings its clearance to rigid tooth j to zero
+        jj = np.array([j])
+
+        def f(d):
+            r, sh = turned(i, direction * d)
+            return float(scene.clearance_to(np.array([r]), sh, jj)[0])
+
+        f0 = f(0.0)
+        if f0 == 0.0:
+            return 0.0
+        # a rotation by d moves no point further than r_max d: f0 / r_max is the
+        # nearest the root can be; expand from there to a sign change, then brentq
+        step = max(abs(f0) / r_max, 1e-12)
+        a, b = 0.0, np.sign(f0) * step
+        fb = f(b)
+        while np.sign(fb) == np.sign(f0) and abs(b) < scene.gamma_b:
+            a, b = b, 2.0 * b
+            fb = f(b)
+        if np.sign(fb) == np.sign(f0):
+            return float("inf")
+        return brentq(f, min(a, b), max(a, b), xtol=1e-13)
+
+    sides = []
+    for idx, direction in ((up, 1.0), (lo, -1.0)):
+        d = scene.clearance_to(rot0, shift0, idx)
+        if d.min() < 0:
+            return float("nan")  # teeth interfere here: there is no dead travel
+        sides.append((idx, direction, d))
+    total = 0.0
+    for idx, direction, d in sides:
+        order = np.argsort(d)
+        best = np.inf
+        for i in order:
+            # a tooth needs at least d / r_max to touch: once that is not below
+            # the best found, no later tooth can beat it
+            if d[i] / r_max >= best:
+                break
+            best = min(best, contact_angle(int(i), int(idx[i]), direction))
+        total += best
+    return float(total)
+
+
+def audit(drive, settings: AuditSettings, progress=None) -> AuditResult:
+    """Clearance audit of a drive over generator angles and sections (2D engine).
+
+    ``progress``, if given, is called as ``progress(done, total, stage)``.
+    """
+    t0 = time.perf_counter()
+    tick = progress or (lambda done, total, stage: None)
+    scene = Scene(drive)
+    angles = np.asarray(settings.angles, dtype=float)
+    sections = [None] if not drive.coned else [float(z) for z in settings.sections]
+    phi_all = _sample_phi(scene, angles)  # (A, z_g)
+    period = 2 * pi / scene.n_w if settings.use_waves else 2 * pi
+    key = _fold(phi_all, period)
+    if settings.use_mirror:
+        key = np.abs(key)
+    n_samples = phi_all.size * len(sections)
+    if settings.use_period:
+        phi_u, inverse = np.unique(np.round(key, 12), return_inverse=True)
+    else:
+        phi_u, inverse = key.ravel(), np.arange(key.size)
+    order = np.argsort(phi_u, kind="stable")
+    phi_sorted = phi_u[order]
+    rank = np.empty_like(order)
+    rank[order] = np.arange(len(order))
+    results = [_SectionSearch(scene, phi_sorted, z, settings) for z in sections]
+    for r in results:  # coarse pass over every section first: the best of any prunes all
+        r.start()
+    best = min(r.best() for r in results)
+    for step, stride in enumerate((64, 16, 4, 1)):
+        tick(step + 1, 6, "clearance")
+        for r in results:
+            best = r.refine(stride, best)
+    for r in results:
+        best = r.finish(best)
+    # global minimum and where
+    best, where = np.inf, None
+    for si, r in enumerate(results):
+        if np.any(r.evaluated):
+            i = int(np.nanargmin(r.value))
+            if r.value[i] < best:
+                best, where = float(r.value[i]), (si, i)
+    si, i = where
+    phi_w = float(phi_sorted[i])
+    # a sample (generator angle, tooth) that realises it
+    flat = np.nonzero(rank[inverse.ravel()] == i)[0][0] if settings.use_period else int(order[i])
+    ai, k = divmod(int(flat), scene.z_g)
+    # the sample's own angle (before mirror folding): flanks are labelled on it
+    phi_w = float(_fold(phi_all.ravel()[flat], period))
+    z_w = sections[si]
+    detail = tooth_clearance(scene, np.array([phi_w]), z_w, area=True)
+    side_val = {"lower": detail["lower"][0], "upper": detail["upper"][0], "third": detail["third"][0]}
+    side = min(side_val, key=side_val.get)
+    pts = scene.place(np.array([phi_w]), z_w)[0]
+    ridx = {"lower": detail["lo"][0], "upper": detail["up"][0]}.get(side, detail["lo"][0])
+    location = _classify(scene, pts, int(ridx), phi_w, z_w)
+    area = detail.get(f"{side}_area", np.zeros(1))[0] if side != "third" else 0.0
+    worst = {
+        "clearance_um": round(1e3 * best, 4),
+        "tooth": int(k),
+        "generator_angle_deg": round(float(np.rad2deg(angles[ai])), 6),
+        "tooth_angle_deg": round(float(np.rad2deg(phi_w)), 6),
+        "section_z_mm": None if z_w is None else round(z_w, 6),
+        "location": location,
+        "overlap_area_um2": round(1e6 * float(area), 4),
+    }
+    tick(5, 6, "entry gap")
+    # entry gap: exact crossing per section
+    gaps = [(entry_gap(scene, z), z) for z in sections]
+    (eg, ephi), ez = min(gaps, key=lambda t: (np.inf if np.isnan(t[0][0]) else t[0][0]))
+    entry = {
+        "tooth_angle_deg": round(float(np.rad2deg(ephi)), 6),
+        "section_z_mm": None if ez is None else round(ez, 6),
+        "side": "entry (+phi)" if scene.entry_sign > 0 else "entry (-phi)",
+    }
+    if np.isfinite(eg):
+        # the pinch: smallest clearance around the crossing, over all sections
+        pinches = [(entry_pinch(scene, ephi, z), z) for z in sections]
+        (pc, pp, ploc), pz = min(pinches, key=lambda t: t[0][0])
+        entry.update({
+            "pinch_um": round(1e3 * pc, 4),
+            "pinch_tooth_angle_deg": round(float(np.rad2deg(pp)), 6),
+            "pinch_section_z_mm": None if pz is None else round(pz, 6),
+            "pinch_location": ploc,
+            # tip-to-tip jamming: the tooth tip meets a rigid tooth before its flank engages
+            "tip_to_tip_risk": bool(pc < settings.interference_tol and ploc == "tip"),
+        })
+    tick(6, 6, "backlash")
+    # backlash at the first requested generator angle, middle section
+    z_mid = sections[len(sections) // 2]
+    bl = [backlash(scene, float(angles[0]), z_mid)]
+    evaluated = int(sum(r.evaluated.sum() for r in results))
+    counts = {
+        "samples": int(n_samples),
+        "unique_tooth_angles": int(len(phi_u)),
+        "sections": len(sections),
+        "evaluated": evaluated,
+        "culled": int(sum(r.culled for r in results)),
+    }
+    rs = {
+        "engine": "2d",
+        "angles": int(len(angles)),
+        "angle_step_deg": round(float(np.rad2deg(np.median(np.diff(angles)))), 6) if len(angles) > 1 else None,
+        "sections_z_mm": [None if z is None else round(z, 6) for z in sections],
+        "sections_note": "identical sections (no coning): one computed" if not drive.coned else "coned: every section computed",
+        "mesh_period": bool(settings.use_period),
+        "identical_waves": bool(settings.use_waves),
+        "mirror_symmetry": bool(settings.use_mirror),
+        "culling": bool(settings.cull),
+        "branch_and_bound": bool(settings.bound),
+        "chord_tol_um": round(1e3 * drive.tol, 6),
+        "working_flank": scene.working,
+        "rigid_pitch_radius_mm": drive.rigid.r,
+    }
+    res = AuditResult(
+        settings=rs,
+        min_clearance=best,
+        worst=worst,
+        entry_gap=eg,
+        entry=entry,
+        backlash=float(min(bl)),
+        backlash_range={"generator_angle_deg": round(float(np.rad2deg(angles[0])), 6), "section_z_mm": None if z_mid is None else round(z_mid, 6)},
+        interference=best < -settings.interference_tol,
+        interference_tol=settings.interference_tol,
+        counts=counts,
+        settings_angles=angles,
+    )
+    res.elapsed_s = time.perf_counter() - t0
+    return res
+
+
+def brute_force_min(drive, angles: np.ndarray, sections) -> float:
+    """Reference: every flexspline tooth against its 3 nearest rigid teeth at every angle and section, no skips."""
+    scene = Scene(drive)
+    best = np.inf
+    secs = [None] if not drive.coned else list(sections)
+    for z in secs:
+        law = scene.law(z)
+        for phi_h in np.asarray(angles, dtype=float):
+            k = np.arange(scene.z_g)
+            mat = 2 * pi * k / scene.z_g + phi_h / scene.ratios["u_hg"]
+            rot, shift = tooth_pose(law, mat - phi_h, drive.r_m, frame_angle=phi_h)
+            lo, up, th = scene.neighbours(shift, rot)
+            for idx in (lo, up, th):
+                best = min(best, float(scene.clearance_to(rot, shift, idx).min()))
+    return best
+
+
+def clearance_profile(scene: Scene, sections, step_deg: float = 0.1) -> dict:
+    """Per-tooth clearance against the tooth's angle from the major axis over one wave, per flank and section.
+
+    This is the function ``c(phi)`` every tooth follows (perfect gears,
+    theory.md 7): the picture designers reason with. Working flank: the
+    side facing the rigid tooth that carries the load (:attr:`Scene.working`).
+
+    Returns
+    -------
+    dict with ``phi`` (P,) rad and ``sections``: list of
+    ``{"z", "working", "nonworking"}`` arrays (mm).
+    """
+    half = pi / scene.n_w
+    phi = np.linspace(-half, half, int(round(2 * np.rad2deg(half) / step_deg)) + 1)
+    out = []
+    for z in sections:
+        res = tooth_clearance(scene, phi, z, third=False)
+        w, n = ("upper", "lower") if scene.working == "upper" else ("lower", "upper")
+        out.append({"z": z, "working": res[w], "nonworking": res[n]})
+    return {"phi": phi, "sections": out}
+
+
+def clearance_vs_angle(scene: Scene, profile: dict, angles: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Smallest clearance over the teeth at each generator angle, per flank (mm), read off the profile.
+
+    Each tooth's clearance at a generator angle is the profile at its tooth
+    angle (mesh period), linearly interpolated between profile points: a
+    picture, not an exact figure (the audit's minimum is exact).
+    """
+    phi = _fold(_sample_phi(scene, np.asarray(angles, dtype=float)), 2 * pi / scene.n_w)
+    w = np.full(len(angles), np.inf)
+    n = np.full(len(angles), np.inf)
+    for sec in profile["sections"]:
+        w = np.minimum(w, np.interp(phi, profile["phi"], sec["working"]).min(axis=1))
+        n = np.minimum(n, np.interp(phi, profile["phi"], sec["nonworking"]).min(axis=1))
+    return w, n

@@ -1,0 +1,42 @@
+"""Helpers for geometry regression tests in pytest: compare a design against a recorded baseline.
+
+Example
+-------
+>>> from wgcad.testing import assert_matches_baseline          # doctest: +SKIP
+>>> assert_matches_baseline("designs/my_drive.toml", "tests/my_drive.baseline.json")  # doctest: +SKIP
+"""
+
+from __future__ import annotations
+
+from .audit import RunSettings, run_audit
+from .regression import baseline_figures, compare, format_drifts, load_baseline, make_baseline
+
+__all__ = ["baseline_drifts", "assert_matches_baseline", "record_baseline"]
+
+
+def _settings(doc: dict) -> RunSettings:
+    s = doc["settings"]
+    return RunSettings(step_deg=float(s["step_deg"]), sections=int(s["sections"]),
+                       chord_tol_um=float(s["chord_tol_um"]), interference_tol_um=float(s["interference_tol_um"]))
+
+
+def baseline_drifts(design_path, baseline_path) -> list:
+    """Recompute the design with the baseline's settings; the figures that drifted (empty when none did)."""
+    doc = load_baseline(baseline_path)
+    drive, result = run_audit(design_path, _settings(doc))
+    return compare(doc, baseline_figures(drive, result.to_json()))
+
+
+def assert_matches_baseline(design_path, baseline_path) -> None:
+    """Fail with a readable diff when any figure drifted beyond its tolerance."""
+    drifts = baseline_drifts(design_path, baseline_path)
+    if drifts:
+        raise AssertionError(f"{design_path} against {baseline_path}: {format_drifts(drifts)}")
+
+
+def record_baseline(design_path, settings: RunSettings | None = None) -> dict:
+    """A baseline document for a design (write it with ``json.dump``)."""
+    rs = settings or RunSettings()
+    drive, result = run_audit(design_path, rs)
+    keep = {k: v for k, v in rs.as_dict().items() if k in ("step_deg", "sections", "chord_tol_um", "interference_tol_um")}
+    return make_baseline(str(design_path), keep, drive, result.to_json())
