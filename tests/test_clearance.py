@@ -1,0 +1,208 @@
+"""The 2D clearance engine: distances against closed forms, shortcuts against the full computation (theory.md 5, 7)."""
+
+from math import pi
+
+import numpy as np
+import pytest
+
+from conftest import TEMPLATES
+from wgcad.clearance.distance import Template, signed_clearance
+from wgcad.clearance.engine import AuditSettings, Scene, audit, brute_force_min, tooth_clearance
+from wgcad.design import load_design, with_changes
+from wgcad.drive import build_drive
+from wgcad.placement import tooth_pose
+
+
+def square(side=1.0):
+    h = side / 2
+    return np.array([[-h, -h], [h, -h], [h, h], [-h, h]])
+
+
+def ngon(r, n):
+    t = np.linspace(0, 2 * pi, n, endpoint=False)
+    return np.stack([r * np.cos(t), r * np.sin(t)], axis=1)
+
+
+def pair(a, b, rot_a, sh_a, rot_b, sh_b):
+    return signed_clearance(Template(a), np.atleast_1d(rot_a), np.atleast_2d(sh_a), Template(b),
+                            np.atleast_1d(rot_b), np.atleast_2d(sh_b))[0]
+
+
+# ---------------------------------------------------------------- closed forms
+@pytest.mark.parametrize("gap", [0.5, 1e-3, 1e-7])
+def test_squares_at_known_separation(gap):
+    assert pair(square(), square(), 0, [0, 0], 0, [1 + gap, 0.3]) == pytest.approx(gap, abs=1e-12)
+
+
+@pytest.mark.parametrize("depth", [0.2, 1e-3, 1e-6])
+def test_overlapping_squares_report_penetration_depth(depth):
+    # offset diagonally so only one corner enters: depth = that corner's distance to the nearest edge
+    assert pair(square(), square(), 0, [0, 0], 0, [1 - depth, 1 - 3 * depth]) == pytest.approx(-depth, abs=1e-12)
+
+
+def test_rotated_square_corner_to_edge():
+    # a square turned 45 deg: its corner sits at half a diagonal from its centre
+    g = 0.01
+    c = 0.5 + g + np.sqrt(2) / 2
+    assert pair(square(), square(), 0, [0, 0], pi / 4, [c, 0.0]) == pytest.approx(g, abs=1e-12)
+
+
+def test_offset_circles():
+    # inscribed 4000-gons of radii 3 and 2 at centre distance 5.5: 0.5 apart, up to the
+    # polygons' sagitta r (1 - cos(pi/n)) per circle
+    r1, r2, n, D = 3.0, 2.0, 4000, 5.5
+    d = pair(ngon(r1, n), ngon(r2, n), 0, [0, 0], 0.3, [D, 0])
+    sag = (r1 + r2) * (1 - np.cos(pi / n))
+    assert D - r1 - r2 <= d <= D - r1 - r2 + sag + 1e-12
+
+
+def test_tooth_and_its_mirror_beyond_the_tip():
+    # the flexspline tooth of D1 and its mirror image in the line x = c: their tips are
+    # 2 (c - r_a) apart (the tip arc's vertex on the centre line is at r_a exactly)
+    drive = build_drive(load_design(TEMPLATES / "d1_involute.toml"))
+    t = drive.flex.tooth_polygon()
+    c = drive.flex.r_a + 0.05
+    mirror = (np.array([2 * c, 0.0]) - t * [1, -1])[::-1]  # reflected x -> 2c - x, kept counter-clockwise
+    assert pair(t, mirror, 0, [0, 0], 0, [0, 0]) == pytest.approx(0.1, abs=1e-12)
+
+
+# ---------------------------------------------------------------- the engine
+@pytest.fixture(scope="module")
+def d4():
+    return build_drive(load_design(TEMPLATES / "d4_discrete.toml"))
+
+
+@pytest.fixture(scope="module")
+def d1():
+    return build_drive(load_design(TEMPLATES / "d1_involute.toml"))
+
+
+def test_tooth_angle_reduction_matches_the_real_tooth(d1):
+    # theory.md 7: the engine evaluates a tooth at angle phi with the material angle
+    # phi (z_b - z_g)/z_b; the real tooth k at generator angle phi_h must be congruent
+    scene = Scene(d1)
+    zg, zb = 200, 202
+    for phi_h in (0.0, 0.37, 2.1):
+        k = np.arange(0, zg, 17)
+        mat = 2 * pi * k / zg + phi_h * (-(zb - zg) / zg)
+        phi = mat - phi_h
+        rot, shift = tooth_pose(d1.law, phi, d1.r_m, frame_angle=phi_h)
+        lo, up, _ = scene.neighbours(shift, rot)
+        real = np.minimum(scene.clearance_to(rot, shift, lo), scene.clearance_to(rot, shift, up))
+        red = tooth_clearance(scene, (phi + pi) % (2 * pi) - pi, None, third=False)
+        np.testing.assert_allclose(np.minimum(red["lower"], red["upper"]), real, atol=1e-12)
+
+
+SHORTCUTS = ["use_period", "use_waves", "use_mirror", "cull", "bound"]
+
+
+def _audit(drive, step_deg, k, **kw):
+    angles = np.deg2rad(np.arange(0, 360, step_deg))
+    return audit(drive, AuditSettings(angles=angles, sections=drive.sections(k), **kw))
+
+
+@pytest.mark.parametrize("name,step,k", [("d4_discrete", 2.0, 1), ("d1_involute", 3.0, 3)])
+def test_each_shortcut_gives_the_full_answer(name, step, k):
+    drive = build_drive(load_design(TEMPLATES / f"{name}.toml"))
+    full = _audit(drive, step, k, **{s: False for s in SHORTCUTS})
+    fast = _audit(drive, step, k)
+    # the same samples are evaluated exactly; mirrored ones agree to rounding
+    assert fast.min_clearance == pytest.approx(full.min_clearance, abs=1e-11)
+    assert fast.entry_gap == pytest.approx(full.entry_gap, abs=1e-11)
+    for s in SHORTCUTS:
+        one_off = _audit(drive, step, k, **{s: False})
+        assert one_off.min_clearance == pytest.approx(full.min_clearance, abs=1e-11), s
+    # and the shortcuts really skip work
+    assert fast.counts["evaluated"] < full.counts["evaluated"] / 5
+    assert fast.counts["unique_tooth_angles"] < full.counts["unique_tooth_angles"] / 3
+
+
+def test_engine_equals_brute_force(d4):
+    angles = np.deg2rad(np.arange(0, 360, 5.0))
+    fast = audit(d4, AuditSettings(angles=angles, sections=d4.sections(1)))
+    assert fast.min_clearance == pytest.approx(brute_force_min(d4, angles, None), abs=1e-11)
+
+
+def test_odd_tooth_counts_interleave_the_waves(d1):
+    # 201/203: the waves are offset by half a pitch; folding still holds (theory.md 7)
+    odd = build_drive(with_changes(d1.design, drive={"z_flex": 201, "z_rigid": 203}))
+    angles = np.deg2rad(np.arange(0, 360, 4.0))
+    fast = audit(odd, AuditSettings(angles=angles, sections=odd.sections(2)))
+    assert fast.min_clearance == pytest.approx(brute_force_min(odd, angles, odd.sections(2)), abs=1e-11)
+    # at one generator angle the two waves hold the same tooth angles with even counts
+    # (the fold halves them) and interleaved ones with odd counts (nothing merges)
+    def unique(drive, waves):
+        r = audit(drive, AuditSettings(angles=np.array([0.1]), sections=drive.sections(1), use_waves=waves, use_mirror=False))
+        return r.counts["unique_tooth_angles"]
+
+    assert unique(odd, True) == unique(odd, False) == 201
+    assert unique(d1, True) * 2 == unique(d1, False) == 200
+
+
+def test_deliberately_interfering_design_is_found_where_and_how_deep(d4):
+    # W0 = 1.6 m pushes the flexspline tip 140 um into the rigid root on the major axis:
+    # r_fb - r_ag - W0 = 18.4 - 17.9 - 0.64 (closed form, D4 radii)
+    bad = build_drive(with_changes(d4.design, generator={"w0_coef": 1.6}))
+    radial = bad.rigid.r_f - bad.flex.r_a - bad.law.w0
+    assert radial == pytest.approx(-0.140, abs=1e-12)
+    scene = Scene(bad)
+    at_axis = tooth_clearance(scene, np.array([0.0]))["min"][0]
+    # the deepest vertex is the tip corner, measured to the root arc: the radial overlap,
+    # within the chord tolerance of the polygons (1 um)
+    assert at_axis == pytest.approx(radial, abs=1e-3)
+    res = _audit(bad, 1.0, 1)
+    assert res.interference and res.min_clearance <= at_axis
+    assert abs(res.worst["tooth_angle_deg"]) < 10.0  # near the major axis
+    clean = _audit(d4, 1.0, 1)
+    assert not clean.interference and clean.min_clearance > 0
+
+
+def test_d1_cycloidal_entry_gap_much_larger_than_involute():
+    # [S1]: the cycloidal teeth enter with a much larger gap than the involute ones
+    res = {}
+    for name in ("d1_involute", "d1_cycloidal"):
+        drive = build_drive(load_design(TEMPLATES / f"{name}.toml"))
+        res[name] = _audit(drive, 30.0, 3)
+    inv, cyc = res["d1_involute"].entry_gap, res["d1_cycloidal"].entry_gap
+    assert 0 < inv < cyc and cyc > 10 * inv
+    # and it is reported at the inner end of the rim for the involute teeth ([S1])
+    assert res["d1_involute"].entry["section_z_mm"] == pytest.approx(30.0)
+
+
+def test_entry_gap_is_clearance_at_the_tip_circle_crossing(d1):
+    scene = Scene(d1)
+    res = _audit(d1, 30.0, 3)
+    phi = np.deg2rad(res.entry["tooth_angle_deg"])
+    z = res.entry["section_z_mm"]
+    pts = scene.place(np.array([phi]), z)[0]
+    # at the crossing the outermost tooth point is on the rigid tip circle. The reported
+    # angle is rounded to 1e-6 deg (1.7e-8 rad); points move < 3 mm/rad, so < 1e-7 mm
+    assert np.hypot(pts[:, 0], pts[:, 1]).max() == pytest.approx(d1.rigid.r_a, abs=1e-7)
+    assert tooth_clearance(scene, np.array([phi]), z)["min"][0] == pytest.approx(res.entry_gap, abs=1e-7)
+    # the pinch is the smallest clearance near it
+    near = np.linspace(phi - np.deg2rad(6), phi + np.deg2rad(6), 2401)
+    assert res.entry["pinch_um"] <= 1e3 * tooth_clearance(scene, near, z)["min"].min() + 1e-6
+
+
+def test_backlash_of_a_clean_design_by_rotation(d4):
+    # turning the flexspline by the reported dead travel each way brings a tooth into contact
+    from wgcad.clearance.engine import backlash
+
+    scene = Scene(d4)
+    total = backlash(scene, 0.0)
+    assert total > 0
+    # turn every tooth by +-total: one side alone must already interfere somewhere
+    k = np.arange(86)
+    mat = 2 * pi * k / 86
+    for sgn in (1, -1):
+        rot, shift = tooth_pose(d4.law, mat, d4.r_m, frame_angle=0.0)
+        c, s = np.cos(sgn * total), np.sin(sgn * total)
+        sh = np.stack([c * shift[:, 0] - s * shift[:, 1], s * shift[:, 0] + c * shift[:, 1]], axis=1)
+        lo, up, _ = scene.neighbours(sh, rot + sgn * total)
+        d = np.minimum(scene.clearance_to(rot + sgn * total, sh, lo), scene.clearance_to(rot + sgn * total, sh, up))
+        assert d.min() < 0
+
+
+def test_interfering_backlash_is_undefined(d1):
+    res = _audit(d1, 30.0, 3)
+    assert res.interference and res.to_json()["backlash_arcmin"] is None
