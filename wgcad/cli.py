@@ -407,7 +407,7 @@ def cmd_audit(args) -> int:
         print(_audit_summary(res["design"], res))
         if "fcl" in res:
             f = res["fcl"]
-            print(f"  FCL 3D check of the tightest pair: {f['summary']}")
+            print(f"  FCL 3D check of the pairs the 2D engine singled out: {f['summary']}")
         if drifts is not None:
             print(f"  baseline {args.baseline}: {format_drifts(drifts)}")
     if drifts:

@@ -1,0 +1,234 @@
+"""Benchmarks: run time against error for each accuracy knob, shortcuts on/off, and the audit's acceptance figures.
+
+Run from the repository root (not part of the test run):
+
+    .venv/bin/python benchmarks/run.py            # everything, a few minutes
+    .venv/bin/python benchmarks/run.py --quick    # smaller sweeps, no brute force
+
+Writes tables (CSV and Markdown) and one PNG per knob to output/bench/.
+Times are wall-clock best-of-N on this machine, quoted with ratios to a
+baseline measured in the same run.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import platform
+import subprocess
+import sys
+import time
+from math import pi
+from pathlib import Path
+
+import numpy as np
+
+ROOT = Path(__file__).resolve().parent.parent
+sys.path.insert(0, str(ROOT))
+
+from wgcad.clearance.engine import AuditSettings, audit, brute_force_min  # noqa: E402
+from wgcad.design import load_design  # noqa: E402
+from wgcad.drive import build_drive  # noqa: E402
+
+OUT = ROOT / "output" / "bench"
+D1 = ROOT / "templates" / "d1_involute.toml"
+
+
+def best_of(fn, n=3):
+    ts, val = [], None
+    for _ in range(n):
+        t = time.perf_counter()
+        val = fn()
+        ts.append(time.perf_counter() - t)
+    return min(ts), val
+
+
+def machine() -> str:
+    return f"{platform.processor() or platform.machine()}, {os.cpu_count()} cores, Python {platform.python_version()}"
+
+
+def audit_of(drive, step_deg, k, **kw):
+    n = int(round(360.0 / step_deg))
+    angles = np.deg2rad(np.arange(n) * 360.0 / n)
+    return audit(drive, AuditSettings(angles=angles, sections=drive.sections(k), **kw))
+
+
+def peak_memory_mb() -> float:
+    """Peak RSS of a fresh process doing only the full-revolution D1 audit."""
+    code = (
+        "import resource, sys; sys.path.insert(0, %r)\n"
+        "from benchmarks.run import audit_of, build_drive, load_design, D1\n"
+        "audit_of(build_drive(load_design(D1)), 0.5, 3)\n"
+        "print(resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0)\n" % str(ROOT)
+    )
+    r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, cwd=ROOT)
+    return float(r.stdout.strip().splitlines()[-1])
+
+
+def bench_audit(quick: bool) -> dict:
+    """Issue 4 acceptance: full revolution at 0.5 deg and 3 sections vs the brute force; one mesh period; memory."""
+    drive = build_drive(load_design(D1))
+    t_fast, fast = best_of(lambda: audit_of(drive, 0.5, 3), 3)
+    mesh = 360.0 / drive.design.drive.z_rigid
+    angles_1p = np.deg2rad(np.arange(0.0, mesh, 0.5))
+    t_1p, one = best_of(lambda: audit(drive, AuditSettings(angles=angles_1p, sections=drive.sections(3))), 5)
+    out = {
+        "machine": machine(),
+        "full_revolution_s": t_fast,
+        "min_clearance_um": 1e3 * fast.min_clearance,
+        "samples": fast.counts["samples"],
+        "evaluated": fast.counts["evaluated"],
+        "one_period_s": t_1p,
+        "one_period_angles": len(angles_1p),
+        "peak_memory_mb": peak_memory_mb(),
+    }
+    if not quick:
+        n = 720
+        angles = np.deg2rad(np.arange(n) * 360.0 / n)
+        t0 = time.perf_counter()
+        brute = brute_force_min(drive, angles, drive.sections(3))
+        out["brute_force_s"] = time.perf_counter() - t0
+        out["brute_force_min_um"] = 1e3 * brute
+        out["speedup"] = out["brute_force_s"] / t_fast
+        out["difference_um"] = abs(1e3 * (brute - fast.min_clearance))
+    return out
+
+
+def bench_shortcuts(quick: bool) -> list[dict]:
+    """Each shortcut switched off alone (and all off): time and the change in the result."""
+    drive = build_drive(load_design(D1))
+    step = 2.0 if quick else 1.0
+    t_on, on = best_of(lambda: audit_of(drive, step, 3), 3)
+    rows = [{"shortcut": "all on (baseline)", "time_s": t_on, "ratio": 1.0, "min_clearance_um": 1e3 * on.min_clearance, "change_um": 0.0}]
+    names = {"use_period": "mesh period", "use_waves": "identical waves", "use_mirror": "mirror symmetry",
+             "cull": "radial culling", "bound": "branch and bound"}
+    for key, label in names.items():
+        t, r = best_of(lambda: audit_of(drive, step, 3, **{key: False}), 1)
+        rows.append({"shortcut": f"{label} off", "time_s": t, "ratio": t / t_on, "min_clearance_um": 1e3 * r.min_clearance,
+                     "change_um": 1e3 * abs(r.min_clearance - on.min_clearance)})
+    t, r = best_of(lambda: audit_of(drive, step, 3, **{k: False for k in names}), 1)
+    rows.append({"shortcut": "all off", "time_s": t, "ratio": t / t_on, "min_clearance_um": 1e3 * r.min_clearance,
+                 "change_um": 1e3 * abs(r.min_clearance - on.min_clearance)})
+    return rows
+
+
+def bench_chord_tol(quick: bool) -> list[dict]:
+    """Chord tolerance of the outlines: audit figures against a converged reference (0.01 um outlines)."""
+    design = load_design(D1)
+    step = 2.0
+    ref_drive = build_drive(design, tol=1e-5)
+    ref = audit_of(ref_drive, step, 3)
+    rows = []
+    tols_um = [10.0, 3.0, 1.0, 0.3] if quick else [30.0, 10.0, 3.0, 1.0, 0.3, 0.1, 0.03]
+    t_base = None
+    for tol_um in tols_um:
+        t, (drive, res) = best_of(lambda: (lambda d: (d, audit_of(d, step, 3)))(build_drive(design, tol=tol_um * 1e-3)), 2)
+        t_base = t_base or t
+        rows.append({
+            "chord_tol_um": tol_um,
+            "vertices_per_tooth": len(drive.flex.period),
+            "time_s": t,
+            "ratio": t / t_base,
+            "min_clearance_error_um": 1e3 * abs(res.min_clearance - ref.min_clearance),
+            "entry_gap_error_um": 1e3 * abs(res.entry_gap - ref.entry_gap),
+        })
+    return rows
+
+
+def bench_angle_step(quick: bool) -> list[dict]:
+    """Generator-angle step: the sampled minimum against a fine reference (0.02 deg)."""
+    drive = build_drive(load_design(D1))
+    ref = audit_of(drive, 0.02, 3)
+    rows = []
+    steps = [5.0, 2.0, 1.0, 0.5] if quick else [10.0, 5.0, 2.0, 1.0, 0.5, 0.2, 0.1]
+    t_base = None
+    for st in steps:
+        t, res = best_of(lambda: audit_of(drive, st, 3), 2)
+        t_base = t_base or t
+        rows.append({"step_deg": st, "time_s": t, "ratio": t / t_base, "min_clearance_error_um": 1e3 * abs(res.min_clearance - ref.min_clearance)})
+    return rows
+
+
+def bench_sections(quick: bool) -> list[dict]:
+    """Cross-sections over the face width (coning): minimum against 61 sections."""
+    drive = build_drive(load_design(D1))
+    ref = audit_of(drive, 1.0, 61)
+    rows = []
+    t_base = None
+    for k in ([2, 3, 5] if quick else [2, 3, 5, 9, 17]):
+        t, res = best_of(lambda: audit_of(drive, 1.0, k), 2)
+        t_base = t_base or t
+        rows.append({"sections": k, "time_s": t, "ratio": t / t_base,
+                     "min_clearance_error_um": 1e3 * abs(res.min_clearance - ref.min_clearance),
+                     "entry_gap_error_um": 1e3 * abs(res.entry_gap - ref.entry_gap)})
+    return rows
+
+
+def table_md(rows: list[dict]) -> str:
+    keys = list(rows[0])
+    lines = ["| " + " | ".join(keys) + " |", "|" + "---|" * len(keys)]
+    for r in rows:
+        lines.append("| " + " | ".join(f"{r[k]:.4g}" if isinstance(r[k], float) else str(r[k]) for k in keys) + " |")
+    return "\n".join(lines)
+
+
+def plot(rows, x, title, path, y="min_clearance_error_um"):
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, ax = plt.subplots(figsize=(6.5, 4.5), dpi=90)
+    ts = [r["time_s"] for r in rows]
+    es = [max(r[y], 1e-7) for r in rows]
+    ax.loglog(ts, es, "o-")
+    for r, t, e in zip(rows, ts, es):
+        ax.annotate(f"{r[x]:g}", (t, e), textcoords="offset points", xytext=(5, 5), fontsize=8)
+    ax.set_xlabel("run time, s")
+    ax.set_ylabel(y.replace("_", " "))
+    ax.set_title(title, fontsize=10)
+    ax.grid(alpha=0.3, which="both")
+    fig.tight_layout()
+    fig.savefig(path)
+    plt.close(fig)
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--quick", action="store_true")
+    ap.add_argument("--only", choices=["audit", "shortcuts", "chord", "step", "sections"])
+    args = ap.parse_args(argv)
+    OUT.mkdir(parents=True, exist_ok=True)
+    report = {"machine": machine()}
+    md = [f"# wgcad benchmarks\n\nMachine: {machine()}. Design: D1 involute (templates/d1_involute.toml).\n"]
+    jobs = [
+        ("audit", bench_audit, None),
+        ("shortcuts", bench_shortcuts, None),
+        ("chord", bench_chord_tol, ("chord_tol_um", "Chord tolerance (label: um)")),
+        ("step", bench_angle_step, ("step_deg", "Generator-angle step (label: deg)")),
+        ("sections", bench_sections, ("sections", "Cross-sections (label: count)")),
+    ]
+    for name, fn, plot_spec in jobs:
+        if args.only and args.only != name:
+            continue
+        t = time.perf_counter()
+        res = fn(args.quick)
+        print(f"{name}: {time.perf_counter() - t:.1f} s", file=sys.stderr)
+        report[name] = res
+        if isinstance(res, list):
+            md.append(f"## {name}\n\n{table_md(res)}\n")
+            if plot_spec:
+                plot(res, plot_spec[0], plot_spec[1], OUT / f"{name}.png")
+            keys = list(res[0])
+            (OUT / f"{name}.csv").write_text(",".join(keys) + "\n" + "\n".join(",".join(str(r[k]) for k in keys) for r in res) + "\n")
+        else:
+            md.append(f"## {name}\n\n" + "\n".join(f"- {k}: {v:.6g}" if isinstance(v, float) else f"- {k}: {v}" for k, v in res.items()) + "\n")
+    (OUT / "report.json").write_text(json.dumps(report, indent=2) + "\n")
+    (OUT / "README.md").write_text("\n".join(md))
+    print("\n".join(md))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
