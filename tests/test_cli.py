@@ -42,6 +42,9 @@ BAD = [
     ("generator", "beta_deg", "95.0", "generator.beta_deg", "(0, 90)"),
     ("rigid", "fillet_coef", "0.3", "rigid.fillet_coef", "largest that fits"),
     ("tooth", "form", '"cycloid"', "tooth.form", "must be one of involute, cycloidal"),
+    ("drive", "waves", "1", "drive.waves", "must be >= 2"),
+    ("generator", "offset", "2.0", "generator.offset", "used only by the ellipse law"),
+    ("generator", "beta_deg", "42.0", "generator.beta_deg", "must not lie in (40.71, 49.29)"),
 ]
 
 

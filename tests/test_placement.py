@@ -121,3 +121,20 @@ def test_flex_rotation_follows_ratio(d1):
     # one generator turn, rigid fixed: flexspline turns -2/200 of a turn (u_hg = -100)
     assert mat[0] == pytest.approx(-2 * pi / 100)
     assert phi[0] == pytest.approx(-2 * pi / 100 - 2 * pi)
+
+
+@pytest.mark.parametrize("form", ["involute", "cycloidal"])
+def test_deformed_outline_is_simple(form):
+    # neighbouring teeth turn by different angles; pointed cycloidal roots then cross
+    from wgcad.design import with_changes
+    from wgcad.placement import join_teeth
+
+    base = load_design(TEMPLATES / "d3_external.toml")
+    des = base if form == "involute" else with_changes(base, tooth={"form": "cycloidal", "clearance_coef": 0.1})
+    d3 = build_drive(des)
+    import shapely
+
+    for phi_h in (0.0, 0.26):
+        outline = join_teeth(place_flex_teeth(d3, phi_h, local=d3.flex.period))
+        assert shapely.LinearRing(outline).is_simple
+        assert abs(shapely.Polygon(outline).area) > 0

@@ -89,6 +89,8 @@ def test_write_then_check_baseline_and_drift_exit_code(tmp_path, capsys):
     (["--engine", "3d"], "--engine"),
     (["--baseline", "missing.json"], "baseline file not found"),
     (["--angles", "10", "--step-deg", "1"], "not allowed with"),
+    (["--angles", "0"], "--angles"),
+    (["--angles", "-5"], "--angles"),
 ])
 def test_audit_bad_flags(tmp_path, capsys, flags, words):
     try:

@@ -32,8 +32,8 @@ class RunSettings:
         return dict(self.__dict__)
 
     def check(self) -> "RunSettings":
-        if not 0.0 < self.step_deg <= 90.0:
-            raise DesignError("--step-deg", f"must be in (0, 90] degrees, got {self.step_deg:g}")
+        if not 1e-4 <= self.step_deg <= 90.0:
+            raise DesignError("--step-deg", f"must be in [1e-4, 90] degrees, got {self.step_deg:g}")
         if not 1 <= self.sections <= 200:
             raise DesignError("--sections", f"must be 1..200, got {self.sections}")
         if not 0.0 < self.chord_tol_um <= 100.0:

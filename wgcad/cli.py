@@ -65,6 +65,16 @@ def _positive_float(lo: float, hi: float, unit: str):
     return conv
 
 
+def _angle_count(text: str) -> int:
+    try:
+        n = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"'{text}' is not a whole number") from None
+    if not 4 <= n <= 3_600_000:
+        raise argparse.ArgumentTypeError(f"must be 4..3600000 angles per revolution, got {n}")
+    return n
+
+
 def _out_dir(args, design_path: str) -> Path:
     return Path(args.out) if args.out else Path("output") / Path(design_path).stem
 
@@ -493,12 +503,13 @@ def build_parser() -> argparse.ArgumentParser:
                        epilog=EPILOG, formatter_class=argparse.RawDescriptionHelpFormatter)
     a.add_argument("design")
     grp = a.add_mutually_exclusive_group()
-    grp.add_argument("--angles", type=int, metavar="N", help="N generator angles over a full revolution")
+    grp.add_argument("--angles", type=_angle_count, metavar="N", help="N generator angles over a full revolution")
     grp.add_argument("--step-deg", type=_positive_float(0.0, 90.0, "deg"), default=0.5, help="generator-angle step, deg (default 0.5)")
     a.add_argument("--sections", type=int, default=3, help="cross-sections over the face width when the flexspline is coned (default 3)")
     a.add_argument("--engine", choices=("2d", "fcl", "both"), default="2d",
                    help="2d (default); fcl/both: also check the tightest pairs with 3D solids in python-fcl")
-    a.add_argument("--chord-tol-um", type=_positive_float(0.0, 100.0, "um"), default=1.0)
+    a.add_argument("--chord-tol-um", type=_positive_float(0.0, 100.0, "um"), default=1.0,
+                   help="largest distance between outline and exact curve, um (default 1)")
     a.add_argument("--interference-tol-um", type=float, default=1.0, help="penetration reported as contact, um (default 1)")
     a.add_argument("--json", metavar="PATH", help="write the results as JSON")
     a.add_argument("--plot", metavar="PATH", help="write PNGs PATH_profile.png, PATH_vs_angle.png, PATH_tightest.png (PATH without .png)")

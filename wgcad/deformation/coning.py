@@ -2,23 +2,13 @@
 
 from __future__ import annotations
 
-import math
-import numbers
 
 import numpy as np
 
 from wgcad.errors import DesignError
+from wgcad.deformation.laws import _real
 
 __all__ = ["coned_w0"]
-
-
-def _real(value, field_name: str, what: str) -> float:
-    if isinstance(value, bool) or not isinstance(value, numbers.Real):
-        raise DesignError(field_name, f"{what} must be a real number, got {value!r}")
-    value = float(value)
-    if not math.isfinite(value):
-        raise DesignError(field_name, f"{what} must be finite, got {value!r}")
-    return value
 
 
 def coned_w0(w0, z, *, length, z_h):

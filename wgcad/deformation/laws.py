@@ -296,7 +296,39 @@ class Harmonic(Law):
 
 
 @dataclass(frozen=True)
-class _DiscShape(_TwoWaveLaw):
+class _SectionedLaw(_TwoWaveLaw):
+    """A two-wave law given by two closed-form sections meeting at ``beta`` (theory.md 3.3, 3.4).
+
+    Subclasses provide ``_sections(phi) -> (section I fields, section II fields)``.
+    """
+
+    def closed_forms(self, phi) -> tuple[RimState, RimState]:
+        """Both closed-form sections at raw `phi` (no folding).
+
+        For checks of continuity at beta: section I is valid on
+        0 <= phi <= beta, section II on beta <= phi <= pi/2.
+
+        Parameters
+        ----------
+        phi : (...) float
+
+        Returns
+        -------
+        (RimState, RimState)
+            Section I and section II formulas evaluated at `phi`.
+        """
+        phi = np.array(phi, dtype=np.float64)
+        s1, s2 = self._sections(phi)
+        return RimState(phi, *s1), RimState(phi, *s2)
+
+    def _quarter(self, psi):
+        sec1, sec2 = self._sections(psi)
+        on_section_one = psi <= self.beta
+        return tuple(np.where(on_section_one, a, b) for a, b in zip(sec1, sec2))
+
+
+@dataclass(frozen=True)
+class _DiscShape(_SectionedLaw):
     """Disc-generator shape of theory.md 3.3 times a sign (+1 disc, -1 external ring)."""
 
     _sign: ClassVar[float] = 1.0
@@ -329,25 +361,6 @@ class _DiscShape(_TwoWaveLaw):
                        ("_C", C), ("_K", w0 / (A - B))):
             object.__setattr__(self, k, val)
 
-    def closed_forms(self, phi) -> tuple[RimState, RimState]:
-        """Both closed-form sections of theory.md 3.3 at raw `phi` (no folding).
-
-        For checks of continuity at beta: section I is valid on
-        0 <= phi <= beta, section II on beta <= phi <= pi/2.
-
-        Parameters
-        ----------
-        phi : (...) float
-
-        Returns
-        -------
-        (RimState, RimState)
-            Section I and section II formulas evaluated at `phi`.
-        """
-        phi = np.array(phi, dtype=np.float64)
-        s1, s2 = self._sections(phi)
-        return RimState(phi, *s1), RimState(phi, *s2)
-
     def _sections(self, phi):
         A, B, C, K, r = self._A, self._B, self._C, self._K * self._sign, self.r_m
         sb2 = math.sin(self.beta) ** 2
@@ -377,10 +390,6 @@ class _DiscShape(_TwoWaveLaw):
         )
         return sec1, sec2
 
-    def _quarter(self, psi):
-        sec1, sec2 = self._sections(psi)
-        on_disc = psi <= self.beta
-        return tuple(np.where(on_disc, a, b) for a, b in zip(sec1, sec2))
 
 
 @dataclass(frozen=True)
@@ -440,7 +449,7 @@ class ExternalRing(_DiscShape):
 
 
 @dataclass(frozen=True)
-class FourForce(_TwoWaveLaw):
+class FourForce(_SectionedLaw):
     """Cam shaped as a ring deformed by four radial forces at +-beta, pi+-beta (theory.md 3.4).
 
     Parameters
@@ -485,24 +494,6 @@ class FourForce(_TwoWaveLaw):
         for k, val in (("w0", w0), ("r_m", r_m), ("beta", beta), ("_D", D)):
             object.__setattr__(self, k, val)
 
-    def closed_forms(self, phi) -> tuple[RimState, RimState]:
-        """Both closed-form sections of theory.md 3.4 at raw `phi` (no folding).
-
-        Section I is valid on 0 <= phi <= beta, section II on
-        beta <= phi <= pi/2.
-
-        Parameters
-        ----------
-        phi : (...) float
-
-        Returns
-        -------
-        (RimState, RimState)
-        """
-        phi = np.array(phi, dtype=np.float64)
-        s1, s2 = self._sections(phi)
-        return RimState(phi, *s1), RimState(phi, *s2)
-
     def _sections(self, phi):
         beta, r = self.beta, self.r_m
         k = self.w0 / self._D
@@ -532,11 +523,6 @@ class FourForce(_TwoWaveLaw):
             return (w, dw, d2w, v, -w, (v - dw) / r, (-w - d2w) / r)
 
         return full(w1, dw1, d2w1, v1), full(w2, dw2, d2w2, v2)
-
-    def _quarter(self, psi):
-        sec1, sec2 = self._sections(psi)
-        on_cam = psi <= self.beta
-        return tuple(np.where(on_cam, a, b) for a, b in zip(sec1, sec2))
 
 
 # --------------------------------------------------------------------------
