@@ -346,9 +346,12 @@ def _audit_summary(name: str, res: dict) -> str:
         sec = "" if e["section_z_mm"] is None else f", section z = {e['section_z_mm']:g} mm"
         lines.append(f"  entry gap: {res['entry_gap_um']:.3f} um at tooth angle {e['tooth_angle_deg']:+.3f} deg{sec} "
                      "(flexspline tip crossing the rigid tip circle)")
-        psec = "" if e["pinch_section_z_mm"] is None else f", section z = {e['pinch_section_z_mm']:g} mm"
-        lines.append(f"  entry pinch: {e['pinch_um']:.3f} um at tooth angle {e['pinch_tooth_angle_deg']:+.3f} deg{psec}, {e['pinch_location']}"
-                     + ("  TIP-TO-TIP RISK" if e["tip_to_tip_risk"] else ""))
+        if e["pinch_um"] is None:
+            lines.append("  entry pinch: none (no local minimum within 6 deg of the crossing)")
+        else:
+            psec = "" if e["pinch_section_z_mm"] is None else f", section z = {e['pinch_section_z_mm']:g} mm"
+            lines.append(f"  entry pinch: {e['pinch_um']:.3f} um at tooth angle {e['pinch_tooth_angle_deg']:+.3f} deg{psec}, {e['pinch_location']}"
+                         + ("  TIP-TO-TIP RISK" if e["tip_to_tip_risk"] else ""))
     else:
         lines.append("  entry gap: none (the tips never cross the rigid tip circle)")
     b = res["backlash_at"]

@@ -13,6 +13,7 @@ __all__ = [
     "tooth_angles",
     "tooth_frames",
     "tooth_pose",
+    "pose_from_displacements",
     "transform",
     "place_points",
     "place_points_first_order",
@@ -76,6 +77,20 @@ def transform(local: np.ndarray, rot, shift) -> np.ndarray:
     return np.stack([x, y], axis=-1)
 
 
+def pose_from_displacements(phi, w, v, theta, r_m: float, frame_angle=0.0):
+    """:func:`tooth_pose` from the neutral-line displacements ``w, v, theta`` at ``phi`` (arrays of one shape)."""
+    phi = np.asarray(phi, dtype=float)
+    c, s = np.cos(phi), np.sin(phi)
+    rad = r_m + w
+    ox0, oy0 = rad * c - v * s, rad * s + v * c
+    fa = np.broadcast_to(np.asarray(frame_angle, dtype=float), phi.shape)
+    rot = fa + phi + theta
+    c, s = np.cos(fa), np.sin(fa)
+    ox = c * ox0 - s * oy0 - r_m * np.cos(rot)
+    oy = s * ox0 + c * oy0 - r_m * np.sin(rot)
+    return rot, np.stack([ox, oy], axis=-1)
+
+
 def tooth_pose(law: Law, phi, r_m: float, frame_angle=0.0):
     """Rigid-body pose of each tooth: the tooth frame (tooth centred on +x) maps to ``R(rot) p + shift``.
 
@@ -90,13 +105,8 @@ def tooth_pose(law: Law, phi, r_m: float, frame_angle=0.0):
     shift : (K, 2) float
     """
     phi = np.atleast_1d(np.asarray(phi, dtype=float))
-    origin, ang = tooth_frames(law, phi, r_m)
-    fa = np.broadcast_to(np.asarray(frame_angle, dtype=float), phi.shape)
-    rot = fa + ang
-    c, s = np.cos(fa), np.sin(fa)
-    ox = c * origin[:, 0] - s * origin[:, 1] - r_m * np.cos(rot)
-    oy = s * origin[:, 0] + c * origin[:, 1] - r_m * np.sin(rot)
-    return rot, np.stack([ox, oy], axis=-1)
+    st = law.state(phi)
+    return pose_from_displacements(phi, st.w, st.v, st.theta, r_m, frame_angle)
 
 
 def place_points(local: np.ndarray, law: Law, phi, r_m: float, frame_angle=0.0) -> np.ndarray:

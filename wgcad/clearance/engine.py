@@ -41,7 +41,7 @@ from scipy.optimize import brentq
 
 from .. import constants
 from ..kinematics import gear_ratios
-from ..placement import tooth_frames, tooth_pose, transform
+from ..placement import pose_from_displacements, tooth_frames, tooth_pose, transform
 from .distance import Template, signed_clearance
 
 __all__ = ["AuditSettings", "AuditResult", "Scene", "tooth_clearance", "audit", "brute_force_min"]
@@ -128,6 +128,29 @@ class Scene:
         mat = phi * (self.z_b - self.z_g) / self.z_b
         return tooth_pose(self.law(z), phi, self.drive.r_m, frame_angle=mat - phi)
 
+    def pose_sections(self, phi: np.ndarray, zi: np.ndarray, zs: list):
+        """Poses of teeth at angles ``phi[k]`` in sections ``zs[zi[k]]``, in one go.
+
+        For laws linear in W0 (all but the exact ellipse) a coned section's
+        displacements are the centre section's scaled by ``W0(z)/W0``: one
+        evaluation of the law serves every section.
+        """
+        phi = np.atleast_1d(np.asarray(phi, dtype=float))
+        zi = np.asarray(zi)
+        mat = phi * (self.z_b - self.z_g) / self.z_b
+        base = self.drive.law
+        if base.linear_in_w0:
+            st = base.state(phi)
+            f = np.array([self.law(z).w0 / base.w0 for z in zs])[zi]
+            return pose_from_displacements(phi, f * st.w, f * st.v, f * st.theta, self.drive.r_m, mat - phi)
+        rot = np.empty(len(phi))
+        shift = np.empty((len(phi), 2))
+        for i, z in enumerate(zs):
+            sel = zi == i
+            if sel.any():
+                rot[sel], shift[sel] = self.pose(phi[sel], z)
+        return rot, shift
+
     def place(self, phi: np.ndarray, z=None, local=None) -> np.ndarray:
         """Tooth polygons at tooth angles ``phi``, rigid frame, ``(K, N, 2)``."""
         return transform(self.flex_local if local is None else local, *self.pose(phi, z))
@@ -182,6 +205,17 @@ def tooth_clearance(scene: Scene, phi, z=None, third: bool = True, area: bool = 
     """
     phi = np.atleast_1d(np.asarray(phi, dtype=float))
     rot, shift = scene.pose(phi, z)
+    return clearance_at_poses(scene, rot, shift, third=third, area=area)
+
+
+def tooth_clearance_sections(scene: Scene, phi: np.ndarray, zi: np.ndarray, zs: list) -> np.ndarray:
+    """Smallest clearance of teeth at angles ``phi[k]`` in sections ``zs[zi[k]]``, in one batch, ``(K,)``."""
+    rot, shift = scene.pose_sections(phi, zi, zs)
+    return clearance_at_poses(scene, rot, shift)["min"]
+
+
+def clearance_at_poses(scene: Scene, rot: np.ndarray, shift: np.ndarray, third: bool = True, area: bool = False) -> dict:
+    """:func:`tooth_clearance` for teeth given by their poses (rigid frame)."""
     lo, up, th = scene.neighbours(shift, rot)
     out = {}
     for key, idx in (("lower", lo), ("upper", up)):
@@ -191,7 +225,7 @@ def tooth_clearance(scene: Scene, phi, z=None, third: bool = True, area: bool = 
         else:
             out[key] = res
     best = np.minimum(out["lower"], out["upper"])
-    out["third"] = np.full(len(phi), np.inf)
+    out["third"] = np.full(len(rot), np.inf)
     if third:
         # the third tooth lies beyond a bracketing one: 2 R sin(dphi/2) bounds its distance,
         # with dphi the angular gap between the tooth and the third tooth's flank extent
@@ -236,31 +270,32 @@ class _SectionSearch:
         self.zone = np.nonzero(zone)[0]
         self.culled = 0
         self.V = 0.0
-        # bounding pays only when there are many samples: below ~1000 one batch is cheaper
-        if settings.bound and self.zone.size >= 64:
-            self.V = scene.speed_bound(phi_u[self.zone], z)
+
+    def prepare_bound(self) -> None:
+        """Speed bound for branch and bound (only worth it with many samples)."""
+        if self.settings.bound and self.zone.size >= 64:
+            self.V = self.scene.speed_bound(self.phi[self.zone], self.z)
 
     def best(self) -> float:
         return float(np.nanmin(self.value)) if self.evaluated.any() else np.inf
 
-    def evaluate(self, ix: np.ndarray) -> None:
-        if ix.size == 0:
-            return
-        res = tooth_clearance(self.scene, self.phi[ix], self.z)
-        self.value[ix] = res["min"]
-        self.lower[ix] = res["min"]
-        self.evaluated[ix] = True
-
-    def start(self) -> None:
-        """Coarse pass: every sample when bounding is off or the zone is small, else every ``stride``-th."""
+    def coarse(self) -> np.ndarray:
+        """Indices of the coarse pass: every sample without bounding, else every ``stride``-th in the zone."""
         self.stride = max(1, min(256, self.zone.size // 16))
         if not self.settings.bound or self.V == 0.0:
-            self.evaluate(self.zone)
-        else:
-            self.evaluate(self.zone[:: self.stride])
+            return self.zone
+        return self.zone[:: self.stride]
 
-    def _bounds(self, cand: np.ndarray) -> np.ndarray:
+    def candidates(self, stride: int, best: float) -> np.ndarray:
+        """Samples on this stride whose lower bound is below ``best`` (indices into :attr:`phi`)."""
+        if self.V == 0.0 or stride >= self.stride:
+            return np.zeros(0, dtype=int)
         zi, pz = self.zone, self.phi[self.zone]
+        cand = np.arange(0, zi.size, stride)
+        cand = cand[~self.evaluated[zi[cand]]]
+        if cand.size == 0:
+            return np.zeros(0, dtype=int)
+        # bound from the nearest evaluated samples on both sides
         ev = np.nonzero(self.evaluated[zi])[0]
         pos = np.searchsorted(ev, cand)
         left = ev[np.clip(pos - 1, 0, len(ev) - 1)]
@@ -269,34 +304,30 @@ class _SectionSearch:
         vr = self.value[zi[right]] - self.V * np.abs(pz[right] - pz[cand])
         lb = np.maximum(np.maximum(vl, vr), self.lower[zi[cand]])
         self.lower[zi[cand]] = lb
-        return lb
+        return zi[cand[lb < best]]
 
-    def refine(self, stride: int, best: float) -> float:
-        """Evaluate the samples on this stride whose bound is below ``best``; return the new best."""
-        if self.V == 0.0 or stride >= self.stride:
-            return min(best, self.best())
-        cand = np.arange(0, self.zone.size, stride)
-        cand = cand[~self.evaluated[self.zone[cand]]]
-        if cand.size == 0:
-            return min(best, self.best())
-        lb = self._bounds(cand)
-        order = np.argsort(lb)  # most promising first, so the running minimum prunes the rest
-        cand, lb = cand[order], lb[order]
-        for start in range(0, len(cand), 256):
-            best = min(best, self.best())
-            chunk = cand[start : start + 256][lb[start : start + 256] < best]
-            if chunk.size == 0:
-                break
-            self.evaluate(self.zone[chunk])
-        return min(best, self.best())
-
-    def finish(self, best: float) -> float:
-        """Culled samples: evaluate any whose radial bound does not clear ``best``."""
+    def culled_needed(self, best: float) -> np.ndarray:
+        """Culled samples whose radial bound does not clear ``best``: they must be evaluated."""
         out = np.nonzero(~self.zone_mask)[0]
         need = out[self.radial[out] < best]
-        self.evaluate(need)
         self.culled = int(out.size - need.size)
-        return min(best, self.best())
+        return need
+
+
+def _evaluate(scene: Scene, searches: list, picks: list, zs: list) -> float:
+    """Evaluate the picked samples of every section in one batch; return the best value so far."""
+    phis = np.concatenate([r.phi[ix] for r, ix in zip(searches, picks)])
+    if phis.size:
+        zi = np.concatenate([np.full(len(ix), i) for i, ix in enumerate(picks)])
+        vals = tooth_clearance_sections(scene, phis, zi, zs)
+        at = 0
+        for r, ix in zip(searches, picks):
+            n = len(ix)
+            r.value[ix] = vals[at : at + n]
+            r.lower[ix] = vals[at : at + n]
+            r.evaluated[ix] = True
+            at += n
+    return min(r.best() for r in searches)
 
 
 @dataclass
@@ -367,83 +398,129 @@ def _classify(scene: Scene, pts: np.ndarray, rigid_idx: int, phi: float, z) -> s
     return "working flank" if side == scene.working else "non-working flank"
 
 
-def entry_gap(scene: Scene, z) -> tuple[float, float]:
-    """Entry gap (theory.md 5): clearance when the tooth's tip crosses the rigid tip circle on the entry side.
+def entry_crossings(scene: Scene, zs: list) -> list[tuple[float, float]]:
+    """Entry gap (theory.md 5) of each section: the clearance when the tooth's tip crosses the rigid tip circle on the entry side.
 
-    Returns ``(gap mm, phi rad)``; the crossing is solved to 1e-13 rad.
+    All sections at once: the crossing is bracketed on a 1 deg grid and the
+    brackets are shrunk 32-fold per step by vectorised grids, to 1e-12 rad.
+
+    Returns
+    -------
+    list of ``(gap mm, phi rad)`` per section (NaN where the tips never cross).
     """
     sgn = scene.entry_sign
     half = pi / scene.n_w
-
     tip = scene.flex_tip_local
+    m = len(zs)
 
-    def f(p):
-        return scene.radial_bound(scene.place(sgn * p, z, local=tip))
+    def f(p, zi):
+        rot, shift = scene.pose_sections(sgn * p, zi, zs)
+        return scene.radial_bound(transform(tip, rot, shift))
 
-    # radial overlap near the major axis (f <= 0), separation toward the minor axis
-    # (f > 0): bracket the first crossing on a grid, then shrink the bracket by
-    # vectorised grids (x180 per level) to below 1e-12 rad
-    lo_, hi_ = 0.0, half
-    grid = np.linspace(lo_, hi_, 181)
-    vals = f(grid)
-    cross = np.nonzero((vals[:-1] <= 0) & (vals[1:] > 0))[0]
-    if cross.size == 0:
-        return float("nan"), float("nan")
-    lo_, hi_ = grid[cross[0]], grid[cross[0] + 1]
-    while hi_ - lo_ > 1e-12:
-        grid = np.linspace(lo_, hi_, 181)
-        vals = f(grid)
-        i = int(np.nonzero(vals > 0)[0][0])
-        lo_, hi_ = grid[max(i - 1, 0)], grid[i]
-    p_star = 0.5 * (lo_ + hi_)
-    gap = tooth_clearance(scene, np.array([sgn * p_star]), z)["min"][0]
-    return float(gap), float(sgn * p_star)
-
-
-def _zoom_min(f, lo: float, hi: float, n0: int = 121, n: int = 21, levels: int = 4):
-    """Minimise ``f`` (vectorised) on ``[lo, hi]``: a grid, then ``levels`` grids of ``n`` points
-    around the best point, each 10x finer. Returns ``(x, f(x))``."""
-    x = np.linspace(lo, hi, n0)
-    v = f(x)
-    for _ in range(levels):
-        i = int(np.argmin(v))
-        h = x[1] - x[0]
-        x = np.linspace(x[i] - h, x[i] + h, n)
-        v = f(x)
-    i = int(np.argmin(v))
-    return float(x[i]), float(v[i])
+    grid = np.linspace(0.0, half, int(round(np.rad2deg(half))) + 1)
+    n = len(grid)
+    vals = f(np.tile(grid, m), np.repeat(np.arange(m), n)).reshape(m, n)
+    # radial overlap near the major axis (f <= 0), separation toward the minor axis (f > 0)
+    lo = np.full(m, np.nan)
+    hi = np.full(m, np.nan)
+    for k in range(m):
+        cross = np.nonzero((vals[k, :-1] <= 0) & (vals[k, 1:] > 0))[0]
+        if cross.size:
+            lo[k], hi[k] = grid[cross[0]], grid[cross[0] + 1]
+    ok = np.nonzero(np.isfinite(lo))[0]
+    steps = 33
+    while ok.size and np.max(hi[ok] - lo[ok]) > 1e-12:
+        g = lo[ok][:, None] + (hi[ok] - lo[ok])[:, None] * np.linspace(0.0, 1.0, steps)[None, :]
+        v = f(g.ravel(), np.repeat(ok, steps)).reshape(len(ok), steps)
+        first = np.argmax(v > 0, axis=1)  # first grid point past the crossing
+        first = np.maximum(first, 1)
+        rows = np.arange(len(ok))
+        lo[ok], hi[ok] = g[rows, first - 1], g[rows, first]
+    out = [(float("nan"), float("nan"))] * m
+    if ok.size:
+        p_star = 0.5 * (lo[ok] + hi[ok])
+        gaps = tooth_clearance_sections(scene, sgn * p_star, ok, zs)
+        for j, k in enumerate(ok):
+            out[k] = (float(gaps[j]), float(sgn * p_star[j]))
+    return out
 
 
-def entry_pinch(scene: Scene, crossings, window_deg: float = 6.0):
+def entry_gap(scene: Scene, z) -> tuple[float, float]:
+    """:func:`entry_crossings` of one section: ``(gap mm, phi rad)``."""
+    return entry_crossings(scene, [z])[0]
+
+
+def lipschitz_min(f, lo: np.ndarray, hi: np.ndarray, V: np.ndarray, tol: float, n0: int = 25):
+    """Global minimum of several 1D functions at once, each on its own interval, from a Lipschitz bound.
+
+    ``f(x, k)`` evaluates function ``k[i]`` at ``x[i]`` (vectorised). Every
+    interval starts as a grid of ``n0`` points; a cell ``[a, b]`` cannot hold a
+    value below ``(f(a) + f(b))/2 - V (b - a)/2``, so cells whose bound is not
+    below the best value found (less ``tol``) are dropped and the rest split
+    in four, until none is left. The result is within ``tol`` of the smallest
+    value of all the functions.
+
+    Returns
+    -------
+    (value, x, k) of the smallest point found.
+    """
+    m = len(lo)
+    xs = np.concatenate([np.linspace(lo[k], hi[k], n0) for k in range(m)])
+    ks = np.repeat(np.arange(m), n0)
+    vs = f(xs, ks)
+    i = int(np.argmin(vs))
+    best = (float(vs[i]), float(xs[i]), int(ks[i]))
+    # cells between neighbouring grid points of the same function
+    same = ks[:-1] == ks[1:]
+    a, b, fa, fb, kc = xs[:-1][same], xs[1:][same], vs[:-1][same], vs[1:][same], ks[:-1][same]
+    for _ in range(60):
+        lb = 0.5 * (fa + fb) - V[kc] * (b - a) / 2
+        keep = lb < best[0] - tol
+        if not keep.any():
+            break
+        a, b, fa, fb, kc = a[keep], b[keep], fa[keep], fb[keep], kc[keep]
+        h = (b - a) / 4
+        x1, x2, x3 = a + h, a + 2 * h, a + 3 * h
+        v = f(np.concatenate([x1, x2, x3]), np.concatenate([kc, kc, kc]))
+        v1, v2, v3 = np.split(v, 3)
+        for xv, vv in ((x1, v1), (x2, v2), (x3, v3)):
+            j = int(np.argmin(vv))
+            if vv[j] < best[0]:
+                best = (float(vv[j]), float(xv[j]), int(kc[j]))
+        a = np.concatenate([a, x1, x2, x3])
+        b = np.concatenate([x1, x2, x3, b])
+        fa = np.concatenate([fa, v1, v2, v3])
+        fb = np.concatenate([v1, v2, v3, fb])
+        kc = np.concatenate([kc, kc, kc, kc])
+    return best
+
+
+def entry_pinch(scene: Scene, crossings, window_deg: float = 6.0, tol: float = 1e-5):
     """Smallest clearance near the entry crossing (theory.md 5: the pinch), over sections.
 
     Parameters
     ----------
     crossings : list of (phi_star, z)
-        Each section's own crossing angle.
+        Each section's own crossing angle; searched over ``phi_star +- window``.
+    tol : float
+        The result is within ``tol`` mm (default 0.01 um) of the true
+        smallest clearance in the windows (:func:`lipschitz_min` with the
+        speed bound of :meth:`Scene.speed_bound`).
 
-    Returns ``(clearance mm, phi rad, z, location)``. Each section is scanned
-    over ``phi_star +- window`` on a 0.1 deg grid; only sections whose coarse
-    minimum, less what the clearance can change between grid points
-    (speed bound x half a step), is below the best coarse minimum are then
-    zoomed in 10x per level to 1e-5 deg.
+    Returns ``(clearance mm, phi rad, z, location)``, or None when the
+    smallest value lies at the edge of the window (no pinch).
     """
     w = np.deg2rad(window_deg)
-    coarse = []
-    for p_star, z in crossings:
-        grid = np.linspace(p_star - w, p_star + w, int(2 * window_deg / 0.1) + 1)
-        c = tooth_clearance(scene, grid, z)["min"]
-        slack = scene.speed_bound(grid, z) * (grid[1] - grid[0]) / 2
-        coarse.append((float(c.min()), slack, p_star, z))
-    best_coarse = min(c for c, _, _, _ in coarse)
-    best = (np.inf, None, None)
-    for c, slack, p_star, z in coarse:
-        if c - slack > best_coarse:
-            continue  # cannot hold the smallest pinch
-        pm, cm = _zoom_min(lambda x: tooth_clearance(scene, x, z)["min"], p_star - w, p_star + w)
-        if cm < best[0]:
-            best = (cm, pm, z)
-    c_min, p_min, z_min = best
+    zs = [z for _, z in crossings]
+    lo = np.array([p - w for p, _ in crossings])
+    hi = np.array([p + w for p, _ in crossings])
+    V = np.array([scene.speed_bound(np.linspace(a, b, 49), z) for a, b, z in zip(lo, hi, zs)])
+    c_min, p_min, k = lipschitz_min(lambda x, kk: tooth_clearance_sections(scene, x, kk, zs), lo, hi, V, tol)
+    z_min = zs[k]
+    if min(p_min - lo[k], hi[k] - p_min) < 0.5 * (hi[k] - lo[k]) / 24:
+        # smallest at the window's edge: no local minimum near the entry (the clearance
+        # keeps falling into flank engagement, or rises from the crossing on)
+        return None
     det = tooth_clearance(scene, np.array([p_min]), z_min)
     side = "lower" if det["lower"][0] <= det["upper"][0] else "upper"
     rot, shift = scene.pose(np.array([p_min]), z_min)
@@ -550,15 +627,14 @@ def audit(drive, settings: AuditSettings, progress=None) -> AuditResult:
     rank = np.empty_like(order)
     rank[order] = np.arange(len(order))
     results = [_SectionSearch(scene, phi_sorted, z, settings) for z in sections]
-    for r in results:  # coarse pass over every section first: the best of any prunes all
-        r.start()
-    best = min(r.best() for r in results)
+    for r in results:
+        r.prepare_bound()
+    # coarse pass over every section first: the best of any prunes all; then finer strides
+    best = _evaluate(scene, results, [r.coarse() for r in results], sections)
     for step, stride in enumerate((64, 16, 4, 1)):
         tick(step + 1, 6, "clearance")
-        for r in results:
-            best = r.refine(stride, best)
-    for r in results:
-        best = r.finish(best)
+        best = _evaluate(scene, results, [r.candidates(stride, best) for r in results], sections)
+    best = _evaluate(scene, results, [r.culled_needed(best) for r in results], sections)
     # global minimum and where
     best, where = np.inf, None
     for si, r in enumerate(results):
@@ -592,7 +668,7 @@ def audit(drive, settings: AuditSettings, progress=None) -> AuditResult:
     }
     tick(5, 6, "entry gap")
     # entry gap: exact crossing per section
-    gaps = [(entry_gap(scene, z), z) for z in sections]
+    gaps = list(zip(entry_crossings(scene, sections), sections))
     (eg, ephi), ez = min(gaps, key=lambda t: (np.inf if np.isnan(t[0][0]) else t[0][0]))
     entry = {
         "tooth_angle_deg": round(float(np.rad2deg(ephi)), 6),
@@ -601,7 +677,15 @@ def audit(drive, settings: AuditSettings, progress=None) -> AuditResult:
     }
     if np.isfinite(eg):
         # the pinch: smallest clearance around each section's own crossing
-        pc, pp, pz, ploc = entry_pinch(scene, [(g[1], z) for g, z in gaps if np.isfinite(g[0])])
+        pinch = entry_pinch(scene, [(g[1], z) for g, z in gaps if np.isfinite(g[0])])
+    else:
+        pinch = None
+    if pinch is None:
+        pp = None
+        entry.update({"pinch_um": None, "pinch_tooth_angle_deg": None, "pinch_section_z_mm": None,
+                      "pinch_location": None, "tip_to_tip_risk": False})
+    else:
+        pc, pp, pz, ploc = pinch
         entry.update({
             "pinch_um": round(1e3 * pc, 4),
             "pinch_tooth_angle_deg": round(float(np.rad2deg(pp)), 6),
@@ -649,7 +733,7 @@ def audit(drive, settings: AuditSettings, progress=None) -> AuditResult:
         interference_tol=settings.interference_tol,
         counts=counts,
         settings_angles=angles,
-        raw={"worst_phi": phi_w, "entry_phi": ephi, "pinch_phi": pp if np.isfinite(eg) else None},
+        raw={"worst_phi": phi_w, "entry_phi": ephi, "pinch_phi": pp},
     )
     res.elapsed_s = time.perf_counter() - t0
     return res

@@ -206,6 +206,10 @@ class Law(abc.ABC):
         """
         return self._state(np.array(phi, dtype=np.float64))
 
+    #: whether every field scales with W0 (closed-form ring laws); the exact
+    #: ellipse does not, its shape changes with the amplitude
+    linear_in_w0: ClassVar[bool] = True
+
     def with_w0(self, w0: float) -> "Law":
         """The same law with another amplitude W0 (mm), e.g. for coning."""
         return replace(self, w0=w0)
@@ -583,6 +587,7 @@ class Ellipse(_TwoWaveLaw):
     (80.88, True)
     """
 
+    linear_in_w0: ClassVar[bool] = False
     name: ClassVar[str] = "ellipse"
 
     w0: float
