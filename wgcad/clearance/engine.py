@@ -670,9 +670,10 @@ def audit(drive, settings: AuditSettings, progress=None) -> AuditResult:
     # entry gap: exact crossing per section
     gaps = list(zip(entry_crossings(scene, sections), sections))
     (eg, ephi), ez = min(gaps, key=lambda t: (np.inf if np.isnan(t[0][0]) else t[0][0]))
+    crossed = bool(np.isfinite(eg))  # NaN: the tips never cross the rigid tip circle (no angle, no section)
     entry = {
-        "tooth_angle_deg": round(float(np.rad2deg(ephi)), 6),
-        "section_z_mm": None if ez is None else round(ez, 6),
+        "tooth_angle_deg": round(float(np.rad2deg(ephi)), 6) if crossed else None,
+        "section_z_mm": None if ez is None or not crossed else round(ez, 6),
         "side": "entry (+phi)" if scene.entry_sign > 0 else "entry (-phi)",
     }
     if np.isfinite(eg):

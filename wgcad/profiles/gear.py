@@ -191,17 +191,24 @@ def make_gear(sp: ToothSpec, tol: float = constants.CHORD_TOL) -> Gear:
         raise DesignError(f"{f}.tip_radius", f"tip radius {r_a:.4f} mm must be outside the root radius {r_f:.4f} mm for external teeth")
     if r_f <= 0 or r_a <= 0:
         raise DesignError(f"{f}.root_radius", f"radii must be positive (tip {r_a:.4f} mm, root {r_f:.4f} mm)")
-    tip_field = f"{f}.tip_radius" if sp.tip_radius is not None else f"{f}.shift"
+    # the field that sets the tip and how to blunt it: cycloidal teeth have no shift, c* truncates them (theory.md 2.2)
+    if sp.form == "involute":
+        tip_field = f"{f}.tip_radius" if sp.tip_radius is not None else f"{f}.shift"
+        fix = "lower the shift or truncate the tip"
+    elif sp.tip_radius is not None:
+        tip_field, fix = f"{f}.tip_radius", "truncate the tip: tip_radius nearer the pitch circle"
+    else:
+        tip_field, fix = "tooth.clearance_coef", "truncate the tip: larger tooth.clearance_coef (or a tip_radius)"
     if sp.form == "involute":
         half, tip_thk, r_base = _involute_half_period(sp, r, r_a, r_f, tol, tip_field)
     else:
-        half, tip_thk, r_base = _cycloid_half_period(sp, r, r_a, r_f, tol, tip_field)
+        half, tip_thk, r_base = _cycloid_half_period(sp, r, r_a, r_f, tol, tip_field, fix)
     s_min = constants.MIN_TIP_THICKNESS_COEF * sp.module
     if tip_thk < s_min:
         raise DesignError(
             tip_field,
             f"pointed teeth: tip thickness {tip_thk:.4f} mm is below the minimum {s_min:.4f} mm "
-            f"({constants.MIN_TIP_THICKNESS_COEF} m); lower the shift or truncate the tip",
+            f"({constants.MIN_TIP_THICKNESS_COEF} m); {fix}",
         )
     half = _dedupe(half)
     mirror = half[::-1] * np.array([1.0, -1.0])
@@ -350,7 +357,7 @@ def _involute_half_period(sp: ToothSpec, r, r_a, r_f, tol, tip_field):
     return _join(tip, tooth_frame[1:]), tip_thk, float(r_b)
 
 
-def _cycloid_half_period(sp: ToothSpec, r, r_a, r_f, tol, tip_field):
+def _cycloid_half_period(sp: ToothSpec, r, r_a, r_f, tol, tip_field, fix):
     """Upper half of one pitch of an exact cycloidal tooth, tooth frame (theory.md 2.2)."""
     f = sp.field
     if sp.shift != 0.0:
@@ -360,9 +367,14 @@ def _cycloid_half_period(sp: ToothSpec, r, r_a, r_f, tol, tip_field):
     q = pi * rho / r - _thin_angle(sp, r)  # pitch point of the upper flank
     add_epi = not sp.internal  # external teeth: epicycloid addendum
     lo, hi = (r - 2 * rho, r + 2 * rho)
-    if not (min(r_a, r_f) >= lo - 1e-12 and max(r_a, r_f) <= hi + 1e-12):
-        bad = f"{f}.tip_radius" if not (lo - 1e-12 <= r_a <= hi + 1e-12) else f"{f}.root_radius"
-        raise DesignError(bad, f"must lie within the cycloid's reach [{lo:.4f}, {hi:.4f}] mm (pitch radius +- m/2)")
+    # the addendum flank runs from the pitch circle to the tip, the dedendum flank from it to the
+    # root: a tip or root across the pitch circle has no flank to end on (theory.md 2.2)
+    reach = {"tip": (r, hi) if add_epi else (lo, r), "root": (lo, r) if add_epi else (r, hi)}
+    for name, where, val in (("tip", tip_field, r_a), ("root", f"{f}.root_radius", r_f)):
+        a, b = reach[name]
+        if not a - 1e-12 <= val <= b + 1e-12:
+            raise DesignError(where, f"{name} radius {val:.4f} mm must lie in [{a:.4f}, {b:.4f}] mm, between the pitch "
+                                     "circle and the cycloid's reach (pitch radius +- m/2)")
     curve_a = cy.epicycloid if add_epi else cy.hypocycloid
     curve_d = cy.hypocycloid if add_epi else cy.epicycloid
     phi_a = float(cy.roll_angle_at_radius(r, rho, r_a, add_epi))
@@ -374,7 +386,7 @@ def _cycloid_half_period(sp: ToothSpec, r, r_a, r_f, tol, tip_field):
     d_pts = sample_curve(ded, 0.0, phi_f, tol)
     psi_a = float(np.arctan2(a_pts[0, 1], a_pts[0, 0]))
     if psi_a <= 0:
-        raise DesignError(tip_field, "pointed teeth: the flanks meet below the tip radius")
+        raise DesignError(tip_field, f"pointed teeth: the flanks meet below the tip radius; {fix}")
     tip_thk = 2.0 * r_a * psi_a
     tip = arc_points((0.0, 0.0), r_a, 0.0, psi_a, tol)
     root0 = float(np.arctan2(d_pts[-1, 1], d_pts[-1, 0]))
