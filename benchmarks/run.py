@@ -69,10 +69,10 @@ def peak_memory_mb() -> float:
 def bench_audit(quick: bool) -> dict:
     """Issue 4 acceptance: full revolution at 0.5 deg and 3 sections vs the brute force; one mesh period; memory."""
     drive = build_drive(load_design(D1))
-    t_fast, fast = best_of(lambda: audit_of(drive, 0.5, 3), 3)
+    t_fast, fast = best_of(lambda: audit_of(drive, 0.5, 3), 5)
     mesh = 360.0 / drive.design.drive.z_rigid
     angles_1p = np.deg2rad(np.arange(0.0, mesh, 0.5))
-    t_1p, one = best_of(lambda: audit(drive, AuditSettings(angles=angles_1p, sections=drive.sections(3))), 5)
+    t_1p, one = best_of(lambda: audit(drive, AuditSettings(angles=angles_1p, sections=drive.sections(3))), 15)
     out = {
         "machine": machine(),
         "full_revolution_s": t_fast,
@@ -165,6 +165,52 @@ def bench_sections(quick: bool) -> list[dict]:
     return rows
 
 
+def bench_engines(quick: bool) -> list[dict]:
+    """2D engine against the FCL 3D check on the same pairs: time and difference.
+
+    D4 (no coning: 2D is exact, the 3D solids are prisms) shows the cost of
+    not skipping 3D; D1 (coned) the loft's section count against its bound.
+    """
+    from wgcad.clearance.engine import Scene, tooth_clearance
+    from wgcad.clearance.fcl3d import check_tooth
+
+    rows = []
+    d4 = build_drive(load_design(ROOT / "templates" / "d4_discrete.toml"))
+    sc = Scene(d4)
+    phis = np.deg2rad(np.linspace(30.0, 60.0, 7 if quick else 13))
+    t2, c2 = best_of(lambda: tooth_clearance(sc, phis, None)["min"], 5)
+    t3, res = best_of(lambda: [check_tooth(sc, float(p)) for p in phis], 1)
+    diff = max(abs(r["fcl_distance_um"] - 1e3 * c) for r, c in zip(res, c2))
+    rows.append({"case": f"D4 prisms, {len(phis)} teeth", "engine": "2d", "time_s": t2, "ratio": 1.0, "difference_um": 0.0, "bound_um": 0.0,
+                 "loft_sections": 0})
+    rows.append({"case": f"D4 prisms, {len(phis)} teeth", "engine": "fcl", "time_s": t3, "ratio": t3 / t2, "difference_um": diff, "bound_um": 0.0,
+                 "loft_sections": 0})
+    d1 = build_drive(load_design(D1))
+    sc1 = Scene(d1)
+    phi = np.deg2rad(45.0)
+    t2, _ = best_of(lambda: [tooth_clearance(sc1, np.array([phi]), z) for z in d1.sections(3)], 5)
+    for n in ([5, 9] if quick else [3, 5, 9, 17]):
+        t3, r = best_of(lambda: check_tooth(sc1, float(phi), n_sections=n), 1)
+        rows.append({"case": f"D1 coned, tooth at 45 deg, {n} loft sections", "engine": "fcl", "time_s": t3, "ratio": t3 / t2,
+                     "difference_um": abs(r["fcl_distance_um"] - r["clearance_2d_um"]), "bound_um": r["bound_um"] or 0.0,
+                     "loft_sections": n})
+    return rows
+
+
+def bench_templates(quick: bool) -> list[dict]:
+    """The audit of every bundled template: full revolution at 0.5 deg, 3 sections, and one mesh period."""
+    rows = []
+    for path in sorted((ROOT / "templates").glob("*.toml")):
+        drive = build_drive(load_design(path))
+        t_full, r = best_of(lambda: audit_of(drive, 0.5, 3), 1 if quick else 3)
+        mesh = 360.0 / drive.design.drive.z_rigid
+        ang = np.deg2rad(np.arange(0.0, mesh, 0.5))
+        t_1p, _ = best_of(lambda: audit(drive, AuditSettings(angles=ang, sections=drive.sections(3))), 15)
+        rows.append({"template": path.stem, "full_revolution_s": t_full, "one_period_s": t_1p,
+                     "samples": r.counts["samples"], "evaluated": r.counts["evaluated"], "min_clearance_um": 1e3 * r.min_clearance})
+    return rows
+
+
 def table_md(rows: list[dict]) -> str:
     keys = list(rows[0])
     lines = ["| " + " | ".join(keys) + " |", "|" + "---|" * len(keys)]
@@ -197,14 +243,16 @@ def plot(rows, x, title, path, y="min_clearance_error_um"):
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--quick", action="store_true")
-    ap.add_argument("--only", choices=["audit", "shortcuts", "chord", "step", "sections"])
+    ap.add_argument("--only", choices=["audit", "templates", "shortcuts", "chord", "step", "sections", "engines"])
     args = ap.parse_args(argv)
     OUT.mkdir(parents=True, exist_ok=True)
     report = {"machine": machine()}
     md = [f"# wgcad benchmarks\n\nMachine: {machine()}. Design: D1 involute (templates/d1_involute.toml).\n"]
     jobs = [
         ("audit", bench_audit, None),
+        ("templates", bench_templates, None),
         ("shortcuts", bench_shortcuts, None),
+        ("engines", bench_engines, None),
         ("chord", bench_chord_tol, ("chord_tol_um", "Chord tolerance (label: um)")),
         ("step", bench_angle_step, ("step_deg", "Generator-angle step (label: deg)")),
         ("sections", bench_sections, ("sections", "Cross-sections (label: count)")),
@@ -220,6 +268,9 @@ def main(argv=None) -> int:
             md.append(f"## {name}\n\n{table_md(res)}\n")
             if plot_spec:
                 plot(res, plot_spec[0], plot_spec[1], OUT / f"{name}.png")
+            if name == "engines":
+                lofts = [r for r in res if r["loft_sections"]]
+                plot(lofts, "loft_sections", "FCL check of a coned D1 tooth: loft sections (label)", OUT / "engines.png", y="bound_um")
             keys = list(res[0])
             (OUT / f"{name}.csv").write_text(",".join(keys) + "\n" + "\n".join(",".join(str(r[k]) for k in keys) for r in res) + "\n")
         else:

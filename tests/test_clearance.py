@@ -179,9 +179,10 @@ def test_entry_gap_is_clearance_at_the_tip_circle_crossing(d1):
     # angle is rounded to 1e-6 deg (1.7e-8 rad); points move < 3 mm/rad, so < 1e-7 mm
     assert np.hypot(pts[:, 0], pts[:, 1]).max() == pytest.approx(d1.rigid.r_a, abs=1e-7)
     assert tooth_clearance(scene, np.array([phi]), z)["min"][0] == pytest.approx(res.entry_gap, abs=1e-7)
-    # the pinch is the smallest clearance near it
+    # the pinch is the smallest clearance near it, to its search tolerance (a tenth of the
+    # chord tolerance) plus the JSON rounding (1e-4 um)
     near = np.linspace(phi - np.deg2rad(6), phi + np.deg2rad(6), 2401)
-    assert res.entry["pinch_um"] <= 1e3 * tooth_clearance(scene, near, z)["min"].min() + 1e-6
+    assert res.entry["pinch_um"] <= 1e3 * tooth_clearance(scene, near, z)["min"].min() + 1e3 * 0.1 * d1.tol + 1e-4
 
 
 def test_backlash_of_a_clean_design_by_rotation(d4):

@@ -71,10 +71,12 @@ def transform(local: np.ndarray, rot, shift) -> np.ndarray:
     """
     rot = np.atleast_1d(np.asarray(rot, dtype=float))
     shift = np.atleast_2d(np.asarray(shift, dtype=float))
-    c, s = np.cos(rot)[:, None], np.sin(rot)[:, None]
-    x = c * local[:, 0] - s * local[:, 1] + shift[:, 0:1]
-    y = s * local[:, 0] + c * local[:, 1] + shift[:, 1:2]
-    return np.stack([x, y], axis=-1)
+    c, s = np.cos(rot), np.sin(rot)
+    rt = np.empty((len(rot), 2, 2))  # transposed rotations: local @ R^T, one batched matmul
+    rt[:, 0, 0], rt[:, 0, 1], rt[:, 1, 0], rt[:, 1, 1] = c, s, -s, c
+    out = np.matmul(local, rt)
+    out += shift[:, None, :]
+    return out
 
 
 def pose_from_displacements(phi, w, v, theta, r_m: float, frame_angle=0.0):

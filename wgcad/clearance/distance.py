@@ -46,7 +46,7 @@ def _relative(rot_a, shift_a, rot_b, shift_b):
     return rel, np.stack([c * d[:, 0] - s * d[:, 1], s * d[:, 0] + c * d[:, 1]], axis=-1)
 
 
-def signed_clearance(a: Template, rot_a, shift_a, b: Template, rot_b, shift_b, b_geoms=None, area: bool = False):
+def signed_clearance(a: Template, rot_a, shift_a, b: Template, rot_b, shift_b, b_geoms=None, area: bool = False, a_geoms=None):
     """Signed clearance of pairs of rigid copies ``(A_k, B_k)``: > 0 apart, < 0 overlapping (minus the depth).
 
     The depth of an overlap is the largest distance by which a vertex of one
@@ -65,8 +65,9 @@ def signed_clearance(a: Template, rot_a, shift_a, b: Template, rot_b, shift_b, b
     rot_a, rot_b : (K,) float
     shift_a, shift_b : (K, 2) float
         Poses of the copies of each pair.
-    b_geoms : (K,) shapely geometries, optional
-        The copies of ``b`` if already built (e.g. static rigid teeth).
+    b_geoms, a_geoms : (K,) shapely geometries, optional
+        The copies of ``b`` (``a``) if already built (e.g. static rigid
+        teeth, or flexspline teeth measured against two neighbours).
     area : bool
         Also return the overlap areas.
 
@@ -79,7 +80,8 @@ def signed_clearance(a: Template, rot_a, shift_a, b: Template, rot_b, shift_b, b
     rot_b = np.broadcast_to(np.asarray(rot_b, dtype=float), rot_a.shape)
     shift_a = np.atleast_2d(np.asarray(shift_a, dtype=float))
     shift_b = np.broadcast_to(np.asarray(shift_b, dtype=float), shift_a.shape)
-    a_geoms = shapely.polygons(transform(a.local, rot_a, shift_a))
+    if a_geoms is None:
+        a_geoms = shapely.polygons(transform(a.local, rot_a, shift_a))
     if b_geoms is None:
         b_geoms = shapely.polygons(transform(b.local, rot_b, shift_b))
     d = shapely.distance(a_geoms, b_geoms)

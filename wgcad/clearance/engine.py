@@ -188,10 +188,10 @@ class Scene:
         R = np.hypot(pts[..., 0], pts[..., 1])
         return R.min(axis=1) - self.r_tip_b if self.external else self.r_tip_b - R.max(axis=1)
 
-    def clearance_to(self, rot, shift, j, area: bool = False):
+    def clearance_to(self, rot, shift, j, area: bool = False, flex_geoms=None):
         """Signed clearance of flexspline teeth at poses ``(rot, shift)`` to rigid teeth ``j``."""
         return signed_clearance(self.flex, rot, shift, self.rigid, self.rigid_rot[j], self.rigid_shift[j],
-                                b_geoms=self.rigid_geoms[j], area=area)
+                                b_geoms=self.rigid_geoms[j], area=area, a_geoms=flex_geoms)
 
 
 def tooth_clearance(scene: Scene, phi, z=None, third: bool = True, area: bool = False) -> dict:
@@ -217,9 +217,11 @@ def tooth_clearance_sections(scene: Scene, phi: np.ndarray, zi: np.ndarray, zs: 
 def clearance_at_poses(scene: Scene, rot: np.ndarray, shift: np.ndarray, third: bool = True, area: bool = False) -> dict:
     """:func:`tooth_clearance` for teeth given by their poses (rigid frame)."""
     lo, up, th = scene.neighbours(shift, rot)
+    pts = transform(scene.flex_local, rot, shift)
+    geoms = shapely.polygons(pts)  # built once, measured against every neighbour
     out = {}
     for key, idx in (("lower", lo), ("upper", up)):
-        res = scene.clearance_to(rot, shift, idx, area=area)
+        res = scene.clearance_to(rot, shift, idx, area=area, flex_geoms=geoms)
         if area:
             out[key], out[f"{key}_area"] = res
         else:
@@ -229,7 +231,6 @@ def clearance_at_poses(scene: Scene, rot: np.ndarray, shift: np.ndarray, third: 
     if third:
         # the third tooth lies beyond a bracketing one: 2 R sin(dphi/2) bounds its distance,
         # with dphi the angular gap between the tooth and the third tooth's flank extent
-        pts = transform(scene.flex_local, rot, shift)
         R = np.hypot(pts[..., 0], pts[..., 1])
         ang = np.arctan2(pts[..., 1], pts[..., 0])
         tc = scene.rigid_rot[th]
@@ -238,7 +239,7 @@ def clearance_at_poses(scene: Scene, rot: np.ndarray, shift: np.ndarray, third: 
         lb = 2.0 * r_lo * np.sin(np.clip(gap, 0.0, None) / 2.0)
         need = np.nonzero(lb < best)[0]
         if need.size:
-            out["third"][need] = scene.clearance_to(rot[need], shift[need], th[need])
+            out["third"][need] = scene.clearance_to(rot[need], shift[need], th[need], flex_geoms=geoms[need])
     out["min"] = np.minimum(best, out["third"])
     out["lo"], out["up"] = lo, up
     return out
@@ -402,7 +403,8 @@ def entry_crossings(scene: Scene, zs: list) -> list[tuple[float, float]]:
     """Entry gap (theory.md 5) of each section: the clearance when the tooth's tip crosses the rigid tip circle on the entry side.
 
     All sections at once: the crossing is bracketed on a 1 deg grid and the
-    brackets are shrunk 32-fold per step by vectorised grids, to 1e-12 rad.
+    brackets are shrunk 32-fold per step by vectorised grids, to 1e-10 rad
+    (the clearance there then moves by less than ``V * 1e-10``, ~3e-10 mm).
 
     Returns
     -------
@@ -429,7 +431,7 @@ def entry_crossings(scene: Scene, zs: list) -> list[tuple[float, float]]:
             lo[k], hi[k] = grid[cross[0]], grid[cross[0] + 1]
     ok = np.nonzero(np.isfinite(lo))[0]
     steps = 33
-    while ok.size and np.max(hi[ok] - lo[ok]) > 1e-12:
+    while ok.size and np.max(hi[ok] - lo[ok]) > 1e-10:
         g = lo[ok][:, None] + (hi[ok] - lo[ok])[:, None] * np.linspace(0.0, 1.0, steps)[None, :]
         v = f(g.ravel(), np.repeat(ok, steps)).reshape(len(ok), steps)
         first = np.argmax(v > 0, axis=1)  # first grid point past the crossing
@@ -450,6 +452,10 @@ def entry_gap(scene: Scene, z) -> tuple[float, float]:
     return entry_crossings(scene, [z])[0]
 
 
+#: cells of :func:`lipschitz_min` split into this many per round
+SPLIT = 4
+
+
 def lipschitz_min(f, lo: np.ndarray, hi: np.ndarray, V: np.ndarray, tol: float, n0: int = 25):
     """Global minimum of several 1D functions at once, each on its own interval, from a Lipschitz bound.
 
@@ -457,7 +463,7 @@ def lipschitz_min(f, lo: np.ndarray, hi: np.ndarray, V: np.ndarray, tol: float, 
     interval starts as a grid of ``n0`` points; a cell ``[a, b]`` cannot hold a
     value below ``(f(a) + f(b))/2 - V (b - a)/2``, so cells whose bound is not
     below the best value found (less ``tol``) are dropped and the rest split
-    in four, until none is left. The result is within ``tol`` of the smallest
+    in :data:`SPLIT`, until none is left. The result is within ``tol`` of the smallest
     value of all the functions.
 
     Returns
@@ -479,37 +485,39 @@ def lipschitz_min(f, lo: np.ndarray, hi: np.ndarray, V: np.ndarray, tol: float, 
         if not keep.any():
             break
         a, b, fa, fb, kc = a[keep], b[keep], fa[keep], fb[keep], kc[keep]
-        h = (b - a) / 4
-        x1, x2, x3 = a + h, a + 2 * h, a + 3 * h
-        v = f(np.concatenate([x1, x2, x3]), np.concatenate([kc, kc, kc]))
-        v1, v2, v3 = np.split(v, 3)
-        for xv, vv in ((x1, v1), (x2, v2), (x3, v3)):
-            j = int(np.argmin(vv))
-            if vv[j] < best[0]:
-                best = (float(vv[j]), float(xv[j]), int(kc[j]))
-        a = np.concatenate([a, x1, x2, x3])
-        b = np.concatenate([x1, x2, x3, b])
-        fa = np.concatenate([fa, v1, v2, v3])
-        fb = np.concatenate([v1, v2, v3, fb])
-        kc = np.concatenate([kc, kc, kc, kc])
+        # split each kept cell in SPLIT: one batched call per round (the calls, not the points, cost most)
+        t = np.arange(1, SPLIT) / SPLIT
+        xi = a[:, None] + (b - a)[:, None] * t[None, :]  # (C, SPLIT-1)
+        vi = f(xi.ravel(), np.repeat(kc, SPLIT - 1)).reshape(xi.shape)
+        j = np.unravel_index(int(np.argmin(vi)), vi.shape)
+        if vi[j] < best[0]:
+            best = (float(vi[j]), float(xi[j]), int(kc[j[0]]))
+        xs_ = np.concatenate([a[:, None], xi, b[:, None]], axis=1)
+        vs_ = np.concatenate([fa[:, None], vi, fb[:, None]], axis=1)
+        a, b = xs_[:, :-1].ravel(), xs_[:, 1:].ravel()
+        fa, fb = vs_[:, :-1].ravel(), vs_[:, 1:].ravel()
+        kc = np.repeat(kc, SPLIT)
     return best
 
 
-def entry_pinch(scene: Scene, crossings, window_deg: float = 6.0, tol: float = 1e-5):
+def entry_pinch(scene: Scene, crossings, window_deg: float = 6.0, tol: float | None = None):
     """Smallest clearance near the entry crossing (theory.md 5: the pinch), over sections.
 
     Parameters
     ----------
     crossings : list of (phi_star, z)
         Each section's own crossing angle; searched over ``phi_star +- window``.
-    tol : float
-        The result is within ``tol`` mm (default 0.01 um) of the true
-        smallest clearance in the windows (:func:`lipschitz_min` with the
-        speed bound of :meth:`Scene.speed_bound`).
+    tol : float, optional
+        The result is within ``tol`` mm of the true smallest clearance in
+        the windows (:func:`lipschitz_min` with the speed bound of
+        :meth:`Scene.speed_bound`). Default: a tenth of the chord tolerance;
+        the outlines themselves are only within that tolerance of the
+        curves, so a finer search would be false precision.
 
     Returns ``(clearance mm, phi rad, z, location)``, or None when the
     smallest value lies at the edge of the window (no pinch).
     """
+    tol = 0.1 * scene.drive.tol if tol is None else tol
     w = np.deg2rad(window_deg)
     zs = [z for _, z in crossings]
     lo = np.array([p - w for p, _ in crossings])
@@ -586,7 +594,7 @@ def backlash(scene: Scene, phi_h: float, z=None) -> float:
     for idx, direction in ((up, 1.0), (lo, -1.0)):
         d = scene.clearance_to(rot0, shift0, idx)
         if d.min() < 0:
-            return float("nan")  # teeth interfere here: there is no dead travel
+            return float("nan")  # teeth interfere here: there is no dead travel (no need to look further)
         sides.append((idx, direction, d))
     total = 0.0
     for idx, direction, d in sides:
