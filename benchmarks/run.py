@@ -113,55 +113,65 @@ def bench_shortcuts(quick: bool) -> list[dict]:
     return rows
 
 
+TEMPLATES = sorted((ROOT / "templates").glob("*.toml"))
+
+
 def bench_chord_tol(quick: bool) -> list[dict]:
-    """Chord tolerance of the outlines: audit figures against a converged reference (0.01 um outlines)."""
-    design = load_design(D1)
-    step = 2.0
-    ref_drive = build_drive(design, tol=1e-5)
-    ref = audit_of(ref_drive, step, 3)
+    """Chord tolerance of the outlines: audit figures against a converged reference (0.01 um outlines), every template."""
     rows = []
-    tols_um = [10.0, 3.0, 1.0, 0.3] if quick else [30.0, 10.0, 3.0, 1.0, 0.3, 0.1, 0.03]
-    t_base = None
-    for tol_um in tols_um:
-        t, (drive, res) = best_of(lambda: (lambda d: (d, audit_of(d, step, 3)))(build_drive(design, tol=tol_um * 1e-3)), 2)
-        t_base = t_base or t
-        rows.append({
-            "chord_tol_um": tol_um,
-            "vertices_per_tooth": len(drive.flex.period),
-            "time_s": t,
-            "ratio": t / t_base,
-            "min_clearance_error_um": 1e3 * abs(res.min_clearance - ref.min_clearance),
-            "entry_gap_error_um": 1e3 * abs(res.entry_gap - ref.entry_gap),
-        })
+    tols_um = [10.0, 1.0, 0.3] if quick else [30.0, 10.0, 3.0, 1.0, 0.3, 0.1, 0.03]
+    step = 2.0
+    for path in TEMPLATES:
+        design = load_design(path)
+        ref = audit_of(build_drive(design, tol=1e-5), step, 3)
+        t_base = None
+        for tol_um in tols_um:
+            t, (drive, res) = best_of(lambda: (lambda d: (d, audit_of(d, step, 3)))(build_drive(design, tol=tol_um * 1e-3)), 2)
+            t_base = t_base or t
+            eg = abs(res.entry_gap - ref.entry_gap) if np.isfinite(ref.entry_gap) else 0.0
+            rows.append({
+                "template": path.stem,
+                "chord_tol_um": tol_um,
+                "vertices_per_tooth": len(drive.flex.period),
+                "time_s": t,
+                "ratio": t / t_base,
+                "min_clearance_error_um": 1e3 * abs(res.min_clearance - ref.min_clearance),
+                "entry_gap_error_um": 1e3 * eg,
+            })
     return rows
 
 
 def bench_angle_step(quick: bool) -> list[dict]:
-    """Generator-angle step: the sampled minimum against a fine reference (0.02 deg)."""
-    drive = build_drive(load_design(D1))
-    ref = audit_of(drive, 0.02, 3)
+    """Generator-angle step: the sampled minimum against a fine reference (0.02 deg), every template."""
     rows = []
-    steps = [5.0, 2.0, 1.0, 0.5] if quick else [10.0, 5.0, 2.0, 1.0, 0.5, 0.2, 0.1]
-    t_base = None
-    for st in steps:
-        t, res = best_of(lambda: audit_of(drive, st, 3), 2)
-        t_base = t_base or t
-        rows.append({"step_deg": st, "time_s": t, "ratio": t / t_base, "min_clearance_error_um": 1e3 * abs(res.min_clearance - ref.min_clearance)})
+    steps = [5.0, 1.0, 0.5] if quick else [10.0, 5.0, 2.0, 1.0, 0.5, 0.2, 0.1]
+    for path in TEMPLATES:
+        drive = build_drive(load_design(path))
+        ref = audit_of(drive, 0.02, 3)
+        t_base = None
+        for st in steps:
+            t, res = best_of(lambda: audit_of(drive, st, 3), 2)
+            t_base = t_base or t
+            rows.append({"template": path.stem, "step_deg": st, "time_s": t, "ratio": t / t_base,
+                         "min_clearance_error_um": 1e3 * abs(res.min_clearance - ref.min_clearance)})
     return rows
 
 
 def bench_sections(quick: bool) -> list[dict]:
-    """Cross-sections over the face width (coning): minimum against 61 sections."""
-    drive = build_drive(load_design(D1))
-    ref = audit_of(drive, 1.0, 61)
+    """Cross-sections over the face width (coned templates): minimum and entry gap against 61 sections."""
     rows = []
-    t_base = None
-    for k in ([2, 3, 5] if quick else [2, 3, 5, 9, 17]):
-        t, res = best_of(lambda: audit_of(drive, 1.0, k), 2)
-        t_base = t_base or t
-        rows.append({"sections": k, "time_s": t, "ratio": t / t_base,
-                     "min_clearance_error_um": 1e3 * abs(res.min_clearance - ref.min_clearance),
-                     "entry_gap_error_um": 1e3 * abs(res.entry_gap - ref.entry_gap)})
+    for path in TEMPLATES:
+        drive = build_drive(load_design(path))
+        if not drive.coned:
+            continue
+        ref = audit_of(drive, 1.0, 61)
+        t_base = None
+        for k in ([2, 3, 5] if quick else [2, 3, 5, 9, 17]):
+            t, res = best_of(lambda: audit_of(drive, 1.0, k), 2)
+            t_base = t_base or t
+            rows.append({"template": path.stem, "sections": k, "time_s": t, "ratio": t / t_base,
+                         "min_clearance_error_um": 1e3 * abs(res.min_clearance - ref.min_clearance),
+                         "entry_gap_error_um": 1e3 * abs(res.entry_gap - ref.entry_gap)})
     return rows
 
 
@@ -220,21 +230,29 @@ def table_md(rows: list[dict]) -> str:
 
 
 def plot(rows, x, title, path, y="min_clearance_error_um"):
+    """Time against error, one line per template (labels: the knob's value)."""
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    fig, ax = plt.subplots(figsize=(6.5, 4.5), dpi=90)
-    ts = [r["time_s"] for r in rows]
-    es = [max(r[y], 1e-7) for r in rows]
-    ax.loglog(ts, es, "o-")
-    for r, t, e in zip(rows, ts, es):
-        ax.annotate(f"{r[x]:g}", (t, e), textcoords="offset points", xytext=(5, 5), fontsize=8)
+    fig, ax = plt.subplots(figsize=(7.5, 5), dpi=90)
+    groups = {}
+    for r in rows:
+        groups.setdefault(r.get("template", ""), []).append(r)
+    floor = 1e-7  # errors of exactly 0 drawn at the floor of the log axis
+    for name, rs in groups.items():
+        ts = [r["time_s"] for r in rs]
+        es = [max(r[y], floor) for r in rs]
+        ax.loglog(ts, es, "o-", label=name or None)
+        for r, t, e in zip(rs, ts, es):
+            ax.annotate(f"{r[x]:g}", (t, e), textcoords="offset points", xytext=(4, 4), fontsize=7)
     ax.set_xlabel("run time, s")
-    ax.set_ylabel(y.replace("_", " "))
+    ax.set_ylabel(y.replace("_", " ") + f" (0 drawn at {floor:g})")
     ax.set_title(title, fontsize=10)
     ax.grid(alpha=0.3, which="both")
+    if any(groups):
+        ax.legend(fontsize=7)
     fig.tight_layout()
     fig.savefig(path)
     plt.close(fig)
@@ -247,7 +265,7 @@ def main(argv=None) -> int:
     args = ap.parse_args(argv)
     OUT.mkdir(parents=True, exist_ok=True)
     report = {"machine": machine()}
-    md = [f"# wgcad benchmarks\n\nMachine: {machine()}. Design: D1 involute (templates/d1_involute.toml).\n"]
+    md = [f"# wgcad benchmarks\n\nMachine: {machine()}. Designs: the bundled templates (D1 involute where one is named).\n"]
     jobs = [
         ("audit", bench_audit, None),
         ("templates", bench_templates, None),
