@@ -6,6 +6,7 @@ __all__ = [
     "ROOT_SPACE_MIN_COEF",
     "NEWTON_TOL",
     "INTERFERENCE_TOL",
+    "DUPLICATE_TOL",
 ]
 
 #: Largest distance (mm) between a discretised outline and the exact curve.
@@ -31,3 +32,9 @@ NEWTON_TOL = 1e-13
 #: default chord tolerance: outlines are only known to within it, so a
 #: smaller overlap is not a finding about the design.
 INTERFERENCE_TOL = 1e-3
+
+#: Consecutive vertices closer than this (mm) are one vertex. 1 pm is six
+#: orders below the 1 um chord tolerance of outlines and far above the
+#: ~1e-14 mm rounding noise of float64 coordinates near 100 mm, so it removes
+#: exact and round-off duplicates and nothing else.
+DUPLICATE_TOL = 1e-9

@@ -48,6 +48,15 @@ def _new_temp(final: Path) -> str:
     raise FileExistsError(f"{final.parent}: no free temporary file name")  # pragma: no cover
 
 
+def _prepare_temp(final: Path) -> str:
+    """Create the folder of ``final`` and an empty temporary file beside it; OutputError if it cannot."""
+    try:
+        final.parent.mkdir(parents=True, exist_ok=True)
+        return _new_temp(final)
+    except OSError as exc:
+        raise OutputError(f"{final.parent}: output folder is not writable ({_reason(exc)})") from exc
+
+
 def _remove_quietly(path: str | os.PathLike) -> None:
     with contextlib.suppress(FileNotFoundError):
         os.remove(path)
@@ -141,13 +150,7 @@ def atomic_writer(path: str | os.PathLike) -> Iterator[str]:
     'done'
     """
     final = Path(path)
-    try:
-        final.parent.mkdir(parents=True, exist_ok=True)
-        temp = _new_temp(final)
-    except OSError as exc:
-        raise OutputError(
-            f"{final.parent}: output folder is not writable ({_reason(exc)})"
-        ) from exc
+    temp = _prepare_temp(final)
     try:
         yield temp
         _fsync(temp)
@@ -267,13 +270,7 @@ class Batch:
         final = Path(path)
         if any(os.path.abspath(final) == os.path.abspath(f) for f, _ in self.pairs):
             raise OutputError(f"{final}: cannot write file (listed twice in one batch)")
-        try:
-            final.parent.mkdir(parents=True, exist_ok=True)
-            temp = _new_temp(final)
-        except OSError as exc:
-            raise OutputError(
-                f"{final.parent}: output folder is not writable ({_reason(exc)})"
-            ) from exc
+        temp = _prepare_temp(final)
         self.pairs.append((final, temp))
         return temp
 

@@ -12,15 +12,11 @@ import numpy as np
 from ezdxf.lldxf.validator import is_valid_layer_name
 
 from wgcad.errors import InputFileError
+from wgcad.constants import DUPLICATE_TOL  # noqa: F401  (re-exported for callers)
 from wgcad.export.atomic import atomic_writer
+from wgcad.export.rings import clean_outline
 
 __all__ = ["DxfLayer", "build_dxf", "write_dxf", "read_dxf", "audit_dxf", "clean_outline"]
-
-#: Consecutive vertices closer than this (mm) are one vertex. 1 pm is six
-#: orders below the 1 um chord tolerance of outlines and far above the
-#: ~1e-14 mm rounding noise of float64 coordinates near 100 mm, so it removes
-#: exact and round-off duplicates and nothing else.
-DUPLICATE_TOL = 1e-9
 
 #: DXF version written: R2010 (AC1024), read by every current CAD program.
 DXF_VERSION = "R2010"
@@ -30,46 +26,6 @@ INSUNITS_MM = 4
 
 #: ``$MEASUREMENT`` 1 = metric.
 MEASUREMENT_METRIC = 1
-
-
-def clean_outline(outline, tol: float = DUPLICATE_TOL) -> np.ndarray:
-    """Remove consecutive duplicate vertices and a repeated closing vertex.
-
-    Parameters
-    ----------
-    outline : (N, 2) float array_like
-        Closed polygon, closing edge implicit or explicit.
-    tol : float
-        Vertices closer than this (mm) to the previous kept vertex are dropped.
-
-    Returns
-    -------
-    (M, 2) float64 ndarray
-        ``M <= N``; the last vertex differs from the first.
-
-    Raises
-    ------
-    ValueError
-        If the input is not (N, 2) finite or fewer than 3 vertices remain.
-
-    Examples
-    --------
-    >>> clean_outline([[0, 0], [1, 0], [1, 0], [0, 1], [0, 0]]).tolist()
-    [[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]]
-    """
-    pts = np.asarray(outline, dtype=np.float64)
-    if pts.ndim != 2 or pts.shape[1] != 2:
-        raise ValueError(f"outline must be an (N, 2) array, got shape {pts.shape}")
-    if not np.all(np.isfinite(pts)):
-        raise ValueError("outline has non-finite coordinates")
-    if len(pts) > 1:
-        step = np.hypot(*np.diff(pts, axis=0).T)
-        pts = pts[np.concatenate(([True], step > tol))]
-    while len(pts) > 1 and math.hypot(*(pts[-1] - pts[0])) <= tol:
-        pts = pts[:-1]
-    if len(pts) < 3:
-        raise ValueError(f"outline has {len(pts)} distinct vertices, needs at least 3")
-    return pts
 
 
 def _readonly(a: np.ndarray) -> np.ndarray:

@@ -13,14 +13,9 @@ from trimesh.exchange.stl import export_stl
 
 from wgcad.errors import GeometryError
 from wgcad.export.atomic import atomic_write
+from wgcad.export.rings import clean_outline
 
 __all__ = ["ring_solid", "stl_bytes", "write_stl"]
-
-#: Consecutive vertices closer than this (mm) are one vertex (same value and
-#: reason as ``wgcad.export.dxf.DUPLICATE_TOL``). Repeated points are removed
-#: before extrusion because trimesh's extruder silently builds broken meshes
-#: from them and manifold3d would merge them anyway.
-DUPLICATE_TOL = 1e-9
 
 #: Largest relative difference allowed between the cross-section area
 #: manifold3d builds and the shapely area of the input polygon. manifold3d
@@ -35,19 +30,9 @@ STL_HEADER = b"wgcad binary STL, units mm"
 
 
 def _ring(points, what: str) -> np.ndarray:
-    pts = np.asarray(points, dtype=np.float64)
-    if pts.ndim != 2 or pts.shape[1] != 2:
-        raise ValueError(f"{what} must be an (N, 2) array, got shape {pts.shape}")
-    if not np.all(np.isfinite(pts)):
-        raise ValueError(f"{what} has non-finite coordinates")
-    if len(pts) > 1:
-        step = np.hypot(*np.diff(pts, axis=0).T)
-        pts = pts[np.concatenate(([True], step > DUPLICATE_TOL))]
-    while len(pts) > 1 and math.hypot(*(pts[-1] - pts[0])) <= DUPLICATE_TOL:
-        pts = pts[:-1]
-    if len(pts) < 3:
-        raise GeometryError(f"{what}: has {len(pts)} distinct vertices, needs at least 3")
-    return pts
+    # repeated points are removed before extrusion: trimesh's extruder silently
+    # builds broken meshes from them and manifold3d would merge them anyway
+    return clean_outline(points, what=what, too_few=GeometryError)
 
 
 def _signed_area(pts: np.ndarray) -> float:
