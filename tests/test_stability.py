@@ -25,7 +25,7 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 from scipy.optimize import brentq
 
-import wgcad.report as report_mod
+import wgcad.report.drive as report_mod
 from conftest import TEMPLATES
 from wgcad import constants
 from wgcad.clearance.distance import Template, signed_clearance

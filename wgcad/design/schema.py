@@ -9,7 +9,7 @@ import typing
 from dataclasses import MISSING, dataclass, fields, replace
 from pathlib import Path
 
-from .errors import DesignError, InputFileError
+from ..errors import DesignError, InputFileError
 
 __all__ = [
     "DriveSpec",

@@ -6,10 +6,10 @@ from math import pi
 
 import numpy as np
 
-from . import __version__
-from .kinematics import gear_ratios
-from .placement import place_points, place_points_first_order, tooth_angles
-from .profiles import cycloid as cy
+from .. import __version__
+from ..kinematics import gear_ratios
+from ..placement import place_points, place_points_first_order, tooth_angles
+from ..profiles import cycloid as cy
 
 __all__ = ["gear_figures", "mesh_figures", "drive_report", "format_summary"]
 
