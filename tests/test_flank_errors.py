@@ -69,9 +69,9 @@ def _spectrum(signal):
 @pytest.mark.parametrize("z_g, z_b", [(200, 202), (300, 298)])  # D2 (internal), D3 (external deformation)
 def test_each_term_at_its_order_in_the_spectrum(z_g, z_b):
     # Relative to the generator the rigid gear turns once per generator turn and the
-    # flexspline z_b/z_g times: over z_g/gcd generator turns (one flexspline revolution
-    # for z_b - z_g = +-2) the rigid-gear terms sit in bin T and the flexspline's in bin
-    # T z_b/z_g, an integer (101 of 100 for D2, 149 of 150 for D3).
+    # flexspline z_b/z_g times: over T = z_g/gcd generator turns (here one flexspline
+    # revolution, as gcd = |z_b - z_g|) the rigid-gear terms sit in bin T and the
+    # flexspline's in bin T z_b/z_g, an integer (101 of 100 for D2, 149 of 150 for D3).
     turns = z_g // math.gcd(z_g, z_b)
     bin_rigid, bin_flex = turns, turns * z_b // z_g
     assert abs(gear_ratios(z_g, z_b)["u_hg"]) == turns  # = one flexspline revolution (docs/models.md 1)

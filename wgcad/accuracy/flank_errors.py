@@ -130,7 +130,8 @@ def gear_angles(phi_h, z_flex: int, z_rigid: int, flex_start: float = 0.0, rigid
     ``phi_h / u_hg - phi_h = -phi_h z_b / z_g`` (docs/models.md 1): the
     flexspline's terms have order ``z_b / z_g`` per generator turn, the rigid
     gear's order 1. Both repeat after ``z_g / gcd(z_g, z_b)`` generator turns
-    (one flexspline revolution for ``z_b - z_g = 2``).
+    (one flexspline revolution, ``|u_hg|`` turns, when ``gcd(z_g, z_b) = |z_b - z_g|``,
+    e.g. 200/202).
 
     Parameters
     ----------
