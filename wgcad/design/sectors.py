@@ -146,14 +146,14 @@ def validate_sectors(spec: SectorsSpec, z_flex: int, z_rigid: int, waves: int) -
     for i, k in enumerate(spec.kinds):
         if k not in KINDS:
             raise DesignError(f"{t}.kinds[{i}]", f"must be one of {', '.join(KINDS)}; got '{k}'")
+    if n != 2 * waves:
+        # one transmission and one coupling sector per wave: each wave end passes both kinds per wave period
+        raise DesignError(f"{t}.kinds", f"must list 2 x drive.waves = {2 * waves} sectors (one of each kind per wave), got {n}")
     if len(spec.teeth) != n:
         raise DesignError(f"{t}.teeth", f"must list one tooth count per sector ({n} kinds), got {len(spec.teeth)}")
     for i, z in enumerate(spec.teeth):
         if z < 2:
             raise DesignError(f"{t}.teeth[{i}]", f"must be at least 2 teeth, got {z}")
-    if n != 2 * waves:
-        # one transmission and one coupling sector per wave: each wave end passes both kinds per wave period
-        raise DesignError(f"{t}.kinds", f"must list 2 x drive.waves = {2 * waves} sectors (one of each kind per wave), got {n}")
     for i in range(n):
         if spec.kinds[i] == spec.kinds[(i + 1) % n]:
             raise DesignError(f"{t}.kinds", f"sectors {i} and {(i + 1) % n} are both {spec.kinds[i]}: transmission and coupling sectors must alternate")

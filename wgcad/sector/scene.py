@@ -39,6 +39,10 @@ __all__ = ["SectoredScene", "SweepPairs", "SectoredAudit", "sectored_audit", "sw
 #: at most |w'| ~ W0 per rad, 1.4 um per 0.1 deg at W0 = 0.8 mm
 DEFAULT_STEP_DEG = 0.1
 
+#: the third-nearest rigid tooth is measured only when the flexspline tooth's centre line lies within this fraction of
+#: a pitch of the nearer bracketing tooth's (see :meth:`SectoredScene.pairs`)
+THIRD_TOOTH_WITHIN = 0.15
+
 #: teeth radially clear of every rigid tip by more than this (mm) are not
 #: measured: their clearance is at least this, far above any finding
 DEFAULT_CULL = 0.05
@@ -121,7 +125,8 @@ class SectoredScene:
         """Flexspline-rigid tooth pairs worth measuring over the generator angles ``phi_h``.
 
         Each flexspline tooth is paired with the two rigid teeth that bracket
-        its centre line and the next nearest; teeth radially clear of the
+        its centre line, and with the next nearest where it can reach it
+        (:data:`THIRD_TOOTH_WITHIN`); teeth radially clear of the
         smallest rigid tip radius by more than ``cull`` are left out.
         ``teeth`` restricts the rigid teeth (indices).
         """
@@ -147,10 +152,15 @@ class SectoredScene:
         lo = (up - 1) % N
         d_lo = np.abs(_wrap(ang - c[lo]))
         d_up = np.abs(_wrap(ang - c[up]))
-        third = np.where(d_lo < d_up, (lo - 1) % N, (up + 1) % N)
-        idx = np.stack([lo, up, third], axis=1)
-        rows = np.repeat(np.arange(len(ang)), 3)
-        ri = idx.ravel()
+        near_lo = d_lo < d_up
+        third = np.where(near_lo, (lo - 1) % N, (up + 1) % N)
+        # Both tooth polygons span half a pitch either side of their centre lines (their bodies are closed there), so a
+        # flexspline tooth reaches past the nearer bracketing tooth only when its centre line is almost on that tooth's;
+        # 0.15 pitch covers the tilt of the tooth (theta ~ 0.05 rad swings its corners by < 0.1 pitch).
+        d_near = np.where(near_lo, d_lo, d_up)
+        need3 = d_near < THIRD_TOOTH_WITHIN * self.layout.pitch[np.where(near_lo, lo, up)]
+        rows = np.concatenate([np.arange(len(ang)), np.arange(len(ang)), np.nonzero(need3)[0]])
+        ri = np.concatenate([lo, up, third[need3]])
         sel = np.ones(len(ri), dtype=bool) if teeth is None else np.isin(ri, np.asarray(teeth))
         rows, ri = rows[sel], ri[sel]
         # angle from the nearer wave end (the law repeats every 2 pi / waves)
