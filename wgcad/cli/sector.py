@@ -159,7 +159,7 @@ def cmd_sector(args) -> int:
 
     bounds = np.rad2deg(lay.bounds)
     name = design.drive.name
-    png_h = sf.heights_png(f"{name}: coupling-tooth heights (theory 2.3), both ways", np.rad2deg(lay.centres), bounds, lay.kinds,
+    png_h = sf.heights_png(f"{name}: tooth heights (theory 2.3), both ways", np.rad2deg(lay.centres), bounds, lay.kinds,
                            res["full"], cf.heights, sim.heights, built, boundary_mm=cfb.heights if cfb is not cf else None,
                            tip_clearance_um=1e3 * res["tip_clearance"])
     # motion phases for the plot over 0..360
@@ -222,6 +222,13 @@ def _print_summary(name, res, summ, out) -> None:
     for r in summ["motion_law"]["runs"][:4]:
         ratio = "output still" if r["mean_ratio"] is None else f"output {r['output_step_deg']:+.6f} deg, mean u = {r['mean_ratio']:.4f}"
         print(f"    {r['kind']:5s} {r['start_deg']:9.4f} .. {r['end_deg']:9.4f} deg ({r['length_deg']:.4f} deg): {ratio}")
+    pieces = [p for p in summ["motion_law"]["phases"] if p["kind"] == "move"]
+    seen, parts = set(), []
+    for p_ in pieces:
+        if p_["ratio"] not in seen:
+            seen.add(p_["ratio"])
+            parts.append(f"u = {p_['ratio']:.4g} over {p_['length_deg']:.4f} deg")
+    print(f"    speed ratio in the move pieces (d phi_h / d phi_g): {'; '.join(parts)}")
     for key, label in (("audit_full", "full-height teeth"), ("audit_built", f"built heights ({res['mode']})")):
         a = res[key]
         where = ""

@@ -28,7 +28,7 @@ def _png(plt, fig) -> bytes:
 
 def _shade_sectors(ax, bounds_deg, kinds, lo, hi):
     for a, b, k in zip(bounds_deg[:-1], bounds_deg[1:], kinds):
-        if hi < a or lo > b:
+        if hi <= a or lo >= b:
             continue
         ax.axvspan(max(a, lo), min(b, hi), color="tab:green" if k == "coupling" else "tab:orange", alpha=0.08, lw=0)
         ax.text(0.5 * (max(a, lo) + min(b, hi)), 1.0, k, transform=ax.get_xaxis_transform(), ha="center", va="bottom", fontsize=8)

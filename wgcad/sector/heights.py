@@ -231,26 +231,39 @@ def simulated_heights(drive, layout: SectorLayout, teeth: TeethByHeight, tip_cle
             unreachable[i] = True
     lo = {i: h_min for i in bad if not unreachable[i]}
     hi = {i: H for i in bad if not unreachable[i]}
+    # a pair whose clearance at the trial height is at least tip_clearance plus the rest of the interval can no longer
+    # decide anything: moving the tip by dh changes the clearance by at most dh (the shorter tooth lies inside the taller)
+    alive = np.isin(pairs.rigid, list(lo))
     while True:
         todo = [i for i in lo if hi[i] - lo[i] > tol]
         if not todo:
             break
         mid = {i: 0.5 * (lo[i] + hi[i]) for i in todo}
-        sel = np.nonzero(np.isin(pairs.rigid, todo))[0]
+        sel = np.nonzero(alive & np.isin(pairs.rigid, todo))[0]
         c = violations(mid, sel)
+        owner = pairs.rigid[sel]
         for i in todo:
-            if c[pairs.rigid[sel] == i].min() >= tip_clearance:
+            mine = owner == i
+            ok = not mine.any() or c[mine].min() >= tip_clearance
+            if ok:
                 lo[i] = mid[i]
+                slack = hi[i] - mid[i]
             else:
                 hi[i] = mid[i]
-    teeth_at_risk = bad
-    for i in teeth_at_risk:
-        i = int(i)
+                slack = 0.0
+            alive[sel[mine & (c >= tip_clearance + slack)]] = False
+    for i in bad:
         heights[i] = lo[i] if not unreachable[i] else h_min
-        mine = np.nonzero(pairs.rigid == i)[0]
-        j = mine[np.argmin(c_full[mine])]
-        worst_phi_h[i] = pairs.phi_h[pairs.angle[j]]
-        worst_phi[i] = pairs.phi[j]
+    # where each lowered tooth is limited: its closest facing sample at the height found
+    if bad:
+        idx = np.nonzero(np.isin(pairs.rigid, bad))[0]
+        c_end = violations({i: heights[i] for i in bad}, idx)
+        for i in bad:
+            mine = pairs.rigid[idx] == i
+            j = idx[mine][np.argmin(c_end[mine])]
+            worst_phi_h[i] = pairs.phi_h[pairs.angle[j]]
+            worst_phi[i] = pairs.phi[j]
+    teeth_at_risk = bad
     for a in (heights, worst_phi_h, worst_phi, unreachable):
         a.setflags(write=False)
     return SimulatedHeights(heights, tip_clearance, worst_phi_h, worst_phi, unreachable, step_deg, tol,
