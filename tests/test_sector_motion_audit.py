@@ -157,3 +157,30 @@ def test_third_tooth_shortcut_changes_nothing(d4, monkeypatch):
         assert b.counts["pairs_measured"] > 1.3 * a.counts["pairs_measured"]
         assert a.min_clearance == b.min_clearance and a.min_tip_clearance == b.min_tip_clearance
         assert np.array_equal(a.per_tooth_tip, b.per_tooth_tip)
+
+
+def test_transmission_sector_is_the_plain_drive(d4):
+    """With the major axis deep in a transmission sector, the sectored scene (motion law, sector layout, pairs) must give
+    what the plain clearance engine gives for the plain 84/88 drive at the plain gear ratio: a transmission sector is a
+    quarter of the 88-tooth gear, and the motion law there is phi_h / u_hg up to whole flexspline pitches."""
+    from wgcad.clearance.engine import Scene, clearance_at_poses
+
+    design, drive, lay, teeth = d4
+    sc = SectoredScene(drive, lay, teeth, np.full(lay.n_teeth, teeth.height))
+    plain = Scene(drive)
+    for phi_h_deg in (120.0, 135.0, 150.0, 315.0):
+        phi_h = np.deg2rad(phi_h_deg)
+        d = sc.motion(phi_h) - flex_rotation(phi_h, 84, 88)
+        assert abs(d / (2 * pi / 84) - round(d / (2 * pi / 84))) < 1e-9
+        p = sc.pairs(np.array([phi_h]))
+        near = np.abs(p.phi) < np.deg2rad(25.0)  # the rigid teeth around them are all transmission teeth
+        p = p.take(near)
+        c = sc.clearance(p)
+        mine = {}
+        for k, v in zip(p.flex, c):
+            mine[int(k)] = min(mine.get(int(k), np.inf), v)
+        ks = np.array(sorted(mine))
+        rot, shift, _ = sc.flex_state(np.array([phi_h]))
+        ref = clearance_at_poses(plain, rot[0, ks], shift[0, ks])["min"]
+        assert len(ks) > 8
+        assert np.allclose([mine[k] for k in ks], ref, rtol=0, atol=1e-12)
