@@ -10,6 +10,7 @@ from dataclasses import MISSING, dataclass, fields, replace
 from pathlib import Path
 
 from ..errors import DesignError, InputFileError
+from .sectors import SectorsSpec, validate_sectors
 
 __all__ = [
     "DriveSpec",
@@ -89,6 +90,7 @@ class Design:
     rigid: GearSpec
     generator: GeneratorSpec
     source: str = "<memory>"
+    sectors: SectorsSpec = SectorsSpec()  # [sectors]: sectored rigid gear (theory.md 2.3); empty = plain
 
     @property
     def module(self) -> float:
@@ -118,8 +120,9 @@ _TABLES: dict[str, type] = {
     "flexspline": GearSpec,
     "rigid": GearSpec,
     "generator": GeneratorSpec,
+    "sectors": SectorsSpec,
 }
-_OPTIONAL_TABLES = ("tooth",)
+_OPTIONAL_TABLES = ("tooth", "sectors")
 
 
 def _base_type(tp) -> tuple[type, bool]:
@@ -155,6 +158,8 @@ def _coerce(table: str, key: str, value, tp):
 
 
 def _build(table: str, cls: type, data) -> object:
+    if hasattr(cls, "from_table"):  # tables with lists parse themselves (design/sectors.py)
+        return cls.from_table(table, data)
     if not isinstance(data, dict):
         raise DesignError(table, f"must be a table [{table}], got {type(data).__name__}")
     known = {f.name: f for f in fields(cls)}
@@ -248,6 +253,7 @@ def validate(d: Design) -> Design:
             raise DesignError("generator.generator_z", f"must be in [0, cone_length = {g.cone_length:g}) mm, got {g.generator_z:g}")
         if dr.face_width > g.cone_length:
             raise DesignError("drive.face_width", f"face width {dr.face_width:g} mm exceeds generator.cone_length {g.cone_length:g} mm")
+    validate_sectors(d.sectors, dr.z_flex, dr.z_rigid, dr.waves)
     return d
 
 

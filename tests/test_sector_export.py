@@ -1,0 +1,91 @@
+"""`wgcad sector`: files written (heights table and plot both ways, motion law CSV/PNG, audit, DXF, STL), read back and checked."""
+
+import csv
+import json
+
+import ezdxf
+import numpy as np
+import pytest
+import trimesh
+
+from conftest import TEMPLATES
+from wgcad.cli import main
+from wgcad.export.dxf import audit_dxf, read_dxf
+
+D4 = TEMPLATES / "d4_sectored.toml"
+
+
+@pytest.fixture(scope="module")
+def run_sim(tmp_path_factory):
+    out = tmp_path_factory.mktemp("sector")
+    code = main(["sector", str(D4), "--out", str(out), "--heights", "simulated", "--step-deg", "1", "--json"])
+    return code, out
+
+
+def test_outputs_written(run_sim):
+    code, out = run_sim
+    assert code == 0  # no tip-to-tip left with the simulated heights
+    names = sorted(p.name for p in out.iterdir())
+    assert names == sorted(f"d4_sectored_{s}" for s in ("heights.csv", "heights.png", "motion.csv", "motion.png",
+                                                       "sector_audit.png", "sector_rigid.dxf", "sector_rigid.stl", "sector.json"))
+    for p in out.glob("*.png"):
+        assert p.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+
+
+def test_stl_watertight_after_read_back(run_sim):
+    _, out = run_sim
+    m = trimesh.load(out / "d4_sectored_sector_rigid.stl")
+    assert m.is_watertight and m.is_volume
+    # volume = (rim disc - toothed hole) x face width, to float32 STL rounding
+    r = read_dxf(out / "d4_sectored_sector_rigid.dxf")
+    o = r["RIGID_SECTORED"]["outlines"][0]
+    x, y = o[:, 0], o[:, 1]
+    hole = 0.5 * abs(np.dot(x, np.roll(y, -1)) - np.dot(np.roll(x, -1), y))
+    R = r["RIGID_RIM"]["circles"][0][2]
+    assert m.volume == pytest.approx((np.pi * R**2 - hole) * 5.0, rel=2e-3)  # rim circle polygon vs true circle: < 1e-3
+
+
+def test_dxf_closed_after_read_back(run_sim):
+    _, out = run_sim
+    path = out / "d4_sectored_sector_rigid.dxf"
+    assert audit_dxf(path) == 0
+    doc = ezdxf.readfile(path)
+    polys = [e for e in doc.modelspace() if e.dxftype() == "LWPOLYLINE"]
+    assert len(polys) == 1 and all(p.closed for p in polys)
+    o = read_dxf(path)["RIGID_SECTORED"]["outlines"][0]
+    import shapely
+
+    assert shapely.Polygon(o).is_valid
+
+
+def test_heights_table_both_ways(run_sim):
+    _, out = run_sim
+    rows = list(csv.DictReader(open(out / "d4_sectored_heights.csv")))
+    assert len(rows) == 86
+    for r in rows:
+        cf, sim, diff = float(r["closed_form_mm"]), float(r["simulated_mm"]), float(r["simulated_minus_closed_um"])
+        assert diff == pytest.approx(1e3 * (sim - cf), abs=1e-3)
+        assert float(r["built_mm"]) == pytest.approx(sim, abs=1e-6)
+    summ = json.loads((out / "d4_sectored_sector.json").read_text())
+    p = summ["closed_form_parameters"]
+    assert {"r_fix_mm", "r_cr_mm", "h_s_mm", "W0_mm", "beta_deg", "generator_angle_rule"} <= p.keys()
+    assert summ["audit_built"]["tip_to_tip"] is False and summ["audit_full_height"]["tip_to_tip"] is True
+
+
+def test_motion_csv_matches_hand_count(run_sim):
+    _, out = run_sim
+    rows = list(csv.DictReader(open(out / "d4_sectored_motion.csv")))
+    a = np.array([float(r["generator_angle_deg"]) for r in rows])
+    g = np.array([float(r["output_rotation_deg"]) for r in rows])
+    dwell = np.array([r["phase"] == "dwell" for r in rows])
+    assert g[-1] - g[0] == pytest.approx(-2 * 360 / 84, abs=1e-6)
+    # dwell samples: 2 x 19 pitches of 360/84 deg out of 360, sampled every 0.1 deg (+-1 sample at each of 4 ends)
+    assert dwell.sum() == pytest.approx(2 * 19 * 360 / 84 / 0.1, abs=4)
+    assert np.ptp(g[dwell & (a < 180)]) < 1e-9
+
+
+def test_full_heights_exit_1(tmp_path, capsys):
+    code = main(["sector", str(D4), "--out", str(tmp_path), "--heights", "full", "--step-deg", "1", "--no-stl"])
+    so = capsys.readouterr().out
+    assert code == 1 and "TIP-TO-TIP" in so
+    assert not (tmp_path / "d4_sectored_sector_rigid.stl").exists()
