@@ -253,7 +253,7 @@ def clearance_profile_figure(profile: dict, title: str):
         c = f"C{i}"
         w, n = np.asarray(sec["working_um"], float), np.asarray(sec["nonworking_um"], float)
         br = fold_breaks(w, n)
-        fold_x += [0.5 * (ph[j] + ph[j + 1]) for j in br]
+        fold_x += [(0.5 * (ph[j] + ph[j + 1]), min(w[j], n[j])) for j in br]
         ax.plot(*_broken(ph, w, br), color=c, lw=1.4, label=f"working flank{lab}")
         ax.plot(*_broken(ph, n, br), color=c, lw=1.0, ls="--", label=f"non-working flank{lab}")
         lows += [np.nanmin(w), np.nanmin(n)]
@@ -279,7 +279,9 @@ def clearance_profile_figure(profile: dict, title: str):
     ticks = np.unique(np.concatenate([ticks, [ph[0], ph[-1]]]))
     names = {0.0: "\nmajor axis"}
     ax.set_xticks(ticks, labels=[f"{t:g}" + (names.get(round(t, 6), "") if abs(t) < half - 1e-6 else "\nminor axis") for t in ticks])
-    for fx in sorted(set(np.round(fold_x, 6))):
+    # a break is worth a word only where the exchanged values are on the scale
+    fold_x = sorted({round(float(x), 1) for x, y in fold_x if y <= top})
+    for fx in fold_x:
         ax.axvline(fx, color="0.4", lw=1.0, ls=":")
     handles, _ = ax.get_legend_handles_labels()
     if fold_x:
@@ -288,7 +290,7 @@ def clearance_profile_figure(profile: dict, title: str):
                                     "a rigid tooth, which passes from one flank's side\n"
                                     "to the other's: the two curves exchange values\n"
                                     "there (not a jump in clearance)"
-                              .format(", ".join(f"{x:+.1f}" for x in sorted(set(np.round(fold_x, 1)))))))
+                              .format(", ".join(f"{x:+.1f}" for x in fold_x))))
     handles.append(Line2D([], [], ls="", label=f"curves above {top:.0f} um not shown\n(teeth out of mesh)"))
     _legend_outside(ax, handles=handles)
     ax.tick_params(labelsize=9)
@@ -380,8 +382,13 @@ def tightest_spot_figure(flex_teeth: np.ndarray, labels, rigid_teeth: np.ndarray
         ax.tick_params(labelsize=9)
         ax.grid(alpha=0.25)
     allu = np.vstack([_unroll(t, r_ref, a_ref) for t in flex_teeth])
-    axs[0].set_xlim(allu[:, 0].min() - 1, allu[:, 0].max() + 1)
-    axs[0].set_ylim(allu[:, 1].min() - 0.3, allu[:, 1].max() + 0.5)
+    x0, x1 = allu[:, 0].min() - 1, allu[:, 0].max() + 1
+    axs[0].set_xlim(x0, x1)
+    # both gears' teeth in view (the rigid ones lie below the flexspline's on an external drive)
+    if len(rigid_teeth):
+        rig = np.vstack([_unroll(t, r_ref, a_ref) for t in rigid_teeth])
+        allu = np.vstack([allu, rig[(rig[:, 0] > x0) & (rig[:, 0] < x1)]])
+    axs[0].set_ylim(allu[:, 1].min() - 0.2, allu[:, 1].max() + 0.2)
     # tooth names above the drawing, not over the rigid teeth
     tops = [_unroll(t, r_ref, a_ref) for t in flex_teeth]
     top = axs[0].secondary_xaxis("top")
