@@ -325,7 +325,8 @@ def clearance_vs_angle_figure(angles_deg, working_um, nonworking_um, tol_um: flo
     ang = np.asarray(angles_deg, float)
     for ax, y, name, style in ((axs[0], working_um, "working flank", "-"), (axs[1], nonworking_um, "non-working flank", "--")):
         y = np.asarray(y, float)
-        y_min, y_max = float(np.nanmin(y)), float(np.nanmax(y))
+        fin = y[np.isfinite(y)]
+        y_min, y_max = (float(fin.min()), float(fin.max())) if fin.size else (0.0, 0.0)
         rip = y_max - y_min
         ax.plot(ang, y, lw=1.2, ls=style, color="C0" if style == "-" else "C1")
         # scaled to the ripple (the reason for this picture), not from zero
@@ -333,11 +334,12 @@ def clearance_vs_angle_figure(angles_deg, working_um, nonworking_um, tol_um: flo
         lo, hi = y_min - pad, y_max + pad
         ax.set_ylim(lo, hi)
         ax.ticklabel_format(axis="y", useOffset=False)
+        where = "0 um above this scale" if hi <= 0.0 else ("0 um below this scale" if lo >= 0.0 else "0 um: black line")
         if hi > -tol_um and lo < tol_um:
-            ax.axhspan(-tol_um, tol_um, color="0.85", zorder=0, label=f"contact tolerance +-{tol_um:g} um")
+            ax.axhspan(-tol_um, tol_um, color="0.85", zorder=0)
+            where += f"; grey band: contact within +-{tol_um:g} um"
         if lo < 0.0 < hi:
             ax.axhline(0.0, color="k", lw=0.8)
-        where = "0 um above this scale" if hi <= 0.0 else ("0 um below this scale" if lo >= 0.0 else "0 um: black line")
         ax.set_title(f"{name}: {y_min:.3f} to {y_max:.3f} um, ripple {rip:.3f} um peak to peak ({where})",
                      fontsize=9.5, loc="left")
         ax.set_ylabel("smallest clearance, um", fontsize=9.5)
