@@ -48,31 +48,13 @@ def cmd_kinematics(args) -> int:
 
     buf = io.StringIO()
     np.savetxt(buf, rows, delimiter=",", header=header, comments="", fmt="%.9g")
-    import matplotlib
+    from ..export.figures import velocities_png
 
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    fig, axs = plt.subplots(1, 2, figsize=(13, 4.5), dpi=90)
-    for c in ("V_w", "V_v", "V_wK", "V_vK", "V_sl", "V_dw", "V_dv"):
-        axs[0].plot(np.rad2deg(phi), getattr(vel, c), label=c)
-    axs[0].set_xlabel("phi, deg from the washer contact (major axis)")
-    axs[0].set_ylabel("mm/s")
-    axs[0].legend(fontsize=7, ncol=2)
-    axs[0].grid(alpha=0.3)
-    axs[1].plot(np.rad2deg(phi), vel.dtheta_dt, color="k")
-    axs[1].set_xlabel("phi, deg")
-    axs[1].set_ylabel("dtheta/dt, rad/s")
-    axs[1].grid(alpha=0.3)
-    fig.suptitle(f"{d.name}: external ring generator velocities, omega_h = {args.omega_h:g} rad/s, a_w = {a_w:.3f} mm")
-    fig.tight_layout()
-    png = io.BytesIO()
-    fig.savefig(png, format="png")
-    plt.close(fig)
+    png = velocities_png(vel, f"{d.name}: external ring generator velocities, omega_h = {args.omega_h:g} rad/s, a_w = {a_w:.3f} mm")
     stem = Path(args.design).stem
     with atomic_batch() as batch:
         Path(batch.temp_path(out / f"{stem}_velocities.csv")).write_text(buf.getvalue())
-        Path(batch.temp_path(out / f"{stem}_velocities.png")).write_bytes(png.getvalue())
+        Path(batch.temp_path(out / f"{stem}_velocities.png")).write_bytes(png)
     i = int(np.argmax(np.abs(vel.V_sl)))
     print(f"  external ring generator, omega_h = {args.omega_h:g} rad/s, a_w = {a_w:.4f} mm:")
     print(f"    washer speed V_d = {vel.V_d[0]:.4g} mm/s; largest sliding speed |V_sl| = {abs(vel.V_sl[i]):.4g} mm/s at phi = {np.rad2deg(phi[i]):.1f} deg")
