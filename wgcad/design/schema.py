@@ -10,6 +10,7 @@ from dataclasses import MISSING, dataclass, fields, replace
 from pathlib import Path
 
 from ..errors import DesignError, InputFileError
+from .load import BearingSpec, LoadSpec, MaterialSpec, validate_load_tables
 
 __all__ = [
     "DriveSpec",
@@ -89,6 +90,9 @@ class Design:
     rigid: GearSpec
     generator: GeneratorSpec
     source: str = "<memory>"
+    material: MaterialSpec = MaterialSpec()  # [material], [bearing], [load]: design/load.py
+    bearing: BearingSpec = BearingSpec()
+    load: LoadSpec = LoadSpec()
 
     @property
     def module(self) -> float:
@@ -118,8 +122,11 @@ _TABLES: dict[str, type] = {
     "flexspline": GearSpec,
     "rigid": GearSpec,
     "generator": GeneratorSpec,
+    "material": MaterialSpec,
+    "bearing": BearingSpec,
+    "load": LoadSpec,
 }
-_OPTIONAL_TABLES = ("tooth",)
+_OPTIONAL_TABLES = ("tooth", "material", "bearing", "load")
 
 
 def _base_type(tp) -> tuple[type, bool]:
@@ -248,6 +255,7 @@ def validate(d: Design) -> Design:
             raise DesignError("generator.generator_z", f"must be in [0, cone_length = {g.cone_length:g}) mm, got {g.generator_z:g}")
         if dr.face_width > g.cone_length:
             raise DesignError("drive.face_width", f"face width {dr.face_width:g} mm exceeds generator.cone_length {g.cone_length:g} mm")
+    validate_load_tables(d)
     return d
 
 
