@@ -33,7 +33,8 @@ GAP_MARGIN = 0.1
 #: Contact forces below this are floored when the Hertz secants are taken, N
 #: (the approach error it leaves is below 1e-5 mm for the balls and teeth of D1).
 FORCE_FLOOR = 1e-2
-_MAX_LINEARISATIONS = 60
+_MAX_LINEARISATIONS = 100
+_TRACE = None  # a list to record (pass, change, relaxation, pairs, loaded contacts) while debugging
 
 
 @dataclass(frozen=True)
@@ -250,6 +251,7 @@ def solve_load(model: ElasticModel, torque_nm: float, cam_offset_um: float = 0.0
         t_sol += time.perf_counter() - t1
         t_geo += t1 - t0
         F = sol.F
+        last = (geo, keys, F, sol, phi_c, b, f, A)
         omega_used = omega
         # under-relaxed update once the plain iteration stops contracting: the exact gaps are piecewise
         # smooth in the poses (polygon vertices), which can leave a 2-cycle of sub-micrometre amplitude
@@ -271,49 +273,61 @@ def solve_load(model: ElasticModel, torque_nm: float, cam_offset_um: float = 0.0
             change = max((float(np.hypot(*(pos[k] - prev_pos[k]))) for k in common), default=0.0)
             # the step the plain iteration takes (a relaxed step is omega times it)
             change = max(change, abs(rigid_pos - prev_rigid) * model.drive.r_m) / prev_omega
+            if _TRACE is not None:
+                _TRACE.append((it, change, omega, len(pos), int((F > 0).sum())))
             if change < tol and set(pos) == set(prev_pos):
                 break
-            if it >= 5 and change > 0.9 * last_change:
-                omega = max(omega * 0.5, 1.0 / 16.0)
+            if it >= 5 and change > 0.95 * last_change:  # a cycle, not a slow contraction
+                omega = max(omega * 0.5, 0.25)
             last_change = change
         prev_pos, prev_rigid, prev_omega = pos, rigid_pos, omega_used
     else:
         raise ContactSolveError(f"load state at {torque_nm:g} N m: tooth positions still moving after {_MAX_LINEARISATIONS} re-linearisations")
+    # the reported state is the last contact solution itself (not a relaxed mixture): its forces, points and
+    # normals are in equilibrium to round-off; the exact gaps are then measured on the final poses
+    geo, keys, F, sol, phi_c, b, f, A = last
+    psi, loads = _merge_loads(phi_c, -(F * f)[:, None] * b)
+    rigid = sol.a.copy()
+    F_ball, Ft = F[:Z], F[Z:]
     model.bearing.check(F_ball)
-    # final state and its exact check
     t0 = time.perf_counter()
     laws = [LoadedLaw(centre, model.section_law(i), model.ring, psi, loads, model.scales[i], tuple(rigid))
             for i in range(len(model.zs))]
     geo2 = _geometry(model, laws, psi, loads, rigid)
     t_geo += time.perf_counter() - t0
-    keys2 = [] if geo2 is None else list(zip(geo2["section"].tolist(), geo2["tooth"].tolist(), geo2["flank"].tolist()))
-    Ft = np.array([F_teeth_prev.get(k, 0.0) for k in keys2])
-    width = model.widths[geo2["section"]] if geo2 is not None else np.zeros(0)
-    appr_t = (model.teeth.bending(geo2["point"], geo2["normal"], width) * Ft + model.teeth.hertz(Ft, width)) if geo2 is not None else np.zeros(0)
-    # ball gaps: clearance - e.e_r + w(psi) of the loaded centre section (radial displacement beyond the nominal law)
+    n_t = len(keys)
+    exact = {} if geo2 is None else dict(zip(zip(geo2["section"].tolist(), geo2["tooth"].tolist(), geo2["flank"].tolist()), geo2["gap"]))
+    if n_t:
+        width = model.widths[geo["section"]]
+        appr_t = model.teeth.bending(geo["point"], geo["normal"], width) * Ft + model.teeth.hertz(Ft, width)
+        # a pair that left the GAP_MARGIN band on the final poses is open by at least that much
+        gap_t = np.array([exact.get(k, GAP_MARGIN) for k in keys])
+    else:
+        appr_t = gap_t = np.zeros(0)
     cb, sb = np.cos(model.bearing.psi), np.sin(model.bearing.psi)
-    wb = (model.ring.field(model.bearing.psi, psi, loads)["w"] + rigid[0] * cb + rigid[1] * sb
-          - rigid[2] * centre.state(model.bearing.psi).v)
-    gap_b = model.bearing.clearance - (e[0] * np.cos(model.bearing.psi) + e[1] * np.sin(model.bearing.psi)) + wb
+    v_nom = centre.state(model.bearing.psi)
+    wb = model.ring.field(model.bearing.psi, psi, loads)["w"] + rigid[0] * cb + rigid[1] * sb - rigid[2] * v_nom.v
+    gap_b = model.bearing.clearance - (e[0] * cb + e[1] * sb) + wb
     appr_b = model.bearing.approach(F_ball)
-    n_t = len(keys2)
-    gap_t = geo2["gap"] if geo2 is not None else np.zeros(0)
     # exact complementarity of the nonlinear contacts: gap + approach >= 0, F >= 0, F (gap + approach) = 0
     g_all = np.concatenate([gap_b + appr_b, gap_t + appr_t])
     F_all = np.concatenate([F_ball, Ft])
     loaded = F_all > 0
     lin = float(np.abs(g_all[loaded]).max()) if loaded.any() else 0.0
+    r_b = centre.r_m + v_nom.w
+    ball_pt = np.stack([r_b * cb - v_nom.v * sb, r_b * sb + v_nom.v * cb], axis=-1)
+    empty2 = np.zeros((0, 2))
     contacts = {
         "kind": np.concatenate([np.zeros(Z, int), np.ones(n_t, int)]),
-        "section": np.concatenate([np.zeros(Z, int), geo2["section"] if geo2 is not None else np.zeros(0, int)]),
-        "tooth": np.concatenate([np.full(Z, -1), geo2["tooth"] if geo2 is not None else np.zeros(0, int)]),
-        "flank": np.concatenate([np.full(Z, -1), geo2["flank"] if geo2 is not None else np.zeros(0, int)]),
-        "phi": np.concatenate([model.bearing.psi, geo2["phi"] if geo2 is not None else np.zeros(0)]),
+        "section": np.concatenate([np.zeros(Z, int), geo["section"] if n_t else np.zeros(0, int)]),
+        "tooth": np.concatenate([np.full(Z, -1), geo["tooth"] if n_t else np.zeros(0, int)]),
+        "flank": np.concatenate([np.full(Z, -1), geo["flank"] if n_t else np.zeros(0, int)]),
+        "phi": np.concatenate([model.bearing.psi, geo["phi"] if n_t else np.zeros(0)]),
         "force": F_all,
         "gap": np.concatenate([gap_b, gap_t]),
         "approach": np.concatenate([appr_b, appr_t]),
-        "point": np.concatenate([np.zeros((Z, 2)), geo2["point"] if geo2 is not None else np.zeros((0, 2))]),
-        "normal": np.concatenate([np.zeros((Z, 2)), geo2["normal"] if geo2 is not None else np.zeros((0, 2))]),
+        "point": np.concatenate([ball_pt, geo["point"] if n_t else empty2]),
+        "normal": np.concatenate([-np.stack([cb, sb], axis=-1), geo["normal"] if n_t else empty2]),
     }
     residuals = {
         "equilibrium": sol.equilibrium,
