@@ -35,16 +35,32 @@ class ContactGeometry:
     rigid: np.ndarray
 
 
-def _deepest(poly_pts: np.ndarray, other_geom, other_ring, sign: float):
-    """Deepest vertex of ``poly_pts`` inside ``other_geom``: (depth, vertex, nearest boundary point) or None."""
-    ins = shapely.contains_xy(other_geom, poly_pts[:, 0], poly_pts[:, 1])
-    if not ins.any():
-        return None
-    cand = poly_pts[ins]
-    d = shapely.distance(other_ring, shapely.points(cand))
-    i = int(np.argmax(d))
-    q = np.asarray(shapely.shortest_line(other_ring, shapely.Point(cand[i])).coords[0])
-    return float(d[i]), cand[i], q
+def _deepest(pts: np.ndarray, geoms: np.ndarray):
+    """Deepest vertex of each polygon ``pts[k]`` ``(K, N, 2)`` inside ``geoms[k]``, all pairs at once.
+
+    Returns depth ``(K,)`` (0 where no vertex is inside), the vertex ``(K, 2)`` and
+    its nearest point on the boundary of ``geoms[k]`` ``(K, 2)``.
+    """
+    K, N, _ = pts.shape
+    depth = np.zeros(K)
+    vert = pts[:, 0].copy()
+    near = pts[:, 0].copy()
+    ins = shapely.contains_xy(geoms[:, None], pts[..., 0], pts[..., 1])
+    kk, ii = np.nonzero(ins)
+    if kk.size == 0:
+        return depth, vert, near
+    rings = shapely.get_exterior_ring(geoms)
+    d = shapely.distance(rings[kk], shapely.points(pts[kk, ii]))
+    full = np.full((K, N), -1.0)
+    full[kk, ii] = d
+    best = np.argmax(full, axis=1)
+    has = full[np.arange(K), best] > 0.0
+    k = np.nonzero(has)[0]
+    depth[k] = full[k, best[k]]
+    vert[k] = pts[k, best[k]]
+    seg = shapely.get_coordinates(shapely.shortest_line(rings[k], shapely.points(vert[k]))).reshape(-1, 2, 2)
+    near[k] = seg[:, 0]
+    return depth, vert, near
 
 
 def _smooth_normals(outlines: np.ndarray, p: np.ndarray) -> np.ndarray:
@@ -109,24 +125,20 @@ def flank_contacts(scene: Scene, rot: np.ndarray, shift: np.ndarray) -> dict[str
             seg = shapely.get_coordinates(shapely.shortest_line(geoms[apart], rg[apart])).reshape(-1, 2, 2)
             point[apart] = seg[:, 0]
             other[apart] = seg[:, 1]
-        for k in np.nonzero(gap <= 0.0)[0]:
-            a_ring = geoms[k].exterior
-            b_geom = rg[k]
-            flex_in = _deepest(pts[k], b_geom, b_geom.exterior, 1.0)
-            rig_pts = scene.rigid_pts[idx[k]]
-            rig_in = _deepest(rig_pts, geoms[k], a_ring, -1.0)
-            best = None
-            if flex_in is not None:
-                depth, v, q = flex_in
-                best = (depth, v, q)
-            if rig_in is not None and (best is None or rig_in[0] > best[0]):
-                depth, u, q = rig_in
-                best = (depth, q, u)
-            if best is None or best[0] <= 0.0:
-                # touching without a vertex inside: outward normal of the flexspline outline there
-                sl = np.asarray(shapely.shortest_line(a_ring, b_geom.exterior).coords)
-                best = (0.0, sl[0], sl[1])
-            point[k], other[k] = best[1], best[2]
+        over = np.nonzero(gap <= 0.0)[0]
+        if over.size:
+            # the vertex that sets the engine's depth: of the flexspline inside the rigid tooth, or the reverse
+            d_f, v_f, q_f = _deepest(pts[over], rg[over])
+            d_r, v_r, q_r = _deepest(scene.rigid_pts[idx[over]], geoms[over])
+            flex_side = d_f >= d_r
+            point[over] = np.where(flex_side[:, None], v_f, q_r)
+            other[over] = np.where(flex_side[:, None], q_f, v_r)
+            touch = np.nonzero(np.maximum(d_f, d_r) <= 0.0)[0]
+            if touch.size:  # touching without a vertex inside
+                k = over[touch]
+                seg = shapely.get_coordinates(shapely.shortest_line(shapely.get_exterior_ring(geoms[k]),
+                                                                    shapely.get_exterior_ring(rg[k]))).reshape(-1, 2, 2)
+                point[k], other[k] = seg[:, 0], seg[:, 1]
         # the contact normal is the normal of the smoother outline there: a tip corner pressing on a
         # flank acts along the flank's normal (vertex normals interpolated, so it does not jump)
         n_f, kink_f = _smooth_normals(pts, point)
