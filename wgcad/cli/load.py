@@ -53,6 +53,15 @@ def _summary(name: str, res: dict) -> str:
         eg = "none" if lv["entry_gap_um"] is None else f"{lv['entry_gap_um']:9.3f}"
         lines.append(f"  {lv['torque_nm']:10g} | {eg:>12} | {lv['teeth_in_contact']:16d} | {lv['largest_tooth_force_n']:17.1f} | "
                      f"{lv['max_ball_load_n']:15.1f} | {lv['wind_up_arcmin']:14.4f} | " + ("-" if st is None else f"{st:.4g}"))
+    top = res["levels"][-1]
+    lines.append(f"  at {top['torque_nm']:g} N m: smallest clearance of unloaded pairs "
+                 + ("-" if top["min_clearance_um"] is None else f"{top['min_clearance_um']:.3f} um")
+                 + f", largest contact approach (teeth pressed into each other, contact not interference) {top['max_contact_approach_um']:.3f} um"
+                 + f", largest ball Hertz pressure {top['max_ball_pressure_mpa']:.0f} MPa")
+    for sec in top["sections"]:
+        zones = ", ".join("-" if z is None else f"{z[0]:+.1f}..{z[1]:+.1f} deg" for z in sec["zone_deg"])
+        lines.append(f"    section z = {sec['section_z_mm']:g} mm: {sec['teeth_in_contact']} teeth in contact "
+                     f"({sec['working_flank_contacts']} working, {sec['non_working_flank_contacts']} non-working flanks), zones per wave {zones}")
     worst = max(lv["residuals"]["equilibrium"] for lv in res["levels"])
     lin = max(lv["residuals"]["linearisation_mm"] for lv in res["levels"])
     lines.append(f"  residuals: equilibrium {worst:.1e} (relative), nonlinear contact law {1e3 * lin:.3f} um; "
