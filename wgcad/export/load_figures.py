@@ -42,8 +42,12 @@ def entry_gap_png(series: list, title: str, tol_um: float = 1.0) -> bytes:
         ax.plot(s["torque_nm"], g, styles[k % len(styles)], ms=4, label=s["label"])
     ax.axhline(0.0, color="k", lw=0.8)
     ax.axhspan(-tol_um, tol_um, color="0.85", lw=0, label=f"contact tolerance +-{tol_um:g} um")
+    vals = np.array([v for s in series for v in s["entry_gap_um"] if v is not None], dtype=float)
+    log = vals.size and np.nanmax(np.abs(vals)) > 20.0 * max(np.nanmin(np.abs(vals)), 1.0)
+    if log:  # series of very different size (e.g. involute ~5 um, cycloidal ~180 um): both readable
+        ax.set_yscale("symlog", linthresh=10.0)
     ax.set_xlabel("output torque M_c, N m")
-    ax.set_ylabel("entry gap, um (below 0: tip interference)")
+    ax.set_ylabel("entry gap, um (below 0: tip interference)" + (", linear below 10 um, log above" if log else ""))
     ax.set_title(title, fontsize=10)
     ax.grid(True, alpha=0.3)
     ax.legend(fontsize=8)
