@@ -51,6 +51,10 @@ def _audit_summary(name: str, res: dict) -> str:
 
 
 def cmd_audit(args) -> int:
+    if args.torque_nm is not None:  # under load: cli/load.py
+        from .load import run_load
+
+        return run_load(args)
     from ..audit import RunSettings, run_audit
     from ..export.atomic import atomic_batch, ensure_writable_dir
     from ..regression import baseline_figures, compare, format_drifts, load_baseline, make_baseline
@@ -196,4 +200,7 @@ def register(sub) -> None:
     a.add_argument("--no-bound", action="store_true")
     a.add_argument("--progress", action="store_true", help="progress bar on stderr even when it is not a terminal")
     a.add_argument("--quiet", action="store_true")
+    from .load import register_args
+
+    register_args(a)
     a.set_defaults(func=cmd_audit)

@@ -11,6 +11,7 @@ from pathlib import Path
 
 from ..errors import DesignError, InputFileError
 from .sectors import SectorsSpec, validate_sectors
+from .load import BearingSpec, LoadSpec, MaterialSpec, validate_load_tables
 
 __all__ = [
     "DriveSpec",
@@ -91,6 +92,9 @@ class Design:
     generator: GeneratorSpec
     source: str = "<memory>"
     sectors: SectorsSpec = SectorsSpec()  # [sectors]: sectored rigid gear (theory.md 2.3); empty = plain
+    material: MaterialSpec = MaterialSpec()  # [material], [bearing], [load]: design/load.py
+    bearing: BearingSpec = BearingSpec()
+    load: LoadSpec = LoadSpec()
 
     @property
     def module(self) -> float:
@@ -121,8 +125,11 @@ _TABLES: dict[str, type] = {
     "rigid": GearSpec,
     "generator": GeneratorSpec,
     "sectors": SectorsSpec,
+    "material": MaterialSpec,
+    "bearing": BearingSpec,
+    "load": LoadSpec,
 }
-_OPTIONAL_TABLES = ("tooth", "sectors")
+_OPTIONAL_TABLES = ("tooth", "sectors", "material", "bearing", "load")
 
 
 def _base_type(tp) -> tuple[type, bool]:
@@ -254,6 +261,7 @@ def validate(d: Design) -> Design:
         if dr.face_width > g.cone_length:
             raise DesignError("drive.face_width", f"face width {dr.face_width:g} mm exceeds generator.cone_length {g.cone_length:g} mm")
     validate_sectors(d.sectors, dr.z_flex, dr.z_rigid, dr.waves)
+    validate_load_tables(d)
     return d
 
 

@@ -1,0 +1,198 @@
+"""The elastic contact model on drive D1 (theory.md 9): residuals, stability, physical sense, the loaded law, bad input."""
+
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from wgcad.deformation import Law
+from wgcad.deformation.elastic import LoadedLaw, build_model, solve_load
+from wgcad.deformation.elastic.state import POSITION_TOL
+from wgcad.deformation.elastic.sweep import torque_sweep
+from wgcad.design.schema import load_design, with_changes
+from wgcad.drive import build_drive
+
+ROOT = Path(__file__).resolve().parents[1]
+D1 = ROOT / "templates" / "d1_involute.toml"
+
+
+@pytest.fixture(scope="module")
+def model():
+    return build_model(build_drive(load_design(D1)), 3)
+
+
+@pytest.fixture(scope="module")
+def sweep(model):
+    return torque_sweep(model, [0.0, 1000.0, 3000.0])
+
+
+@pytest.fixture(scope="module")
+def offset_sweep(model):
+    return torque_sweep(model, [1000.0], cam_offset_um=40.0, cam_offset_deg=0.0)
+
+
+def test_every_body_in_equilibrium_and_contacts_complementary(sweep):
+    for st, lv in zip(sweep["states"], sweep["levels"]):
+        r = st.residuals
+        assert r["equilibrium"] < 1e-9  # flexspline rim: net force and moment against the cup's torque
+        assert r["complementarity"] < 1e-9  # linear complementarity of the last pass, relative
+        # the nonlinear contact laws (Hertz balls, tooth compliance) on the exact geometry at the solution:
+        # loaded contacts close to within the re-linearisation tolerance, none penetrates beyond it
+        assert r["linearisation_mm"] < POSITION_TOL
+        assert r["min_gap_plus_approach_mm"] > -POSITION_TOL
+        c = st.contacts
+        assert c["force"].min() >= 0.0
+
+
+def test_reported_forces_balance_the_rim_exactly(sweep):
+    # every reported contact force (teeth from the rigid gear, balls from the cam) acts on the rim at its point
+    # along -normal; with the cup's torque they balance to round-off (equilibrium of the rim; the rigid gear's
+    # and the cam's reactions are these forces reversed)
+    for st in sweep["states"]:
+        c = st.contacts
+        F, n, p = c["force"], c["normal"], c["point"]
+        net = -(F[:, None] * n).sum(axis=0)
+        moment = -(F * (p[:, 0] * n[:, 1] - p[:, 1] * n[:, 0])).sum() + st.model.torque_sign * 1e3 * st.torque_nm
+        scale = float((F * np.hypot(p[:, 0], p[:, 1])).max())
+        assert np.abs(net).max() < 1e-9 * float(F.max())
+        assert abs(moment) < 1e-9 * scale
+
+
+def test_positions_stable_when_the_tolerance_is_halved(model, sweep):
+    a = sweep["states"][1]
+    b = solve_load(model, 1000.0, tol=0.5 * POSITION_TOL)
+    phi = np.linspace(-np.pi, np.pi, 401)
+    for la, lb in zip(a.laws, b.laws):
+        sa, sb = la.state(phi), lb.state(phi)
+        move = np.hypot(sa.w - sb.w, sa.v - sb.v) + 3.0 * np.abs(sa.theta - sb.theta)
+        assert move.max() < 2 * POSITION_TOL  # each within one tolerance step of the fixed point
+
+
+def test_loaded_law_is_a_law(sweep):
+    law = sweep["states"][1].laws[0]
+    assert isinstance(law, LoadedLaw) and isinstance(law, Law)
+    st = law.state(np.linspace(0, 1, 5))
+    assert st.w.shape == (5,)
+    # the coned family: with_w0 of the section amplitude gives this section back
+    again = law.with_w0(law.w0)
+    assert np.allclose(again.state([0.3]).w, st.w[:1] * 0 + law.state([0.3]).w, atol=1e-15)
+
+
+def test_zero_load_zero_offset_zero_clearance_follows_the_cam_law():
+    d = load_design(D1)
+    # 0.14 mm thinning opens D1's nominal overlaps (-58 um flank, -14 um entry pinch): no tooth touches at no load
+    d = with_changes(d, flexspline={"thinning": 0.14}, bearing={"internal_clearance_um": 0.0, "fit_clearance_um": 0.0})
+    drive = build_drive(d)
+    m = build_model(drive, 3)
+    st = solve_load(m, 0.0)
+    phi = np.linspace(-np.pi, np.pi, 721)
+    for i, law in enumerate(st.laws):
+        a, b = law.state(phi), m.section_law(i).state(phi)
+        for k in ("w", "v", "theta"):
+            assert np.abs(getattr(a, k) - getattr(b, k)).max() < 1e-12
+    assert st.contacts["force"].max() == 0.0
+
+
+def test_teeth_in_contact_grow_with_torque(sweep):
+    n = [lv["teeth_in_contact"] for lv in sweep["levels"]]
+    assert all(b >= a for a, b in zip(n, n[1:])) and n[-1] > n[0]
+    w = [sum(s["working_flank_contacts"] for s in lv["sections"]) for lv in sweep["levels"]]
+    assert all(b > a for a, b in zip(w, w[1:]))
+
+
+def test_wind_up_grows_and_stiffness_is_of_catalogue_order(sweep):
+    wind = [st.wind_up for st in sweep["states"]]
+    assert all(b > a for a, b in zip(wind, wind[1:]))
+    # secant stiffness to a third of the rated torque: catalogue drives of ~160 mm pitch
+    # diameter are of order 1e5 - 1e6 N m/rad (theory.md 4.1)
+    k = 1000.0 / (wind[1] - wind[0])
+    assert 1e5 <= k <= 1e6
+
+
+def test_entry_gap_closes_with_torque_at_the_open_end_and_middle(sweep):
+    for z in (0.0, 15.0):
+        g = [min(e["entry_gap_um"] for e in lv["entry"] if e["section_z_mm"] == z) for lv in sweep["levels"]]
+        assert all(b <= a for a, b in zip(g, g[1:])), (z, g)
+
+
+@pytest.mark.xfail(strict=True, reason="finding: at the inner end (z = 30 mm), where D1's entry gap is smallest, the loaded "
+                   "rim opens the gap by ~1 um at 3000 N m (6.1 -> 7.1 um) in this model, while it closes by 8-22 um "
+                   "at z = 0 and 15 mm; [S1] reports a closing gap")
+def test_more_torque_never_opens_the_involute_entry_gap(sweep):
+    g = [lv["entry_gap_um"] for lv in sweep["levels"]]
+    assert all(b <= a for a, b in zip(g, g[1:])), g
+
+
+def test_cam_offset_lowers_the_entry_gap_on_its_side(offset_sweep):
+    for lv in offset_sweep["levels"]:
+        wave = {w: min(e["entry_gap_um"] for e in lv["entry"] if e["wave"] == w) for w in (0, 1)}
+        assert wave[0] < wave[1]  # the offset points along the major axis of wave 0
+
+
+def _cli(*args):
+    return subprocess.run([sys.executable, "-m", "wgcad", *args], capture_output=True, text=True, cwd=ROOT,
+                          env={"PYTHONPATH": str(ROOT), "PATH": "/usr/bin:/bin"})
+
+
+def _design(tmp_path, extra_replace):
+    text = D1.read_text()
+    for a, b in extra_replace:
+        assert a in text
+        text = text.replace(a, b)
+    p = tmp_path / "d.toml"
+    p.write_text(text)
+    return p
+
+
+def test_bad_input_is_one_line_and_exit_2(tmp_path):
+    r = _cli("audit", str(D1), "--torque-nm", "-5")
+    assert r.returncode == 2 and r.stderr.count("\n") == 1 and "--torque-nm" in r.stderr
+    for old, new, field in (("internal_clearance_um = 26.0", "internal_clearance_um = -1.0", "bearing.internal_clearance_um"),
+                            ("youngs_modulus_gpa = 206.0", "youngs_modulus_gpa = -206.0", "material.youngs_modulus_gpa"),
+                            ("balls = 24 ", "balls = 24\nballs_typo = 3 ", "bearing.balls_typo")):
+        p = _design(tmp_path, [(old, new)])
+        r = _cli("audit", str(p), "--torque-nm", "1000")
+        assert r.returncode == 2, r.stderr
+        assert r.stderr.count("\n") == 1 and field in r.stderr and "Traceback" not in r.stderr
+
+
+def test_bearing_that_cannot_carry_the_load(tmp_path):
+    # 3 mm balls: D1's tooth preload alone puts ~5 kN on the balls at the major axis
+    p = _design(tmp_path, [("ball_diameter_mm = 12.7", "ball_diameter_mm = 3.0")])
+    r = _cli("audit", str(p), "--torque-nm", "0")
+    assert r.returncode == 2 and "bearing.ball_diameter_mm" in r.stderr and "cannot carry" in r.stderr
+    assert r.stderr.count("\n") == 1
+
+
+def test_teeth_that_never_meet(tmp_path):
+    # flexspline tips cut down to 81.9 mm and W0 = 0.4 mm: the tips stay 0.26 mm inside the rigid tip circle
+    p = _design(tmp_path, [("fillet_coef = 0.25    # theory.md 2.1 default", "fillet_coef = 0.25\ntip_radius = 81.9"),
+                           ("w0_coef = 1.1 ", "w0_coef = 0.5 ")])
+    r = _cli("audit", str(p), "--torque-nm", "500")
+    assert r.returncode == 2 and "never" in r.stderr and r.stderr.count("\n") == 1
+
+
+def test_cli_writes_json_and_pngs(tmp_path):
+    out = tmp_path / "load"
+    r = _cli("audit", str(D1), "--torque-nm", "0,500", "--json", str(tmp_path / "l.json"), "--plot", str(out), "--quiet")
+    assert r.returncode == 0, r.stderr
+    import json
+
+    doc = json.loads((tmp_path / "l.json").read_text())
+    assert [lv["torque_nm"] for lv in doc["levels"]] == [0.0, 500.0]
+    for key in ("entry_gap_um", "teeth_in_contact", "largest_tooth_force_n", "ball_load_n", "wind_up_arcmin", "sections"):
+        assert key in doc["levels"][1]
+    assert (tmp_path / "load_entry_gap.png").stat().st_size > 10000
+    assert (tmp_path / "load_forces.png").stat().st_size > 10000
+
+
+def test_entry_gap_of_the_nominal_law_matches_the_engine(model):
+    from wgcad.clearance.engine import entry_crossings
+    from wgcad.deformation.elastic.mesh import entry_gap
+
+    ref = entry_crossings(model.scene, list(model.zs))
+    for z, (g, phi) in zip(model.zs, ref):
+        g2, phi2 = entry_gap(model.scene, model.drive.law_at(float(z)))
+        assert abs(g2 - g) < 1e-9 and abs(phi2 - phi) < 1e-9

@@ -1,0 +1,135 @@
+"""``wgcad audit DESIGN --torque-nm ...``: the drive under load (elastic contact model, theory.md 4.1)."""
+
+from __future__ import annotations
+
+import json
+import sys
+from pathlib import Path
+
+from ..errors import DesignError
+from .common import EXIT_INTERFERENCE, EXIT_OK, Progress
+
+__all__ = ["register_args", "run_load", "torque_levels"]
+
+
+def torque_levels(text: str) -> list[float]:
+    """``"0:3000:250"`` (start:stop:step, stop included), ``"500"`` or ``"0,500,1000"`` -> torques in N m (>= 0)."""
+    import math
+
+    try:
+        if ":" in text:
+            a, b, c = (float(x) for x in text.split(":"))
+            if not (c > 0 and b >= a):
+                raise ValueError
+            n = int(math.floor((b - a) / c + 1e-9))
+            out = [a + i * c for i in range(n + 1)]
+        else:
+            out = [float(x) for x in text.split(",")]
+    except ValueError:
+        raise DesignError("--torque-nm", f"expected START:STOP:STEP, a value or a comma list of torques in N m, got '{text}'") from None
+    for t in out:
+        if not (math.isfinite(t) and t >= 0):
+            raise DesignError("--torque-nm", f"torques must be >= 0 N m, got {t:g}")
+    return out
+
+
+def register_args(a) -> None:
+    """Add the load flags to the ``audit`` subparser."""
+    g = a.add_argument_group("under load (elastic contact model; needs [bearing] in the design)")
+    g.add_argument("--torque-nm", metavar="SPEC", help="output torques: START:STOP:STEP (e.g. 0:3000:250), a value or a list; "
+                   "exit 1 when the entry gap closes at a requested load")
+    g.add_argument("--cam-offset-um", type=float, default=None, help="cam axis offset e_h, um (default: [load] of the design, else 0)")
+    g.add_argument("--cam-offset-deg", type=float, default=None, help="direction of e_h from the major axis, deg (default: [load], else 0)")
+    g.add_argument("--compare", metavar="DESIGN2", help="also sweep DESIGN2 and plot both designs' entry gap against torque "
+                   "for e_h = 0 and the given offset (40 um if none): PATH_compare.png")
+
+
+def _summary(name: str, res: dict) -> str:
+    lines = [f"{name}: under load (elastic contact model, {len(res['model']['sections_z_mm'])} sections), "
+             f"cam offset {res['cam_offset_um']:g} um at {res['cam_offset_deg']:g} deg"]
+    lines.append("  torque N m | entry gap um | teeth in contact | max tooth force N | max ball load N | wind-up arcmin | stiffness N m/rad")
+    for k, lv in enumerate(res["levels"]):
+        st = res["stiffness_nm_per_rad"][k - 1] if k else None
+        eg = "none" if lv["entry_gap_um"] is None else f"{lv['entry_gap_um']:9.3f}"
+        lines.append(f"  {lv['torque_nm']:10g} | {eg:>12} | {lv['teeth_in_contact']:16d} | {lv['largest_tooth_force_n']:17.1f} | "
+                     f"{lv['max_ball_load_n']:15.1f} | {lv['wind_up_arcmin']:14.4f} | " + ("-" if st is None else f"{st:.4g}"))
+    top = res["levels"][-1]
+    lines.append(f"  at {top['torque_nm']:g} N m: smallest clearance of unloaded pairs "
+                 + ("-" if top["min_clearance_um"] is None else f"{top['min_clearance_um']:.3f} um")
+                 + f", largest contact approach (teeth pressed into each other, contact not interference) {top['max_contact_approach_um']:.3f} um"
+                 + f", largest ball Hertz pressure {top['max_ball_pressure_mpa']:.0f} MPa")
+    for sec in top["sections"]:
+        zones = ", ".join("-" if z is None else f"{z[0]:+.1f}..{z[1]:+.1f} deg" for z in sec["zone_deg"])
+        lines.append(f"    section z = {sec['section_z_mm']:g} mm: {sec['teeth_in_contact']} teeth in contact "
+                     f"({sec['working_flank_contacts']} working, {sec['non_working_flank_contacts']} non-working flanks), zones per wave {zones}")
+    worst = max(lv["residuals"]["equilibrium"] for lv in res["levels"])
+    lin = max(lv["residuals"]["linearisation_mm"] for lv in res["levels"])
+    lines.append(f"  residuals: equilibrium {worst:.1e} (relative), nonlinear contact law {1e3 * lin:.3f} um; "
+                 f"{res['elapsed_s']:.2f} s")
+    if res["entry_gap_closes"]:
+        lines.append("  ENTRY GAP CLOSES under load: tip interference")
+    return "\n".join(lines)
+
+
+def _sweep(path, torques, e_um, e_deg, sections, progress):
+    from ..deformation.elastic.model import build_model
+    from ..deformation.elastic.sweep import torque_sweep
+    from ..design.schema import load_design
+    from ..drive import build_drive
+
+    drive = build_drive(load_design(path))
+    ld = drive.design.load
+    e_um = ld.cam_offset_um if e_um is None else e_um
+    e_deg = ld.cam_offset_deg if e_deg is None else e_deg
+    if e_um < 0:
+        raise DesignError("--cam-offset-um", f"must be >= 0 um, got {e_um:g}")
+    model = build_model(drive, sections)
+    res = torque_sweep(model, torques, e_um, e_deg, progress=progress)
+    res.pop("states")
+    res["design"] = drive.design.drive.name
+    res["source"] = drive.design.source
+    return drive, res
+
+
+def run_load(args) -> int:
+    """The load audit: sweep, print, write JSON and PNGs atomically; exit 1 when the entry gap closes."""
+    from ..export.atomic import atomic_batch, ensure_writable_dir
+
+    torques = torque_levels(args.torque_nm)
+    for path in (args.json, args.plot):
+        if path:
+            ensure_writable_dir(Path(path).parent if str(Path(path).parent) else Path("."))
+    prog = Progress(args.progress or sys.stderr.isatty())
+    drive, res = _sweep(args.design, torques, args.cam_offset_um, args.cam_offset_deg, args.sections, prog)
+    compare = None
+    if args.compare:
+        e = args.cam_offset_um if args.cam_offset_um else 40.0
+        compare = []
+        for path in (args.design, args.compare):
+            for eu in (0.0, e):
+                d2, r2 = _sweep(path, torques, eu, args.cam_offset_deg or 0.0, args.sections, prog)
+                compare.append({"label": f"{d2.design.drive.name}, e_h = {eu:g} um", "torque_nm": [lv["torque_nm"] for lv in r2["levels"]],
+                                "entry_gap_um": [lv["entry_gap_um"] for lv in r2["levels"]]})
+        res["compare"] = compare
+    with atomic_batch() as batch:
+        if args.json:
+            Path(batch.temp_path(args.json)).write_text(json.dumps(res, indent=2) + "\n")
+        if args.plot:
+            from ..export.load_figures import entry_gap_png, force_distribution_png
+
+            p = Path(args.plot)
+            name = res["design"]
+            series = [{"label": f"{name}, e_h = {res['cam_offset_um']:g} um", "torque_nm": [lv["torque_nm"] for lv in res["levels"]],
+                       "entry_gap_um": [lv["entry_gap_um"] for lv in res["levels"]]}]
+            Path(batch.temp_path(p.with_name(f"{p.stem}_entry_gap.png"))).write_bytes(
+                entry_gap_png(series, f"{name}: entry gap against output torque (smallest over waves and sections)", res["interference_tol_um"]))
+            Path(batch.temp_path(p.with_name(f"{p.stem}_forces.png"))).write_bytes(
+                force_distribution_png(res["levels"], f"{name}: tooth forces (all sections) and ball loads around the rim"))
+            if compare:
+                Path(batch.temp_path(p.with_name(f"{p.stem}_compare.png"))).write_bytes(
+                    entry_gap_png(compare, "entry gap against output torque: tooth forms and cam offsets", res["interference_tol_um"]))
+    if not args.quiet:
+        print(_summary(res["design"], res))
+        for c in compare or []:
+            print("  compare " + c["label"] + ": entry gap um " + ", ".join("none" if g is None else f"{g:.2f}" for g in c["entry_gap_um"]))
+    return EXIT_INTERFERENCE if res["entry_gap_closes"] else EXIT_OK

@@ -1,0 +1,106 @@
+"""The loaded flexspline as a deformation law: analytic cam law + elastic ring field + rigid-body motion (theory.md 3.1, 4.1)."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field, replace
+from typing import ClassVar
+
+import numpy as np
+
+from ..laws import Law, RimState
+from .ring import Ring
+
+__all__ = ["LoadedLaw"]
+
+
+@dataclass(frozen=True)
+class LoadedLaw(Law):
+    """Neutral line of the loaded flexspline, usable wherever a :class:`~wgcad.deformation.Law` is.
+
+    ``state(phi)`` = the nominal law of the section + ``scale`` times the
+    ring's response to the contact loads (n >= 2 modes, :class:`Ring`) + the
+    rigid-body motion ``(dx, dy, rot)`` of the rim (first order in ``rot``:
+    ``w -= rot v``, ``v += rot (r_m + w)``, ``theta += rot``). ``phi`` is the
+    material angle from the generator's major axis as for every law; the
+    loads are expressed in the generator frame, so the state is the one the
+    drive holds at the generator angle it was solved for, and the clearance
+    engine, the pictures and the kinematic-error model use it unchanged
+    (quasi-static: teeth passing through keep this rim shape).
+
+    Attributes
+    ----------
+    centre : Law
+        Nominal law of the generator's centre section (amplitude ``w0_ref``).
+    section : Law
+        Nominal law of this section (coned amplitude ``w0``).
+    ring : Ring
+    psi : (L,) float
+        Angles of the generalized loads, rad.
+    loads : (L, 3) float
+        Radial force, tangential force (N), couple (N mm) on the ring at ``psi``.
+    scale : float
+        Coning factor of the elastic field at this section, ``W0(z)/W0``.
+    rigid : (3,) float
+        ``dx, dy`` (mm, generator frame) and ``rot`` (rad, counter-clockwise) of the rim.
+    phase : float
+        The law is ``state(phi + phase)`` (``pi``: the second wave seen as the first).
+    """
+
+    name: ClassVar[str] = "loaded"
+    linear_in_w0: ClassVar[bool] = False
+    centre: Law
+    section: Law
+    ring: Ring
+    psi: np.ndarray
+    loads: np.ndarray
+    scale: float = 1.0
+    rigid: tuple = (0.0, 0.0, 0.0)
+    phase: float = 0.0
+    w0: float = field(init=False)
+    r_m: float = field(init=False)
+    n_waves: int = field(init=False)
+
+    def __post_init__(self):
+        object.__setattr__(self, "w0", float(self.section.w0))
+        object.__setattr__(self, "r_m", float(self.section.r_m))
+        object.__setattr__(self, "n_waves", int(self.section.n_waves))
+        psi = np.array(self.psi, dtype=float)
+        loads = np.array(self.loads, dtype=float).reshape(len(psi), 3)
+        psi.flags.writeable = False
+        loads.flags.writeable = False
+        object.__setattr__(self, "psi", psi)
+        object.__setattr__(self, "loads", loads)
+        object.__setattr__(self, "rigid", tuple(float(x) for x in self.rigid))
+
+    def with_w0(self, w0: float) -> "LoadedLaw":
+        """The loaded law of the section whose nominal amplitude is ``w0`` (coning scales the elastic field alike)."""
+        return replace(self, section=self.centre.with_w0(w0), scale=float(w0) / float(self.centre.w0))
+
+    def shifted(self, phase: float) -> "LoadedLaw":
+        """This state seen from ``phase`` further on: ``state(phi) -> state(phi + phase)`` (e.g. ``pi`` for the other wave)."""
+        return replace(self, phase=self.phase + float(phase))
+
+    def elastic(self, phi) -> dict:
+        """Elastic field alone at ``phi`` (dict of ``w, dw, d2w, v, dv, theta, dtheta``), this section's scale applied."""
+        f = self.ring.field(np.ravel(phi), self.psi, self.loads)
+        return {k: self.scale * v.reshape(np.shape(phi)) for k, v in f.items()}
+
+    def _state(self, phi: np.ndarray) -> RimState:
+        p = phi + self.phase
+        nom = self.section.state(p)
+        el = self.elastic(p)
+        dx, dy, rot = self.rigid
+        c, s = np.cos(p), np.sin(p)
+        w_t = dx * c + dy * s
+        v_t = -dx * s + dy * c
+        return RimState(
+            phi,
+            w=nom.w + el["w"] + w_t - rot * nom.v,
+            dw=nom.dw + el["dw"] + v_t - rot * nom.dv,
+            d2w=nom.d2w + el["d2w"] - w_t + rot * nom.dw,
+            v=nom.v + el["v"] + v_t + rot * (self.r_m + nom.w),
+            dv=nom.dv + el["dv"] - w_t + rot * nom.dw,
+            theta=nom.theta + el["theta"] + rot,
+            dtheta=nom.dtheta + el["dtheta"],
+        )
+

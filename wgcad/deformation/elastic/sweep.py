@@ -1,0 +1,133 @@
+"""A torque sweep of the loaded drive as data: entry gap, contacts, forces, ball loads, wind-up, stiffness (theory.md 4.1, 5)."""
+
+from __future__ import annotations
+
+import time
+from math import pi
+
+import numpy as np
+
+from wgcad.constants import INTERFERENCE_TOL
+
+from .mesh import entry_gap
+from .model import ElasticModel
+from .state import LoadState, solve_load
+
+__all__ = ["level_summary", "torque_sweep"]
+
+
+def _deg(x):
+    return round(float(np.rad2deg(x)), 4)
+
+
+def _wave_of(phi):
+    """Index of the wave (major axis at 0 or pi) a tooth angle belongs to."""
+    return (np.cos(phi) < 0.0).astype(int)
+
+
+def level_summary(st: LoadState) -> dict:
+    """Figures of one load state (units in the keys)."""
+    m = st.model
+    c = st.contacts
+    tooth = c["kind"] == 1
+    F = c["force"]
+    working = 1 if m.scene.working == "upper" else 0
+    entries = []
+    for w, phase in enumerate((0.0, pi)):
+        for i, law in enumerate(st.laws):
+            g, phi = entry_gap(m.scene, law.shifted(phase))
+            entries.append({"wave": w, "section_z_mm": float(m.zs[i]), "entry_gap_um": round(1e3 * g, 4),
+                            "tooth_angle_deg": _deg(phi + phase)})
+    gaps = [e["entry_gap_um"] for e in entries if np.isfinite(e["entry_gap_um"])]
+    sections = []
+    for i in range(len(m.zs)):
+        sel = tooth & (c["section"] == i) & (F > 0)
+        zone = []
+        for w in (0, 1):
+            sw = sel & (_wave_of(c["phi"]) == w)
+            if sw.any():
+                ph = np.mod(c["phi"][sw] - w * pi + pi, 2 * pi) - pi
+                zone.append([_deg(ph.min() + w * pi), _deg(ph.max() + w * pi)])
+            else:
+                zone.append(None)
+        sections.append({
+            "section_z_mm": float(m.zs[i]),
+            "teeth_in_contact": int(len(np.unique(c["tooth"][sel]))),
+            "working_flank_contacts": int((sel & (c["flank"] == working)).sum()),
+            "non_working_flank_contacts": int((sel & (c["flank"] != working)).sum()),
+            "zone_deg": zone,
+        })
+    # force per tooth (all sections and flanks), for the distribution
+    tid = c["tooth"][tooth]
+    per_tooth = np.zeros(m.drive.design.drive.z_flex)
+    np.add.at(per_tooth, tid, F[tooth])
+    z_g = len(per_tooth)
+    phi_t = 2 * pi * np.arange(z_g) / z_g
+    free = tooth & (F <= 0)
+    pen = -(c["gap"] + c["approach"])
+    return {
+        "torque_nm": st.torque_nm,
+        "entry_gap_um": min(gaps) if gaps else None,
+        "entry": entries,
+        "min_clearance_um": round(1e3 * float(c["gap"][free].min()), 4) if free.any() else None,
+        "max_contact_approach_um": round(1e3 * float(c["approach"][tooth].max()), 4) if tooth.any() else 0.0,
+        "unexplained_penetration_um": round(1e3 * max(float(pen.max()), 0.0), 4),
+        "teeth_in_contact": int(len(np.unique(c["tooth"][tooth & (F > 0)]))),
+        "sections": sections,
+        "largest_tooth_force_n": round(float(per_tooth.max()), 3),
+        "largest_contact_force_n": round(float(F[tooth].max()), 3) if tooth.any() else 0.0,
+        "tooth_force_n": [round(float(x), 3) for x in per_tooth],
+        "tooth_angle_deg": [_deg(x) for x in phi_t],
+        "ball_load_n": [round(float(x), 3) for x in F[~tooth]],
+        "ball_angle_deg": [_deg(x) for x in c["phi"][~tooth]],
+        "max_ball_load_n": round(float(F[~tooth].max()), 3),
+        "max_ball_pressure_mpa": round(float(m.bearing.pressure(F[~tooth]).max()), 1),
+        "wind_up_arcmin": round(float(np.rad2deg(st.wind_up) * 60.0), 5),
+        "mesh_wind_up_arcmin": round(float(np.rad2deg(st.mesh_wind_up) * 60.0), 5),
+        "rim_shift_um": [round(1e3 * float(x), 4) for x in st.rigid[:2]],
+        "residuals": {k: (float(v) if not isinstance(v, int) else v) for k, v in st.residuals.items()},
+        "timing_s": {k: round(v, 4) for k, v in st.timing.items()},
+    }
+
+
+def torque_sweep(model: ElasticModel, torques_nm, cam_offset_um: float = 0.0, cam_offset_deg: float = 0.0,
+                 tol: float | None = None, progress=None) -> dict:
+    """Solve every torque level (each warm-started from the previous) and summarise.
+
+    Returns
+    -------
+    dict with ``levels`` (list of :func:`level_summary`), ``stiffness_nm_per_rad``
+    (secant between neighbouring levels), ``entry_gap_closes`` (bool) and settings.
+    """
+    kw = {} if tol is None else {"tol": tol}
+    levels, states = [], []
+    prev = None
+    t0 = time.perf_counter()
+    for k, T in enumerate(torques_nm):
+        st = solve_load(model, float(T), cam_offset_um, cam_offset_deg, warm=prev, **kw)
+        prev = st
+        states.append(st)
+        levels.append(level_summary(st))
+        if progress:
+            progress(k + 1, len(torques_nm), "load levels")
+    stiff = []
+    for a, b in zip(states[:-1], states[1:]):
+        dth = b.wind_up - a.wind_up
+        stiff.append(round((b.torque_nm - a.torque_nm) / dth, 1) if dth > 0 else None)
+    closes = any(lv["entry_gap_um"] is not None and lv["entry_gap_um"] < -1e3 * INTERFERENCE_TOL for lv in levels)
+    return {
+        "levels": levels,
+        "stiffness_nm_per_rad": stiff,
+        "entry_gap_closes": bool(closes),
+        "interference_tol_um": 1e3 * INTERFERENCE_TOL,
+        "cam_offset_um": cam_offset_um,
+        "cam_offset_deg": cam_offset_deg,
+        "model": {
+            "ring_ei_n_mm2": {k: round(v, 1) for k, v in model.ei_parts.items()},
+            "cup_torsional_stiffness_nm_per_rad": round(model.cup_stiffness * 1e-3, 1),
+            "bearing_clearance_um": round(1e3 * model.bearing.clearance, 3),
+            "sections_z_mm": [float(z) for z in model.zs],
+        },
+        "elapsed_s": round(time.perf_counter() - t0, 4),
+        "states": states,
+    }

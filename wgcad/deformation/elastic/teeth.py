@@ -1,0 +1,198 @@
+"""Tooth contacts: points, normals and gaps from the exact 2D engine, and the tooth pair's compliance (theory.md 4.1, 5)."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+import numpy as np
+import shapely
+
+from wgcad.clearance.engine import Scene, clearance_at_poses
+from wgcad.placement import transform
+
+__all__ = ["ContactGeometry", "flank_contacts", "ToothCompliance"]
+
+
+@dataclass(frozen=True)
+class ContactGeometry:
+    """Linearised contacts between placed flexspline teeth and rigid teeth (rigid-gear frame), arrays of length K.
+
+    Attributes
+    ----------
+    gap : (K,) float
+        Signed clearance from the engine, mm (negative: penetration depth).
+    point : (K, 2) float
+        The point of the flexspline tooth where the gap is measured.
+    normal : (K, 2) float
+        Outward unit normal of the flexspline outline at ``point``: a motion of
+        the flexspline point along it closes the gap (``d gap = -normal . d point``).
+    rigid : (K,) int
+        Index of the rigid tooth.
+    """
+
+    gap: np.ndarray
+    point: np.ndarray
+    normal: np.ndarray
+    rigid: np.ndarray
+
+
+def _deepest(pts: np.ndarray, geoms: np.ndarray):
+    """Deepest vertex of each polygon ``pts[k]`` ``(K, N, 2)`` inside ``geoms[k]``, all pairs at once.
+
+    Returns depth ``(K,)`` (0 where no vertex is inside), the vertex ``(K, 2)`` and
+    its nearest point on the boundary of ``geoms[k]`` ``(K, 2)``.
+    """
+    K, N, _ = pts.shape
+    depth = np.zeros(K)
+    vert = pts[:, 0].copy()
+    near = pts[:, 0].copy()
+    ins = shapely.contains_xy(geoms[:, None], pts[..., 0], pts[..., 1])
+    kk, ii = np.nonzero(ins)
+    if kk.size == 0:
+        return depth, vert, near
+    rings = shapely.get_exterior_ring(geoms)
+    d = shapely.distance(rings[kk], shapely.points(pts[kk, ii]))
+    full = np.full((K, N), -1.0)
+    full[kk, ii] = d
+    best = np.argmax(full, axis=1)
+    has = full[np.arange(K), best] > 0.0
+    k = np.nonzero(has)[0]
+    depth[k] = full[k, best[k]]
+    vert[k] = pts[k, best[k]]
+    seg = shapely.get_coordinates(shapely.shortest_line(rings[k], shapely.points(vert[k]))).reshape(-1, 2, 2)
+    near[k] = seg[:, 0]
+    return depth, vert, near
+
+
+def _smooth_normals(outlines: np.ndarray, p: np.ndarray) -> np.ndarray:
+    """Outward normals of counter-clockwise outlines ``(K, N, 2)`` at points ``p`` ``(K, 2)`` on them.
+
+    Vertex normals (the mean of the two edge normals) interpolated along the
+    nearest edge: a normal field that is continuous along the outline, so the
+    contact direction does not jump from edge to edge of the polygon (which
+    would leave the re-linearisation cycling by a fraction of a micrometre).
+    """
+    a = outlines
+    b = np.roll(outlines, -1, axis=1)
+    ab = b - a
+    L2 = np.maximum((ab * ab).sum(axis=-1), 1e-300)
+    t = np.clip(((p[:, None, :] - a) * ab).sum(axis=-1) / L2, 0.0, 1.0)
+    d2 = ((a + t[..., None] * ab - p[:, None, :]) ** 2).sum(axis=-1)
+    e = np.argmin(d2, axis=1)
+    en = np.stack([ab[..., 1], -ab[..., 0]], axis=-1) / np.sqrt(L2)[..., None]  # edge i: vertex i -> i+1
+    vn = en + np.roll(en, 1, axis=1)  # vertex i: edges i-1 and i
+    vn /= np.hypot(vn[..., 0], vn[..., 1])[..., None]
+    k = np.arange(len(p))
+    N = outlines.shape[1]
+    te = t[k, e][:, None]
+    n = (1.0 - te) * vn[k, e] + te * vn[k, (e + 1) % N]
+    # how sharp the outline turns at the ends of that edge (0: straight, pi/2: a right-angled corner)
+    cosang = lambda i: np.clip((en[k, (i - 1) % N] * en[k, i]).sum(axis=-1), -1.0, 1.0)  # noqa: E731
+    kink = np.maximum(np.arccos(cosang(e)), np.arccos(cosang((e + 1) % N)))
+    return n / np.hypot(n[:, 0], n[:, 1])[:, None], kink
+
+
+def flank_contacts(scene: Scene, rot: np.ndarray, shift: np.ndarray) -> dict[str, ContactGeometry]:
+    """Contacts of flexspline teeth at poses ``(rot, shift)`` with their lower and upper rigid neighbours.
+
+    The gaps are the engine's (:func:`wgcad.clearance.engine.clearance_at_poses`);
+    the point and normal come from the shortest segment between the outlines
+    when apart, and from the deepest vertex and its nearest point on the other
+    outline when overlapping (the vertex that sets the engine's depth): the
+    point where the gap is measured, and ``-normal`` approximates the gradient
+    of the gap with respect to a translation of
+    the flexspline tooth in both cases. The normal is the outward normal of
+    the flexspline outline at that point, or the inward normal of the rigid
+    outline at its point when that outline is the smoother one there (a
+    corner against a flank), interpolated between vertex normals.
+
+    Returns
+    -------
+    dict with keys ``"lower"``, ``"upper"`` of :class:`ContactGeometry`.
+    """
+    rot = np.atleast_1d(np.asarray(rot, dtype=float))
+    shift = np.atleast_2d(np.asarray(shift, dtype=float))
+    res = clearance_at_poses(scene, rot, shift, third=False)
+    pts = transform(scene.flex_local, rot, shift)
+    geoms = shapely.polygons(pts)
+    out = {}
+    for key, idx in (("lower", res["lo"]), ("upper", res["up"])):
+        gap = np.asarray(res[key], dtype=float)
+        rg = scene.rigid_geoms[idx]
+        point = np.empty((len(rot), 2))
+        other = np.empty((len(rot), 2))
+        apart = np.nonzero(gap > 0.0)[0]
+        if apart.size:
+            seg = shapely.get_coordinates(shapely.shortest_line(geoms[apart], rg[apart])).reshape(-1, 2, 2)
+            point[apart] = seg[:, 0]
+            other[apart] = seg[:, 1]
+        over = np.nonzero(gap <= 0.0)[0]
+        if over.size:
+            # the vertex that sets the engine's depth: of the flexspline inside the rigid tooth, or the reverse
+            d_f, v_f, q_f = _deepest(pts[over], rg[over])
+            d_r, v_r, q_r = _deepest(scene.rigid_pts[idx[over]], geoms[over])
+            flex_side = d_f >= d_r
+            point[over] = np.where(flex_side[:, None], v_f, q_r)
+            other[over] = np.where(flex_side[:, None], q_f, v_r)
+            touch = np.nonzero(np.maximum(d_f, d_r) <= 0.0)[0]
+            if touch.size:  # touching without a vertex inside
+                k = over[touch]
+                seg = shapely.get_coordinates(shapely.shortest_line(shapely.get_exterior_ring(geoms[k]),
+                                                                    shapely.get_exterior_ring(rg[k]))).reshape(-1, 2, 2)
+                point[k], other[k] = seg[:, 0], seg[:, 1]
+        # the contact normal is the normal of the smoother outline there: a tip corner pressing on a
+        # flank acts along the flank's normal (vertex normals interpolated, so it does not jump)
+        n_f, kink_f = _smooth_normals(pts, point)
+        n_r, kink_r = _smooth_normals(scene.rigid_pts[idx], other)
+        normal = np.where((kink_r < kink_f)[:, None], -n_r, n_f)
+        out[key] = ContactGeometry(gap, point, normal, np.asarray(idx))
+    return out
+
+
+@dataclass(frozen=True)
+class ToothCompliance:
+    """Compliance of one tooth pair along the contact normal over a face-width slice (docs/models.md 4.1).
+
+    Both teeth are cantilevers of thickness ``s`` (the pitch tooth thickness,
+    pi m / 2) loaded at their contact heights: bending ``4 h^3 / (E b s^3)``
+    plus shear ``1.2 h / (G b s)``, times ``cos^2`` of the angle between the
+    normal and the tooth's tangential direction. The flanks' approach is
+    Palmgren's steel line contact ``3.84e-5 Q^0.9 / b^0.8`` (mm, N, mm)
+    scaled by ``E'_steel / E'``.
+    """
+
+    E: float  # MPa
+    nu: float
+    s: float  # mm, tooth thickness
+    r_root_flex: float
+    r_root_rigid: float
+
+    def bending(self, point, normal, width):
+        """Bending + shear compliance of both teeth, mm/N, for flexspline contact points ``(K, 2)``."""
+        R = np.hypot(point[:, 0], point[:, 1])
+        er = point / R[:, None]
+        c_t = np.abs(normal[:, 0] * -er[:, 1] + normal[:, 1] * er[:, 0])  # |n . e_t|
+        G = self.E / (2.0 * (1.0 + self.nu))
+        out = np.zeros(len(R))
+        for h in (np.abs(R - self.r_root_flex), np.abs(self.r_root_rigid - R)):
+            h = np.maximum(h, 0.05 * self.s)
+            out += 4.0 * h**3 / (self.E * width * self.s**3) + 1.2 * h / (G * width * self.s)
+        return out * c_t**2
+
+    def hertz(self, Q, width):
+        """Palmgren line-contact approach of the flanks, mm, for normal loads ``Q`` (N)."""
+        scale = (2.06e5 / (1 - 0.3**2)) / (self.E / (1 - self.nu**2))
+        return scale * 3.84e-5 * np.maximum(Q, 0.0) ** 0.9 / np.asarray(width) ** 0.8
+
+    def tangent(self, Q, width, q_floor: float):
+        """Newton linearisation of :meth:`hertz` about ``Q``: ``(offset, slope)``, secant at ``q_floor`` for ``Q <= q_floor``."""
+        Q = np.asarray(Q, dtype=float)
+        on = Q > q_floor
+        Qf = np.where(on, Q, q_floor)
+        lam = self.hertz(Qf, width)
+        return np.where(on, 0.1 * lam, 0.0), np.where(on, 0.9 * lam / Qf, lam / Qf)
+
+    def secant(self, Q, width, q_floor: float):
+        """Secant compliance ``hertz(Q)/Q`` with ``Q`` floored at ``q_floor`` N, mm/N."""
+        Q = np.maximum(np.asarray(Q, dtype=float), q_floor)
+        return self.hertz(Q, width) / Q
+
