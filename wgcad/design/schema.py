@@ -10,6 +10,7 @@ from dataclasses import MISSING, dataclass, fields, replace
 from pathlib import Path
 
 from ..errors import DesignError, InputFileError
+from .imperfections import ImperfectionsSpec, validate_imperfections
 
 __all__ = [
     "DriveSpec",
@@ -89,6 +90,7 @@ class Design:
     rigid: GearSpec
     generator: GeneratorSpec
     source: str = "<memory>"
+    imperfections: ImperfectionsSpec = ImperfectionsSpec()  # optional table, docs/models.md 6.2
 
     @property
     def module(self) -> float:
@@ -118,8 +120,9 @@ _TABLES: dict[str, type] = {
     "flexspline": GearSpec,
     "rigid": GearSpec,
     "generator": GeneratorSpec,
+    "imperfections": ImperfectionsSpec,
 }
-_OPTIONAL_TABLES = ("tooth",)
+_OPTIONAL_TABLES = ("tooth", "imperfections")
 
 
 def _base_type(tp) -> tuple[type, bool]:
@@ -248,6 +251,7 @@ def validate(d: Design) -> Design:
             raise DesignError("generator.generator_z", f"must be in [0, cone_length = {g.cone_length:g}) mm, got {g.generator_z:g}")
         if dr.face_width > g.cone_length:
             raise DesignError("drive.face_width", f"face width {dr.face_width:g} mm exceeds generator.cone_length {g.cone_length:g} mm")
+    validate_imperfections(d.imperfections, dr.module)
     return d
 
 
