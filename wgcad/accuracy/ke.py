@@ -179,8 +179,8 @@ def contact_table(drive, imp: Imperfections, n_per_mesh: int = DEFAULT_N, sectio
     return tab
 
 
-def _terms(tab: ContactTable, side: int, imp: Imperfections, i: np.ndarray, e: np.ndarray, which: str) -> np.ndarray:
-    """One group of linear error terms of the closing rotation, for samples ``i`` (I, 1) and contacts ``e`` (I, C)."""
+def _geometry(tab: ContactTable, side: int, i: np.ndarray, e: np.ndarray) -> dict:
+    """Per (sample, contact): flexspline tooth ``k``, rigid shift ``sb`` and ``R(rho) nt`` in the actual frame."""
     S = tab.sides[side]
     N, z_g, z_b = tab.N, tab.z_g, tab.z_b
     m = S["m"][e]
@@ -189,21 +189,28 @@ def _terms(tab: ContactTable, side: int, imp: Imperfections, i: np.ndarray, e: n
     # the table frame turned to the actual one by whole rigid pitches: (m' + sigma i) / N, with m'
     # the lattice index of the folded tooth angle (docs/models.md 7: phi z_g / z_b + phi_h)
     sb = (((m + M // 2) % M - M // 2) + tab.sigma * i) // N
-    rho = 2 * pi * sb / z_b
+    rho = (2 * pi / z_b) * sb
     cr, sr = np.cos(rho), np.sin(rho)
     ntx, nty = S["nt"][e, 0], S["nt"][e, 1]
-    nx, ny = cr * ntx - sr * nty, sr * ntx + cr * nty  # R(rho) nt: the table frame turned to the actual one
+    return {"k": k, "sb": sb, "nx": cr * ntx - sr * nty, "ny": sr * ntx + cr * nty}
+
+
+def _terms(tab: ContactTable, side: int, imp: Imperfections, i: np.ndarray, e: np.ndarray, which: str, geo=None) -> np.ndarray:
+    """One group of linear error terms of the closing rotation, for samples ``i`` (I, 1) and contacts ``e`` (I, C)."""
+    S = tab.sides[side]
+    z_g, z_b = tab.z_g, tab.z_b
+    geo = _geometry(tab, side, i, e) if geo is None else geo
+    nx, ny = geo["nx"], geo["ny"]
     if which == "rigid":
         T = rigid_translation(imp)
-        j = (S["j"][e] + sb) % z_b
+        j = (S["j"][e] + geo["sb"]) % z_b
         return T[0] * nx + T[1] * ny + rigid_deviations(imp, j, z_b, tab.r_b) * S["a_beta"][e]
     if which == "flex":
-        da, dr = flex_deviations(imp, k, z_g, tab.r_g)
+        da, dr = flex_deviations(imp, geo["k"], z_g, tab.r_g)
         return -da * S["a_phi"][e] - dr * S["a_rho"][e]
-    phi_h = tab.sigma * i * (2 * pi / (z_b * N))
+    phi_h = tab.sigma * i * (2 * pi / (z_b * tab.N))
     E = cam_offset(imp, phi_h, phi_h / gear_ratios(z_g, z_b)["u_hg"], parts=("flex", "fixed"))
-    c = S["c"][e]
-    return -c * (E[..., 0] * nx + E[..., 1] * ny)
+    return -S["c"][e] * (E[..., 0] * nx + E[..., 1] * ny)
 
 
 def _lanes(tab: ContactTable, side: int, imp: Imperfections) -> np.ndarray:
@@ -262,16 +269,19 @@ def _side_arrays(tab, side, imp, lanes, i, lever):
     pad = e < 0
     e = np.where(pad, 0, e)
     ii = i[:, None]
-    base = tab.sides[side]["g"][e] + _terms(tab, side, imp, ii, e, "cam")
-    for grp in ("rigid", "flex"):
-        if grp != lever:
-            base = base + _terms(tab, side, imp, ii, e, grp)
+    geo = _geometry(tab, side, ii, e)
+    base = tab.sides[side]["g"][e].copy()
+    used = {"cam": imp.cam_flex or imp.cam_fixed, "rigid": imp.rigid_runout or imp.rigid_ecc,
+            "flex": imp.flex_runout or imp.flex_ecc}
+    for grp in ("cam", "rigid", "flex"):
+        if grp != lever and used[grp]:  # a group without errors adds nothing
+            base += _terms(tab, side, imp, ii, e, grp, geo)
     base[pad] = np.inf
     if lever is None:
         return base, None, None
     key = "rigid_install" if lever == "rigid" else "flex_install"
-    X = _terms(tab, side, imp.replace(**{key: 0.0}), ii, e, lever)
-    Y = _terms(tab, side, imp.replace(**{key: 0.5 * pi}), ii, e, lever)
+    X = _terms(tab, side, imp.replace(**{key: 0.0}), ii, e, lever, geo)
+    Y = _terms(tab, side, imp.replace(**{key: 0.5 * pi}), ii, e, lever, geo)
     X[pad] = 0.0
     Y[pad] = 0.0
     return base, X, Y
