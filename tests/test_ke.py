@@ -146,3 +146,42 @@ def test_fixed_flexspline_is_refused(tmp_path, capsys):
     (tmp_path / "f.toml").write_text(text)
     assert main(["ke", str(tmp_path / "f.toml")]) == 2
     assert "drive.fixed" in capsys.readouterr().err
+
+
+def _zone0(tab):
+    """The table restricted to the zone around the major axis (+x)."""
+    M = tab.z_g * tab.N
+    for side, S in tab.sides.items():
+        keep = np.abs(((S["m"] + M // 2) % M - M // 2) / M * 2 * math.pi) < 0.5 * math.pi
+        tab.sides[side] = {k: v[keep] for k, v in S.items()}
+    return tab
+
+
+def test_contact_ke_agrees_with_the_double_flank_formula_to_first_order(d2):
+    # docs/models.md 6.1: in double-flank engagement a geometric eccentricity e of the flexspline
+    # moves the mesh tangentially by dT = (cos a / cos a_w) e sin t (a = a_w here: the same teeth)
+    # and its radial part cancels between the flanks. The contact model's double-flank position
+    # (the centre between the working and the other flank's contact, one zone) must turn the
+    # flexspline back by dT over the contact radius, to first order in e.
+    from wgcad.accuracy import flank_errors, gear_angles
+    from wgcad.accuracy.flank_errors import Eccentricities
+
+    psi = 0.3
+    n = 4 * 202 * 5 // 4  # 1.25 generator turns: the flexspline's terms go once round
+    theta = {}
+    for e in (0.0, 1e-3, 2e-3):
+        imp = Imperfections(flex_ecc=e, flex_ecc_phase=psi)
+        tab = _zone0(K.contact_table(d2, imp, 4, sections=[None]))
+        res = K.kinematic_error(d2, imp, table=tab, samples=n)
+        theta[e] = tab.side_w * 0.5 * (res.delta_w - res.delta_n)
+        phi_h, side_w = res.phi_h, tab.side_w
+        R = float(np.hypot(*tab.sides[side_w]["q"].T).mean())  # contact radius
+    d1, d2_ = theta[1e-3] - theta[0.0], theta[2e-3] - theta[0.0]
+    # first order: doubling e doubles the change (the second-order residual is ~e^2 / r)
+    assert np.abs(d2_ - 2 * d1).max() < 0.02 * np.abs(d1).max()
+    ty, tb = gear_angles(phi_h, 200, 202, flex_start=psi)
+    a = math.radians(20.0)
+    dT = flank_errors(ty, tb, Eccentricities(flex_geometric=1e-3), a, a, "double").dT
+    # the flexspline turns back by dT / R; 3 % covers the contacts' spread about the zone's axis
+    # (teeth within +-10 deg: the tangential direction there differs by cos 10 deg = 0.985)
+    np.testing.assert_allclose(d1, -dT / R, atol=0.03 * np.abs(dT).max() / R)

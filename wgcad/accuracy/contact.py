@@ -164,7 +164,7 @@ def closing_rotation(flex: Template, rot, shift, rigid: Template, rot_b, shift_b
         nxt = np.where(use_rf, rf, nxt)
         tight = br & ((hi_t - lo_t) * lever < 0.1 * GAP_TOL)
         done |= tight & np.isfinite(lo_d)
-        far = nxt > reach
+        far = np.abs(nxt) > reach  # beyond reach either way (turned back past a neighbour: a jam)
         ok[far & ~done] = False
         done |= far
         t = np.where(done, t, nxt)
