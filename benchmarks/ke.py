@@ -84,6 +84,17 @@ def main() -> None:
                                 "ke_pp_error_arcsec": round((res.ke_pp - res10.ke_pp) * AS, 4),
                                 "max_abs_diff_at_common_angles_arcsec": round(float(np.abs(common - res.ke).max()) * AS, 6)}
         print(json.dumps(out["reference_10x"]), flush=True)
+    # where the linear model holds: the [S4] amplitudes scaled down (N = 4, centre section, to be quick)
+    out["linear_vs_direct_by_scale"] = []
+    for scale in (1.0, 0.1, 0.02):
+        sc = imp.replace(**{k: getattr(imp, k) * scale for k in ("flex_runout", "rigid_runout", "cam_cam", "cam_fixed", "cam_flex")})
+        tb = K.contact_table(drive, sc, 4, sections=[None])
+        r = K.kinematic_error(drive, sc, table=tb, samples=4 * 202 * 3)
+        dd = [(arr[i] - K.closing_direct(drive, sc, r.phi_h[i], side, sections=[None])) * AS
+              for i in (0, 301, 1001, 2222) for side, arr in ((tb.side_w, r.delta_w), (-tb.side_w, r.delta_n))]
+        row = {"scale": scale, "max_abs_arcsec": round(float(np.abs(dd).max()), 5), "engagement": r.engagement}
+        out["linear_vs_direct_by_scale"].append(row)
+        print(json.dumps(row), flush=True)
     dest = ROOT / "output" / "bench"
     dest.mkdir(parents=True, exist_ok=True)
     (dest / "ke.json").write_text(json.dumps(out, indent=2))
