@@ -56,6 +56,9 @@ def cmd_ke(args) -> int:
     print(f"  engagement: {res.engagement}; lost motion {out['lost_motion_arcsec']['min']:.1f} .. {out['lost_motion_arcsec']['max']:.1f} arcsec")
     print(f"  largest KE (peak to peak): {out['ke_pp_arcsec']:.2f} arcsec; perfect parts: {out['intrinsic_ke_pp_arcsec']:.3f} arcsec")
     print(f"  strongest orders: " + ", ".join(f"{s['order']:g} ({s['amplitude_arcsec']:.2f}'')" for s in out["spectrum_top"][:4]))
+    if res.lost_motion.min() < 0:
+        print("  note: the teeth interfere (negative lost motion): the rigid-body position splits the interference; "
+              "errors must stay well below the overlap for the linear model (docs/models.md 6.2) - under load use the elastic model")
     sc = out["shortcuts"]
     print(f"  shortcuts that hold: mesh period {sc['mesh_period']}, identical waves {sc['identical_waves']}, mirror {sc['mirror_symmetry']} ({sc['why']})")
     scan = None

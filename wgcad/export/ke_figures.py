@@ -29,33 +29,44 @@ def _png(fig, plt) -> bytes:
 
 
 def ke_png(title: str, res, orders, amp, expected: dict, intrinsic=None) -> bytes:
-    """KE over the record (arcsec against cam turns) and its amplitude spectrum with the expected orders marked."""
+    """KE over the record (arcsec against cam turns), its first mesh periods, and its spectrum with the expected orders marked."""
     plt = _plt()
-    fig, ax = plt.subplots(2, 1, figsize=(11, 7.5), dpi=90)
+    fig, ax = plt.subplots(3, 1, figsize=(11, 10), dpi=90)
     turns = np.abs(res.phi_h) / (2 * np.pi)
-    ax[0].plot(turns, res.ke * _AS, lw=0.4, color="k", label=f"KE ({res.engagement}), {res.ke_pp * _AS:.1f}'' peak to peak")
-    if intrinsic is not None:
-        t2 = np.abs(intrinsic.phi_h) / (2 * np.pi)
-        ax[0].plot(t2, intrinsic.ke * _AS, lw=0.6, color="tab:orange", label=f"perfect parts, {intrinsic.ke_pp * _AS:.2f}''")
+    ax[0].plot(turns, res.ke * _AS, lw=0.4, color="k", label=f"KE ({res.engagement}), {res.ke_pp * _AS:.2f}'' peak to peak")
     ax[0].set_xlabel("generator turns (one flexspline revolution)")
     ax[0].set_ylabel("KE, arcsec")
     ax[0].legend(fontsize=8, loc="upper right")
     ax[0].grid(alpha=0.3)
+    # the first three mesh periods: the ripple of the tooth mesh itself
+    n = min(len(res.ke), 3 * res.n_per_mesh * 4)
+    deg = np.degrees(np.abs(res.phi_h[:n]))
+    ax[1].plot(deg, res.ke[:n] * _AS, ".-", ms=3, lw=0.8, color="k", label="KE")
+    if intrinsic is not None:
+        m = min(n, len(intrinsic.ke))
+        ax[1].plot(np.degrees(np.abs(intrinsic.phi_h[:m])), intrinsic.ke[:m] * _AS, ".-", ms=3, lw=0.8,
+                   color="tab:orange", label=f"perfect parts, {intrinsic.ke_pp * _AS:.3f}'' peak to peak")
+    ax[1].set_xlabel("generator angle, deg (the first mesh periods)")
+    ax[1].set_ylabel("KE, arcsec")
+    ax[1].legend(fontsize=8, loc="upper right")
+    ax[1].grid(alpha=0.3)
     low = {k: v for k, v in expected.items() if k != "mesh"}
     top = max(low.values()) * 1.6
     sel = (orders > 0) & (orders <= top)
-    ax[1].semilogy(orders[sel], np.maximum(amp[sel] * _AS, 1e-6), lw=0.8, color="k")
+    ax[1 + 1].semilogy(orders[sel], np.maximum(amp[sel] * _AS, 1e-6), lw=0.8, color="k")
+    tr = ax[2].get_xaxis_transform()
     for (name, o), c in zip(low.items(), ["tab:red", "tab:blue", "tab:red", "tab:blue"]):
-        ax[1].axvline(o, color=c, ls="--", lw=0.8, alpha=0.7)
-        ax[1].text(o, float(np.max(amp[sel]) * _AS), f" {name} ({o:g})", rotation=90, va="top", fontsize=7, color=c)
+        ax[2].axvline(o, color=c, ls="--", lw=0.8, alpha=0.7)
+        ax[2].text(o, 0.97, f" {name} ({o:g})", rotation=90, va="top", fontsize=7, color=c, transform=tr)
+    label = "order, cycles per flexspline revolution"
     if "mesh" in expected:
         mo = expected["mesh"]
         near = np.abs(orders - mo) <= 0.5
         ma = float(amp[near].max() * _AS) if near.any() else float("nan")
-        ax[1].set_title(f"spectrum up to order {top:g}; mesh order {mo:g}: {ma:.3g} arcsec", fontsize=9)
-    ax[1].set_xlabel("order, cycles per flexspline revolution")
-    ax[1].set_ylabel("amplitude, arcsec")
-    ax[1].grid(alpha=0.3, which="both")
+        label += f"  (mesh order {mo:g}, off the axis: {ma:.3g} arcsec)"
+    ax[2].set_xlabel(label)
+    ax[2].set_ylabel("amplitude, arcsec")
+    ax[2].grid(alpha=0.3, which="both")
     fig.suptitle(title)
     return _png(fig, plt)
 
