@@ -12,6 +12,7 @@ from pathlib import Path
 from ..errors import DesignError, InputFileError
 from .sectors import SectorsSpec, validate_sectors
 from .load import BearingSpec, LoadSpec, MaterialSpec, validate_load_tables
+from .imperfections import ImperfectionsSpec, validate_imperfections
 
 __all__ = [
     "DriveSpec",
@@ -95,6 +96,7 @@ class Design:
     material: MaterialSpec = MaterialSpec()  # [material], [bearing], [load]: design/load.py
     bearing: BearingSpec = BearingSpec()
     load: LoadSpec = LoadSpec()
+    imperfections: ImperfectionsSpec = ImperfectionsSpec()  # optional table, docs/models.md 6.2
 
     @property
     def module(self) -> float:
@@ -128,8 +130,9 @@ _TABLES: dict[str, type] = {
     "material": MaterialSpec,
     "bearing": BearingSpec,
     "load": LoadSpec,
+    "imperfections": ImperfectionsSpec,
 }
-_OPTIONAL_TABLES = ("tooth", "sectors", "material", "bearing", "load")
+_OPTIONAL_TABLES = ("tooth", "sectors", "material", "bearing", "load", "imperfections")
 
 
 def _base_type(tp) -> tuple[type, bool]:
@@ -262,6 +265,7 @@ def validate(d: Design) -> Design:
             raise DesignError("drive.face_width", f"face width {dr.face_width:g} mm exceeds generator.cone_length {g.cone_length:g} mm")
     validate_sectors(d.sectors, dr.z_flex, dr.z_rigid, dr.waves)
     validate_load_tables(d)
+    validate_imperfections(d.imperfections, dr.module)
     return d
 
 

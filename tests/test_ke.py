@@ -1,0 +1,187 @@
+"""No-load KE of imperfect drives from contact (docs/models.md 6.2, 7): lattice table and linear errors against the direct computation."""
+
+import math
+
+import numpy as np
+import pytest
+
+from conftest import TEMPLATES, edit_toml
+from wgcad.accuracy import ke as K
+from wgcad.accuracy.imperfect import Imperfections, flex_poses, rigid_poses, shortcuts
+from wgcad.cli import main
+from wgcad.design import load_design
+from wgcad.drive import build_drive
+
+AS = 180.0 / math.pi * 3600.0
+
+
+@pytest.fixture(scope="module")
+def d2():
+    return build_drive(load_design(TEMPLATES / "d2.toml"))
+
+
+@pytest.fixture(scope="module")
+def table0(d2):
+    return K.contact_table(d2, Imperfections(), 8, sections=[None])
+
+
+def test_perfect_parts_mesh_periodic_and_small(d2, table0):
+    # the direct computation (exact poses, no table) repeats after a rigid pitch of generator rotation
+    p = 2 * math.pi / 202
+    for phi in (0.0031, 0.0107):
+        a = K.closing_direct(d2, Imperfections(), phi, table0.side_w, sections=[None])
+        b = K.closing_direct(d2, Imperfections(), phi + 7 * p, table0.side_w, sections=[None])
+        assert abs(a - b) * AS < 1e-6
+    res = K.kinematic_error(d2, Imperfections(), table=table0, samples=8 * 202)
+    ke = res.ke
+    np.testing.assert_allclose(ke[8:], ke[:-8], atol=1e-12)
+    # intrinsic KE of perfect involute teeth on a non-conjugate deformation: sub-arcsecond ripple
+    assert 0.0 < res.ke_pp * AS < 2.0
+
+
+@pytest.mark.parametrize("imp", [
+    Imperfections(),
+    Imperfections(rigid_runout=2e-3, rigid_runout_phase=0.4),
+    Imperfections(flex_runout=2e-3, flex_runout_phase=1.1),
+    Imperfections(rigid_ecc=1e-3, rigid_ecc_phase=0.5),
+    Imperfections(flex_ecc=1e-3, flex_ecc_phase=2.0),
+    Imperfections(cam_fixed=1e-3, cam_fixed_phase=0.7, cam_flex=1e-3),
+    Imperfections(cam_cam=3e-3, cam_cam_phase=0.4, rigid_runout=1e-3, flex_runout=1e-3),
+], ids=["perfect", "rigid_runout", "flex_runout", "rigid_ecc", "flex_ecc", "cam_fixed_flex", "cam_cam_mix"])
+def test_table_and_linear_errors_match_the_direct_computation(d2, table0, imp):
+    # The fast KE (contacts tabulated once on the lattice, errors added through each contact's
+    # sensitivity) against exact poses of every tooth and a fresh contact search. Errors of 1-3 um:
+    # the linear model's residual is second order, (e / r)^2-ish rotations times the lever,
+    # far below 0.05 arcsec (2.4e-7 rad, 19 nm at the pitch circle); the perfect case is exact.
+    tab = K.contact_table(d2, imp, 8, sections=[None])  # built for these amplitudes (which contacts to refine)
+    res = K.kinematic_error(d2, imp, table=tab, samples=8 * 202 * 3)
+    for i in (0, 77, 1501, 3001, 4447):
+        for side, arr in ((tab.side_w, res.delta_w), (-tab.side_w, res.delta_n)):
+            ref = K.closing_direct(d2, imp, res.phi_h[i], side, sections=[None])
+            assert abs(arr[i] - ref) * AS < 0.05, (i, side, arr[i] * AS, ref * AS)
+
+
+def test_one_eccentricity_gives_the_hand_estimate(d2, table0):
+    # Rigid gear off-centre by e: in a zone its teeth move by e against the flexspline's, which
+    # shifts a contact by e / (r cos alpha) of rotation (alpha = 20 deg; the table's contacts
+    # have |nt| r ~ 1.05); the two zones move oppositely, once per generator turn. The KE is
+    # therefore of the order of e / (r cos alpha) = 2.7'' for e = 1 um, at order |u_hg| = 100
+    # (once per generator turn) or twice that (the first zone to touch rectifies it).
+    e = 1e-3
+    res = K.kinematic_error(d2, Imperfections(rigid_ecc=e), table=K.contact_table(d2, Imperfections(rigid_ecc=e), 8, sections=[None]))
+    hand = e / (d2.rigid.r * math.cos(math.radians(20.0)))
+    intr = K.kinematic_error(d2, Imperfections(), table=table0, samples=8 * 202).ke_pp
+    assert 0.5 * hand < res.ke_pp - intr < 2.5 * hand
+    orders, amp = K.spectrum(res)
+    low = (orders > 0) & (orders < 1000)
+    top = orders[low][np.argmax(amp[low])]
+    assert top in (100.0, 200.0)
+
+
+def test_install_angle_optimiser_against_a_brute_force_scan(d2):
+    imp = Imperfections(rigid_runout=0.01, rigid_runout_phase=0.3, cam_fixed=0.004, cam_fixed_phase=1.0)
+    tab = K.contact_table(d2, imp, 2, sections=[None])
+    best, best_pp, grid, pp = K.optimize_install_angle(tab, imp, n_grid=18)
+    # brute force: the whole KE recomputed with the angle set, on a 10 deg grid (finer than the 20 deg scan)
+    brute = np.radians(np.arange(0.0, 360.0, 10.0))
+    vals = np.array([K.kinematic_error(d2, imp.replace(rigid_install=g), table=tab).ke_pp for g in brute])
+    # the optimiser refines to 0.2 deg, so it can only be at least as good as the 10 deg grid
+    assert best_pp <= vals.min() + 1e-12
+    # and no angle of a 0.5 deg brute-force grid within +-5 deg of it does better than the last
+    # refinement's spacing (0.2 deg) times the curve's steepest slope (from the scan) allows
+    slope = np.abs(np.diff(np.append(pp, pp[0]))).max() / np.radians(20.0)
+    near = best + np.radians(np.arange(-5.0, 5.01, 0.5))
+    vn = np.array([K.kinematic_error(d2, imp.replace(rigid_install=g), table=tab).ke_pp for g in near])
+    assert vn.min() >= best_pp - slope * np.radians(0.2)
+    # its value is the KE recomputed directly at that angle (the cos/sin split of the lever is exact)
+    assert abs(K.kinematic_error(d2, imp.replace(rigid_install=best), table=tab).ke_pp - best_pp) < 1e-12
+
+
+def test_shortcuts_that_hold():
+    assert shortcuts(Imperfections()) == {**shortcuts(Imperfections()), "mesh_period": True, "identical_waves": True, "mirror_symmetry": True}
+    s = shortcuts(Imperfections(cam_cam=0.01))
+    assert s["mesh_period"] and not s["identical_waves"] and s["mirror_symmetry"]
+    s = shortcuts(Imperfections(cam_cam=0.01, cam_cam_phase=0.5))
+    assert s["mesh_period"] and not s["mirror_symmetry"]
+    assert not shortcuts(Imperfections(rigid_runout=0.01))["mesh_period"]
+
+
+def test_poses_of_an_imperfect_drive(d2):
+    # run-out alone turns each tooth about the axis by (F / 2r) sin(a + xi) (rigid) / along the rim (flex)
+    imp = Imperfections(rigid_runout=0.02, rigid_runout_phase=0.3)
+    r0, s0 = rigid_poses(d2, Imperfections())
+    r1, s1 = rigid_poses(d2, imp)
+    a = (np.arange(202) + 0.5) * 2 * math.pi / 202
+    np.testing.assert_allclose(r1 - r0, 0.01 / d2.rigid.r * np.sin(a + 0.3), atol=1e-15)
+    # a stationary cam offset translates every flexspline tooth by it (no coning at the centre section)
+    f0 = flex_poses(d2, Imperfections(), 0.3)
+    f1 = flex_poses(d2, Imperfections(cam_fixed=0.03, cam_fixed_phase=0.0), 0.3)
+    np.testing.assert_allclose(f1[1] - f0[1], np.tile([0.03, 0.0], (200, 1)), atol=1e-13)
+
+
+@pytest.mark.parametrize("key,value,msg", [
+    ("rigid_runout_um", "-5.0", "imperfections.rigid_runout_um: must be >= 0"),
+    ("flex_runout_phase_deg", "400.0", "imperfections.flex_runout_phase_deg: must be in [-360, 360]"),
+    ("cam_offset_cam_um", "900.0", "imperfections.cam_offset_cam_um: must be at most a quarter module"),
+    ("runout_um", "5.0", "imperfections.runout_um: unknown key"),
+])
+def test_bad_imperfections_exit_2(tmp_path, capsys, key, value, msg):
+    text = edit_toml((TEMPLATES / "d2_imperfect.toml").read_text(), "imperfections", key, value)
+    (tmp_path / "bad.toml").write_text(text)
+    code = main(["ke", str(tmp_path / "bad.toml"), "--json", str(tmp_path / "o.json")])
+    err = capsys.readouterr().err
+    assert code == 2
+    assert msg in err and err.count("\n") == 1 and "Traceback" not in err
+    assert not (tmp_path / "o.json").exists()
+
+
+def test_bad_flag_exits_2(capsys):
+    with pytest.raises(SystemExit) as e:
+        main(["ke", str(TEMPLATES / "d2_imperfect.toml"), "--per-mesh", "0"])
+    assert e.value.code == 2
+
+
+def test_fixed_flexspline_is_refused(tmp_path, capsys):
+    text = edit_toml((TEMPLATES / "d2_imperfect.toml").read_text(), "drive", "fixed", '"flexspline"')
+    (tmp_path / "f.toml").write_text(text)
+    assert main(["ke", str(tmp_path / "f.toml")]) == 2
+    assert "drive.fixed" in capsys.readouterr().err
+
+
+def _zone0(tab):
+    """The table restricted to the zone around the major axis (+x)."""
+    M = tab.z_g * tab.N
+    for side, S in tab.sides.items():
+        keep = np.abs(((S["m"] + M // 2) % M - M // 2) / M * 2 * math.pi) < 0.5 * math.pi
+        tab.sides[side] = {k: v[keep] for k, v in S.items()}
+    return tab
+
+
+def test_contact_ke_agrees_with_the_double_flank_formula_to_first_order(d2):
+    # docs/models.md 6.1: in double-flank engagement a geometric eccentricity e of the flexspline
+    # moves the mesh tangentially by dT = (cos a / cos a_w) e sin t (a = a_w here: the same teeth)
+    # and its radial part cancels between the flanks. The contact model's double-flank position
+    # (the centre between the working and the other flank's contact, one zone) must turn the
+    # flexspline back by dT over the contact radius, to first order in e.
+    from wgcad.accuracy import flank_errors, gear_angles
+    from wgcad.accuracy.flank_errors import Eccentricities
+
+    psi = 0.3
+    n = 4 * 202 * 5 // 4  # 1.25 generator turns: the flexspline's terms go once round
+    theta = {}
+    for e in (0.0, 1e-3, 2e-3):
+        imp = Imperfections(flex_ecc=e, flex_ecc_phase=psi)
+        tab = _zone0(K.contact_table(d2, imp, 4, sections=[None]))
+        res = K.kinematic_error(d2, imp, table=tab, samples=n)
+        theta[e] = tab.side_w * 0.5 * (res.delta_w - res.delta_n)
+        phi_h, side_w = res.phi_h, tab.side_w
+        R = float(np.hypot(*tab.sides[side_w]["q"].T).mean())  # contact radius
+    d1, d2_ = theta[1e-3] - theta[0.0], theta[2e-3] - theta[0.0]
+    # first order: doubling e doubles the change (the second-order residual is ~e^2 / r)
+    assert np.abs(d2_ - 2 * d1).max() < 0.02 * np.abs(d1).max()
+    ty, tb = gear_angles(phi_h, 200, 202, flex_start=psi)
+    a = math.radians(20.0)
+    dT = flank_errors(ty, tb, Eccentricities(flex_geometric=1e-3), a, a, "double").dT
+    # the flexspline turns back by dT / R; 3 % covers the contacts' spread about the zone's axis
+    # (teeth within +-10 deg: the tangential direction there differs by cos 10 deg = 0.985)
+    np.testing.assert_allclose(d1, -dT / R, atol=0.03 * np.abs(dT).max() / R)

@@ -1,0 +1,485 @@
+"""Kinematic error and lost motion of a real drive from tooth contact, no load (docs/models.md 6.2, 7).
+
+At each generator angle the flexspline (rigid gear fixed) is turned as a
+rigid body until a tooth touches its rigid neighbour: ``delta_w`` towards the
+working flanks, ``delta_n`` towards the others; their sum is the lost motion.
+Where it is positive (backlash) the output under a light load sits on the
+working flanks, ``theta = s_w delta_w``; where it is negative the teeth
+interfere (a preloaded mesh) and the rigid-body position splits the
+interference between the flanks, ``theta = s_w (delta_w - delta_n) / 2``
+(double-flank engagement, docs/models.md 6.1). Both read
+``theta = s_w (delta_w - min(LM, 0) / 2)``. The KE is
+``F(phi_h) = phi_h / u_hg - (phi_out - phi_out0) = -(theta - theta_0)``
+over one flexspline revolution.
+
+What is exploited (tested against the direct computation in tests/test_ke.py):
+
+* **lattice**: with generator angles on a grid of ``N`` per mesh period, the
+  teeth's angles from the major axis fall on a fixed lattice of ``N z_g``
+  angles (docs/models.md 7), so the contacts of the perfect drive (with the
+  cam-borne offset, constant in the generator frame) are computed once, at
+  exactly those angles: no interpolation;
+* **linear errors**: run-out, eccentricities and the flexspline-borne and
+  stationary cam offsets move the teeth by tens of micrometres; their effect
+  on a contact's closing rotation is ``(u_b - u_f) . nt`` with ``nt`` stored
+  per contact (:mod:`wgcad.accuracy.contact`);
+* **pruning**: a contact whose perfect closing rotation exceeds the best of
+  its lattice class by more than both error bounds can never be the first;
+* **installation angles**: the closing rotations depend on an installation
+  angle ``gamma`` as ``base + X cos(gamma) + Y sin(gamma)``; ``X`` and ``Y``
+  are computed once and every angle costs a few array operations.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from math import pi
+
+import numpy as np
+
+from ..clearance.distance import Template
+from ..errors import DesignError
+from ..kinematics import gear_ratios
+from ..placement import tooth_pose, transform
+from .contact import closing_rotation
+from .imperfect import (Imperfections, cam_offset, coning_factor, flex_deviations, flex_poses,
+                        rigid_deviations, rigid_poses, rigid_translation)
+
+__all__ = ["ContactTable", "contact_table", "KEResult", "kinematic_error", "install_angle_scan",
+           "optimize_install_angle", "closing_direct", "spectrum", "expected_orders", "DEFAULT_N"]
+
+#: generator angles per mesh period (2 pi / z_b); benchmarks/ke.py measures the error of
+#: 16 against 160: it is what keeps the full D2 revolution (323 200 angles) within seconds
+DEFAULT_N = 16
+_CHUNK = 8192
+#: contacts whose closing-rotation sensitivity |nt| exceeds this over the pitch radius are dropped:
+#: the contact normal is within 14 deg of radial (a tip grazing a root), a rotation hardly closes
+#: the gap, and a few micrometres of radial error change it by arcminutes (the linear model fails)
+NT_MAX = 2.0
+
+
+def _fold(x):
+    return (x + pi) % (2 * pi) - pi
+
+
+@dataclass
+class ContactTable:
+    """Contacts of the perfect drive (plus the cam-borne offset) on the tooth-angle lattice, per side.
+
+    ``sides[s]`` (s = +1: counter-clockwise, towards the rigid tooth above)
+    holds arrays over the contacts found: lattice index ``m``, ``g``
+    (closing rotation, rad), ``nt`` (E, 2), ``a_phi``, ``a_rho``, ``a_beta``
+    (sensitivities to a tooth's along-rim shift, radial offset, and a rigid
+    tooth's rotation), ``j`` (rigid tooth, table frame), ``c`` (coning factor).
+    """
+
+    z_g: int
+    z_b: int
+    N: int
+    sections: list
+    side_w: int
+    sigma: int
+    r_g: float
+    r_b: float
+    cam_cam: tuple
+    sides: dict = field(default_factory=dict)
+
+
+def _check(drive):
+    d = drive.design.drive
+    if d.fixed != "rigid":
+        raise DesignError("drive.fixed", f"wgcad ke models a fixed rigid gear, flexspline output (docs/models.md 6.2); got '{d.fixed}'")
+
+
+def contact_table(drive, imp: Imperfections, n_per_mesh: int = DEFAULT_N, sections=None, reach_pitches: float = 0.5) -> ContactTable:
+    """Tabulate every tooth's contact on both sides at the ``N z_g`` lattice angles (module docstring).
+
+    Parameters
+    ----------
+    drive : wgcad.drive.Drive
+    imp : Imperfections
+        Only the cam-borne offset enters the table (exactly); the rest is linear.
+    n_per_mesh : int
+        Generator angles per mesh period, N.
+    sections : list of float or None
+        Axial sections (mm from the open end); default the three of the audit
+        (ends and middle) with coning, one without.
+    reach_pitches : float
+        Contacts that need a rotation beyond this many flexspline pitches are dropped.
+    """
+    _check(drive)
+    if not isinstance(n_per_mesh, int) or n_per_mesh < 1:
+        raise DesignError("n_per_mesh", f"must be a positive whole number, got {n_per_mesh!r}")
+    d = drive.design.drive
+    z_g, z_b = d.z_flex, d.z_rigid
+    if sections is None:
+        sections = [float(z) for z in drive.sections(3)] if drive.coned else [None]
+    u = gear_ratios(z_g, z_b)["u_hg"]
+    sigma = 1 if d.rotation == "ccw" else -1
+    side_w = 1 if sigma / u < 0 else -1  # the flank facing against the relative motion carries the load
+    flex, rigid = Template(drive.flex.tooth_polygon()), Template(drive.rigid.tooth_polygon())
+    gamma_b = 2 * pi / z_b
+    M = z_g * n_per_mesh
+    m_all = np.arange(M)
+    phi = _fold(2 * pi * m_all / M)
+    fa = -phi * z_g / z_b  # generator angle that puts a tooth at phi with its material angle at phi (z_b - z_g)/z_b
+    # radial reach of the linear errors (the cam-borne offset is in the table exactly), plus 2 um
+    margin = 2e-3 + imp.flex_ecc + imp.rigid_ecc + imp.cam_flex + imp.cam_fixed
+    tab = ContactTable(z_g, z_b, n_per_mesh, list(sections), side_w, sigma, drive.flex.r, drive.rigid.r,
+                       (imp.cam_cam, imp.cam_cam_phase))
+    parts = {s: [] for s in (1, -1)}
+    h = 1e-6
+    for si, z in enumerate(sections):
+        law = drive.law if z is None else drive.law_at(z)
+        cz = coning_factor(drive, z)
+        off = cz * cam_offset(imp, fa, 0.0, parts=("cam",))
+        rot, shift = tooth_pose(law, phi, drive.r_m, frame_angle=fa)
+        shift = shift + off
+        # radially engaged (plus the errors' reach): the others cannot touch by turning
+        c, s = np.cos(rot), np.sin(rot)
+        xs = flex.local[:, 0][None, :] * c[:, None] - flex.local[:, 1][None, :] * s[:, None] + shift[:, :1]
+        ys = flex.local[:, 0][None, :] * s[:, None] + flex.local[:, 1][None, :] * c[:, None] + shift[:, 1:]
+        R = np.hypot(xs, ys)
+        # radially engaged, or within the errors' radial reach of it. A tooth that barely reaches past
+        # the rigid tip circle touches with a tip corner, and there a few micrometres of radial error
+        # decide whether it touches at all: the linear model holds only for errors well below that
+        # overlap (tests/test_ke.py, benchmarks/ke.py measure it against the direct computation)
+        over = (drive.rigid.r_a - R.min(axis=1)) if drive.external else (R.max(axis=1) - drive.rigid.r_a)
+        eng = over >= -margin
+        idx = np.nonzero(eng)[0]
+        a = np.arctan2(shift[idx, 1] + drive.r_m * s[idx], shift[idx, 0] + drive.r_m * c[idx])
+        lo = np.floor(a / gamma_b - 0.5).astype(int)
+        # derivative of the pose along the rim (tooth angle phi, frame fixed): for the along-rim shifts
+        rp, sp = tooth_pose(law, phi[idx] + h, drive.r_m, frame_angle=fa[idx])
+        rm_, sm = tooth_pose(law, phi[idx] - h, drive.r_m, frame_angle=fa[idx])
+        drot, dshift = (rp - rm_) / (2 * h), (sp - sm) / (2 * h)
+        for side in (1, -1):
+            j = (lo + (1 if side > 0 else 0)) % z_b
+            rb = (j + 0.5) * gamma_b
+            con = closing_rotation(flex, rot[idx], shift[idx], rigid, rb, np.zeros((len(idx), 2)), side,
+                                   reach_pitches * 2 * pi / z_g)
+            good = con.ok & (np.hypot(con.nt[:, 0], con.nt[:, 1]) * drive.rigid.r <= NT_MAX)
+            k = np.nonzero(good)[0]
+            t = side * con.delta[k]
+            ct, st = np.cos(t), np.sin(t)
+            sh = np.stack([ct * shift[idx[k], 0] - st * shift[idx[k], 1], st * shift[idx[k], 0] + ct * shift[idx[k], 1]], -1)
+            ds = np.stack([ct * dshift[k, 0] - st * dshift[k, 1], st * dshift[k, 0] + ct * dshift[k, 1]], -1)
+            p, q, nt = con.p[k], con.q[k], con.nt[k]
+            dP = drot[k, None] * np.stack([-(p[:, 1] - sh[:, 1]), p[:, 0] - sh[:, 0]], -1) + ds
+            rr = rot[idx[k]] + t
+            parts[side].append({
+                "m": m_all[idx[k]], "g": con.delta[k], "nt": nt,
+                "a_phi": np.einsum("ij,ij->i", dP, nt),
+                "a_rho": np.cos(rr) * nt[:, 0] + np.sin(rr) * nt[:, 1],
+                "a_beta": -q[:, 1] * nt[:, 0] + q[:, 0] * nt[:, 1],
+                "j": j[k], "c": np.full(len(k), cz),
+                "dP": dP, "rr": rr, "q": q, "rot": rot[idx[k]], "shift": shift[idx[k]],
+            })
+    for side in (1, -1):
+        tab.sides[side] = {key: np.concatenate([p[key] for p in parts[side]]) for key in parts[side][0]}
+        _refine(tab, side, imp, flex, rigid, reach_pitches * 2 * pi / z_g)
+    return tab
+
+
+#: translation (mm) of the rigid tooth for the finite-difference sensitivities: 0.1 um, where the
+#: closing rotation (converged to a 1e-8 mm gap) is known to 1e-4 of the difference
+_FD_H = 1e-4
+
+
+def _refine(tab: ContactTable, side: int, imp: Imperfections, flex, rigid, reach: float) -> None:
+    """Sensitivities of the contacts that can be first to touch, by central differences.
+
+    The nearest-point normal is exact on a flank, but where a tooth's corner
+    meets the other outline's vertex (tip corners, interfering teeth) it is
+    not the direction the contact slides in; translating the rigid tooth by
+    +-0.1 um in x and y and solving again gives the true ``nt``.
+    """
+    S = tab.sides[side]
+    lanes = _lanes(tab, side, imp, slack=2.0)
+    e = np.unique(lanes[lanes >= 0])
+    if e.size == 0:
+        return
+    rb = (S["j"][e] + 0.5) * 2 * pi / tab.z_b
+    nt = np.empty((e.size, 2))
+    for ax in (0, 1):
+        dv = np.zeros((e.size, 2))
+        dv[:, ax] = _FD_H
+        cp = closing_rotation(flex, S["rot"][e], S["shift"][e], rigid, rb, dv, side, reach)
+        cm = closing_rotation(flex, S["rot"][e], S["shift"][e], rigid, rb, -dv, side, reach)
+        nt[:, ax] = (cp.delta - cm.delta) / (2 * _FD_H)
+    # a difference across a switch of the touching feature is no derivative: keep the nearest-point
+    # normal's value there (within 50 % of it is a slide along one feature; the corner cases differ by ~10 %)
+    good = np.all(np.isfinite(nt), axis=1) & (np.hypot(*(nt - S["nt"][e]).T) <= 0.5 * np.hypot(*S["nt"][e].T))
+    e, nt = e[good], nt[good]
+    S["nt"][e] = nt
+    S["a_phi"][e] = np.einsum("ij,ij->i", S["dP"][e], nt)
+    S["a_rho"][e] = np.cos(S["rr"][e]) * nt[:, 0] + np.sin(S["rr"][e]) * nt[:, 1]
+    S["a_beta"][e] = -S["q"][e, 1] * nt[:, 0] + S["q"][e, 0] * nt[:, 1]
+
+
+def _geometry(tab: ContactTable, side: int, i: np.ndarray, e: np.ndarray) -> dict:
+    """Per (sample, contact): flexspline tooth ``k``, rigid shift ``sb`` and ``R(rho) nt`` in the actual frame."""
+    S = tab.sides[side]
+    N, z_g, z_b = tab.N, tab.z_g, tab.z_b
+    m = S["m"][e]
+    M = z_g * N
+    k = ((m + tab.sigma * i) % M) // N  # the flexspline tooth (material index)
+    # the table frame turned to the actual one by whole rigid pitches: (m' + sigma i) / N, with m'
+    # the lattice index of the folded tooth angle (docs/models.md 7: phi z_g / z_b + phi_h)
+    sb = (((m + M // 2) % M - M // 2) + tab.sigma * i) // N
+    rho = (2 * pi / z_b) * sb
+    cr, sr = np.cos(rho), np.sin(rho)
+    ntx, nty = S["nt"][e, 0], S["nt"][e, 1]
+    return {"k": k, "sb": sb, "nx": cr * ntx - sr * nty, "ny": sr * ntx + cr * nty}
+
+
+def _terms(tab: ContactTable, side: int, imp: Imperfections, i: np.ndarray, e: np.ndarray, which: str, geo=None) -> np.ndarray:
+    """One group of linear error terms of the closing rotation, for samples ``i`` (I, 1) and contacts ``e`` (I, C)."""
+    S = tab.sides[side]
+    z_g, z_b = tab.z_g, tab.z_b
+    geo = _geometry(tab, side, i, e) if geo is None else geo
+    nx, ny = geo["nx"], geo["ny"]
+    if which == "rigid":
+        T = rigid_translation(imp)
+        j = (S["j"][e] + geo["sb"]) % z_b
+        return T[0] * nx + T[1] * ny + rigid_deviations(imp, j, z_b, tab.r_b) * S["a_beta"][e]
+    if which == "flex":
+        da, dr = flex_deviations(imp, geo["k"], z_g, tab.r_g)
+        return -da * S["a_phi"][e] - dr * S["a_rho"][e]
+    phi_h = tab.sigma * i * (2 * pi / (z_b * tab.N))
+    E = cam_offset(imp, phi_h, phi_h / gear_ratios(z_g, z_b)["u_hg"], parts=("flex", "fixed"))
+    return -S["c"][e] * (E[..., 0] * nx + E[..., 1] * ny)
+
+
+def _lanes(tab: ContactTable, side: int, imp: Imperfections, slack: float = 1.05) -> np.ndarray:
+    """Candidate contacts per lattice class (N, C), padded with -1: those that can be the first to touch.
+
+    Within a group (one zone, one section) the errors move neighbouring teeth
+    almost alike: ``|Delta_e - Delta_e*| <= D_e`` (bounded term by term from
+    the amplitudes and the differences of the contacts' sensitivities and of
+    the teeth's positions), so a contact whose perfect closing rotation
+    exceeds the group's smallest, ``g_e*``, by more than ``D_e`` is never first.
+    Across groups the whole error bound ``B`` prunes.
+    """
+    S = tab.sides[side]
+    z_g, z_b, N = tab.z_g, tab.z_b, tab.N
+    ntn = np.hypot(S["nt"][:, 0], S["nt"][:, 1])
+    A_b = 0.5 * imp.rigid_runout / tab.r_b
+    A_a = (0.5 * imp.flex_runout + imp.flex_ecc) / tab.r_g
+    Vmax = imp.rigid_ecc + S["c"] * (imp.cam_flex + imp.cam_fixed)
+    B = Vmax * ntn + A_b * np.abs(S["a_beta"]) + A_a * np.abs(S["a_phi"]) + imp.flex_ecc * np.abs(S["a_rho"])
+    B = B * slack + 1e-12  # 5 % for the linearisation's second order (2x before the sensitivities are refined)
+    M = z_g * N
+    phi = _fold(2 * pi * S["m"] / M)
+    zone = np.where(np.abs(phi) <= 0.5 * pi, 0, 1)  # 0: the zone around +x, 1: around -x (two waves)
+    cls = (-tab.sigma * np.arange(N)) % N  # lattice class of sample residue r
+    out = []
+    for r in range(N):
+        e = np.nonzero(S["m"] % N == cls[r])[0]
+        if e.size == 0:
+            out.append(e)
+            continue
+        keep = S["g"][e] - B[e] <= np.min(S["g"][e] + B[e])
+        for key in np.unique(np.stack([zone[e], np.round(S["c"][e] * 1e6).astype(int)], 1), axis=0):
+            grp = e[(zone[e] == key[0]) & (np.round(S["c"][e] * 1e6).astype(int) == key[1])]
+            es = grp[np.argmin(S["g"][grp])]
+            mf = (S["m"] + M // 2) % M - M // 2  # folded lattice index
+            dk = np.abs(mf[grp] - mf[es]) // N  # teeth apart (same class: a whole number)
+            dj = np.abs(((S["j"][grp] - S["j"][es] + (mf[grp] - mf[es]) // N) + z_b // 2) % z_b - z_b // 2)
+            dnt = np.hypot(*(S["nt"][grp] - S["nt"][es]).T)
+            D = (Vmax[grp] * (dnt + ntn[es] * 2 * pi * dk / z_b)
+                 + A_b * (np.abs(S["a_beta"][grp] - S["a_beta"][es]) + np.abs(S["a_beta"][es]) * 2 * pi * dj / z_b)
+                 + A_a * (np.abs(S["a_phi"][grp] - S["a_phi"][es]) + np.abs(S["a_phi"][es]) * 2 * pi * dk / z_g)
+                 + imp.flex_ecc * (np.abs(S["a_rho"][grp] - S["a_rho"][es]) + np.abs(S["a_rho"][es]) * 2 * pi * dk / z_g))
+            far = S["g"][grp] - S["g"][es] > slack * D + 1e-12
+            keep[np.isin(e, grp[far])] = False
+        out.append(e[keep])
+    C = max(len(x) for x in out)
+    lanes = np.full((N, max(C, 1)), -1, dtype=int)
+    for r, x in enumerate(out):
+        lanes[r, : len(x)] = x
+    return lanes
+
+
+def _side_arrays(tab, side, imp, lanes, i, lever):
+    """``base`` and, with a lever, ``X``, ``Y`` (I, C) of one side for samples ``i``."""
+    e = lanes[i % tab.N]
+    pad = e < 0
+    e = np.where(pad, 0, e)
+    ii = i[:, None]
+    geo = _geometry(tab, side, ii, e)
+    base = tab.sides[side]["g"][e].copy()
+    used = {"cam": imp.cam_flex or imp.cam_fixed, "rigid": imp.rigid_runout or imp.rigid_ecc,
+            "flex": imp.flex_runout or imp.flex_ecc}
+    for grp in ("cam", "rigid", "flex"):
+        if grp != lever and used[grp]:  # a group without errors adds nothing
+            base += _terms(tab, side, imp, ii, e, grp, geo)
+    base[pad] = np.inf
+    if lever is None:
+        return base, None, None
+    key = "rigid_install" if lever == "rigid" else "flex_install"
+    X = _terms(tab, side, imp.replace(**{key: 0.0}), ii, e, lever, geo)
+    Y = _terms(tab, side, imp.replace(**{key: 0.5 * pi}), ii, e, lever, geo)
+    X[pad] = 0.0
+    Y[pad] = 0.0
+    return base, X, Y
+
+
+def _theta(tab, dw, dn):
+    lm = dw + dn
+    return tab.side_w * (dw - 0.5 * np.minimum(lm, 0.0)), lm
+
+
+@dataclass
+class KEResult:
+    """No-load KE over a flexspline revolution (radians; arrays over the generator angles)."""
+
+    phi_h: np.ndarray
+    delta_w: np.ndarray
+    delta_n: np.ndarray
+    lost_motion: np.ndarray
+    ke: np.ndarray
+    n_per_mesh: int
+    turns: float
+    engagement: str
+    u: float
+
+    @property
+    def flex_turns_per_record(self) -> float:
+        """Flexspline revolutions the record covers (1 for a full record)."""
+        return self.turns / self.u
+
+    @property
+    def ke_pp(self) -> float:
+        """Largest KE: max minus min of F over the record, rad."""
+        return float(self.ke.max() - self.ke.min())
+
+
+def _record(tab: ContactTable) -> int:
+    u = abs(gear_ratios(tab.z_g, tab.z_b)["u_hg"])
+    return int(np.ceil(tab.N * tab.z_b * u - 1e-9))
+
+
+def kinematic_error(drive, imp: Imperfections, n_per_mesh: int = DEFAULT_N, sections=None, table=None,
+                    samples: int | None = None) -> KEResult:
+    """No-load KE of an imperfect drive over one flexspline revolution (``|u_hg|`` generator turns).
+
+    Parameters
+    ----------
+    table : ContactTable, optional
+        Reused if given (it must have been built with the same cam-borne offset).
+    samples : int, optional
+        Only the first ``samples`` generator angles (tests); default the revolution.
+    """
+    tab = table if table is not None else contact_table(drive, imp, n_per_mesh, sections)
+    if tab.cam_cam != (imp.cam_cam, imp.cam_cam_phase):
+        raise DesignError("imperfections.cam_offset_cam_um", "the contact table was built for another cam-borne offset")
+    I = _record(tab) if samples is None else int(samples)
+    lw, ln = _lanes(tab, tab.side_w, imp), _lanes(tab, -tab.side_w, imp)
+    dw, dn = np.empty(I), np.empty(I)
+    for a in range(0, I, _CHUNK):
+        i = np.arange(a, min(I, a + _CHUNK))
+        dw[a : a + len(i)] = _side_arrays(tab, tab.side_w, imp, lw, i, None)[0].min(axis=1)
+        dn[a : a + len(i)] = _side_arrays(tab, -tab.side_w, imp, ln, i, None)[0].min(axis=1)
+    theta, lm = _theta(tab, dw, dn)
+    phi_h = tab.sigma * np.arange(I) * 2 * pi / (tab.z_b * tab.N)
+    eng = "single-flank (backlash)" if lm.min() >= 0 else "double-flank (interference)" if lm.max() < 0 else "mixed"
+    return KEResult(phi_h, dw, dn, lm, -(theta - theta[0]), tab.N, I / (tab.N * tab.z_b), eng,
+                    abs(gear_ratios(tab.z_g, tab.z_b)["u_hg"]))
+
+
+def install_angle_scan(tab: ContactTable, imp: Imperfections, angles, lever: str = "rigid") -> np.ndarray:
+    """Largest KE (rad) for each installation angle (rad) of the rigid gear (``lever="rigid"``) or the flexspline."""
+    if lever not in ("rigid", "flex"):
+        raise DesignError("lever", f"must be rigid or flex, got {lever!r}")
+    ang = np.atleast_1d(np.asarray(angles, dtype=float))
+    ca, sa = np.cos(ang), np.sin(ang)
+    I = _record(tab)
+    lw, ln = _lanes(tab, tab.side_w, imp), _lanes(tab, -tab.side_w, imp)  # the bounds hold for every angle
+    hi = np.full(len(ang), -np.inf)
+    lo = np.full(len(ang), np.inf)
+    for a in range(0, I, _CHUNK):
+        i = np.arange(a, min(I, a + _CHUNK))
+        bw, Xw, Yw = _side_arrays(tab, tab.side_w, imp, lw, i, lever)
+        bn, Xn, Yn = _side_arrays(tab, -tab.side_w, imp, ln, i, lever)
+        for g in range(len(ang)):
+            dw = (bw + ca[g] * Xw + sa[g] * Yw).min(axis=1)
+            dn = (bn + ca[g] * Xn + sa[g] * Yn).min(axis=1)
+            th, _ = _theta(tab, dw, dn)
+            hi[g] = max(hi[g], th.max())
+            lo[g] = min(lo[g], th.min())
+    return hi - lo
+
+
+def optimize_install_angle(tab: ContactTable, imp: Imperfections, lever: str = "rigid", n_grid: int = 36):
+    """Installation angle (rad) that minimises the largest KE: a grid of ``n_grid`` angles, then finer grids (1/10, 1/100 of its step) around the three best local minima.
+
+    Returns
+    -------
+    best_angle : float
+        rad, in [0, 2 pi).
+    best_pp : float
+        Largest KE there, rad.
+    grid, grid_pp : (n_grid,) float
+        The coarse scan (the curve of the largest KE against the angle).
+    """
+    grid = 2 * pi * np.arange(n_grid) / n_grid
+    pp = install_angle_scan(tab, imp, grid, lever)
+    # the curve can have several basins of similar depth: refine around the three best local minima
+    loc = [i for i in range(n_grid) if pp[i] <= pp[i - 1] and pp[i] <= pp[(i + 1) % n_grid]]
+    starts = sorted(loc, key=lambda i: pp[i])[:3] or [int(np.argmin(pp))]
+    step0 = 2 * pi / n_grid
+    fine = np.concatenate([grid[i] + np.linspace(-step0, step0, 21) for i in starts])
+    v = install_angle_scan(tab, imp, fine, lever)
+    best_a, best_v = float(fine[int(np.argmin(v))]), float(v.min())
+    fine = best_a + np.linspace(-step0 / 10, step0 / 10, 21)
+    v = install_angle_scan(tab, imp, fine, lever)
+    if v.min() < best_v:
+        best_a, best_v = float(fine[int(np.argmin(v))]), float(v.min())
+    return best_a % (2 * pi), best_v, grid, pp
+
+
+def closing_direct(drive, imp: Imperfections, phi_h: float, side: int, sections=None) -> float:
+    """Reference: the closing rotation at ``phi_h`` from the exact poses of every tooth (no table, no linearisation), rad."""
+    _check(drive)
+    d = drive.design.drive
+    z_b = d.z_rigid
+    if sections is None:
+        sections = [float(z) for z in drive.sections(3)] if drive.coned else [None]
+    flex, rigid = Template(drive.flex.tooth_polygon()), Template(drive.rigid.tooth_polygon())
+    rr, rs = rigid_poses(drive, imp)
+    best = np.inf
+    gamma_b = 2 * pi / z_b
+    for z in sections:
+        rot, shift = flex_poses(drive, imp, phi_h, z=z)
+        a = np.arctan2(shift[:, 1] + drive.r_m * np.sin(rot), shift[:, 0] + drive.r_m * np.cos(rot))
+        pts_r = np.hypot(*transform(flex.local, rot, shift).transpose(2, 0, 1))
+        # radially engaged: the tooth reaches past the rigid tip circle (docs/models.md 7, culling)
+        near = (pts_r.min(axis=1) <= drive.rigid.r_a) if drive.external else (pts_r.max(axis=1) >= drive.rigid.r_a)
+        idx = np.nonzero(near)[0]
+        lo = np.floor(a[idx] / gamma_b - 0.5).astype(int)
+        j = (lo + (1 if side > 0 else 0)) % z_b
+        con = closing_rotation(flex, rot[idx], shift[idx], rigid, rr[j], rs[j], side, 0.5 * 2 * pi / d.z_flex)
+        if con.ok.any():
+            best = min(best, float(con.delta[con.ok].min()))
+    return best
+
+
+def spectrum(res: KEResult):
+    """Amplitude spectrum of the KE over the record: orders (cycles per record) and amplitudes (rad)."""
+    f = res.ke - res.ke.mean()
+    amp = 2.0 * np.abs(np.fft.rfft(f)) / len(f)
+    return np.arange(len(amp)) * (res.flex_turns_per_record ** -1), amp
+
+
+def expected_orders(z_g: int, z_b: int) -> dict:
+    """Orders (cycles per flexspline revolution) where the errors should show (docs/models.md 6.1, 7).
+
+    Rigid gear and stationary cam offset: once per generator turn, ``|u_hg|``;
+    flexspline and flexspline-borne offset: ``|u_hb|``; the no-load contact
+    takes the first zone to touch, which rectifies them (twice those); the
+    mesh: ``z_b |u_hg|``.
+    """
+    r = gear_ratios(z_g, z_b)
+    uh, ub = abs(r["u_hg"]), abs(r["u_hb"])
+    return {"rigid": uh, "flex": ub, "rigid x2": 2 * uh, "flex x2": 2 * ub, "mesh": z_b * uh}

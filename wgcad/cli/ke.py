@@ -1,0 +1,126 @@
+"""``wgcad ke``: no-load kinematic error and lost motion of an imperfect drive, the installation-angle lever (docs/models.md 6.2)."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+from .common import EPILOG, EXIT_OK
+
+__all__ = ["register", "cmd_ke"]
+
+_AS = 180.0 / 3.141592653589793 * 3600.0
+
+
+def cmd_ke(args) -> int:
+    import math
+
+    import numpy as np
+
+    from ..accuracy import flank_error_table
+    from ..accuracy import ke as K
+    from ..accuracy.imperfect import Imperfections, shortcuts
+    from ..design import load_design
+    from ..drive import build_drive
+    from ..export.atomic import atomic_batch, ensure_writable_dir
+
+    design = load_design(args.design)
+    drive = build_drive(design)
+    imp = Imperfections.from_spec(design.imperfections)
+    if args.plot:
+        ensure_writable_dir(Path(args.plot).parent if str(Path(args.plot).parent) else Path("."))
+    if args.json:
+        ensure_writable_dir(Path(args.json).parent if str(Path(args.json).parent) else Path("."))
+    tab = K.contact_table(drive, imp, args.per_mesh)
+    res = K.kinematic_error(drive, imp, table=tab)
+    perfect = Imperfections()
+    tab0 = tab if imp.cam_cam == 0.0 else K.contact_table(drive, perfect, args.per_mesh)
+    intr = K.kinematic_error(drive, perfect, table=tab0, samples=args.per_mesh * drive.design.drive.z_rigid)
+    orders, amp = K.spectrum(res)
+    d = design.drive
+    expected = K.expected_orders(d.z_flex, d.z_rigid)
+    top = np.argsort(amp)[::-1][:8]
+    out = {
+        "design": str(args.design),
+        "engagement": res.engagement,
+        "ke_pp_arcsec": round(res.ke_pp * _AS, 4),
+        "intrinsic_ke_pp_arcsec": round(intr.ke_pp * _AS, 4),
+        "lost_motion_arcsec": {"min": round(float(res.lost_motion.min()) * _AS, 4),
+                               "max": round(float(res.lost_motion.max()) * _AS, 4)},
+        "samples": int(len(res.ke)), "per_mesh_period": args.per_mesh, "generator_turns": round(res.turns, 6),
+        "shortcuts": shortcuts(imp),
+        "expected_orders": expected,
+        "spectrum_top": [{"order": round(float(orders[i]), 4), "amplitude_arcsec": round(float(amp[i]) * _AS, 4)} for i in top],
+    }
+    print(f"{d.name}: no-load KE over one flexspline revolution ({res.turns:g} generator turns, {len(res.ke)} angles)")
+    print(f"  engagement: {res.engagement}; lost motion {out['lost_motion_arcsec']['min']:.1f} .. {out['lost_motion_arcsec']['max']:.1f} arcsec")
+    print(f"  largest KE (peak to peak): {out['ke_pp_arcsec']:.2f} arcsec; perfect parts: {out['intrinsic_ke_pp_arcsec']:.3f} arcsec")
+    print(f"  strongest orders: " + ", ".join(f"{s['order']:g} ({s['amplitude_arcsec']:.2f}'')" for s in out["spectrum_top"][:4]))
+    if res.lost_motion.min() < 0:
+        print("  note: the teeth interfere (negative lost motion): the rigid-body position splits the interference; "
+              "errors must stay well below the overlap for the linear model (docs/models.md 6.2) - under load use the elastic model")
+    sc = out["shortcuts"]
+    print(f"  shortcuts that hold: mesh period {sc['mesh_period']}, identical waves {sc['identical_waves']}, mirror {sc['mirror_symmetry']} ({sc['why']})")
+    scan = None
+    if args.optimize_install_angle:
+        best, best_pp, grid, pp = K.optimize_install_angle(tab, imp, "rigid")
+        fpp = K.install_angle_scan(tab, imp, grid, "flex")
+        scan = (np.degrees(grid), pp, math.degrees(best), best_pp, fpp)
+        out["install_angle"] = {
+            "best_rigid_angle_deg": round(math.degrees(best), 3), "best_ke_pp_arcsec": round(best_pp * _AS, 4),
+            "angles_deg": [round(float(a), 3) for a in np.degrees(grid)],
+            "rigid_ke_pp_arcsec": [round(float(v) * _AS, 4) for v in pp],
+            "flex_ke_pp_arcsec": [round(float(v) * _AS, 4) for v in fpp],
+        }
+        print(f"  rigid gear installation angle: best {math.degrees(best):.2f} deg, largest KE {best_pp * _AS:.2f} arcsec "
+              f"(range over angles {pp.min() * _AS:.2f} .. {pp.max() * _AS:.2f}); flexspline position: {fpp.min() * _AS:.2f} .. {fpp.max() * _AS:.2f}")
+    with atomic_batch() as batch:
+        if args.json:
+            Path(batch.temp_path(Path(args.json))).write_text(json.dumps(out, indent=2))
+        if args.plot:
+            from ..export.ke_figures import flank_png, install_png, ke_png
+
+            stem = Path(args.plot)
+            Path(batch.temp_path(stem.with_name(stem.name + "_ke.png"))).write_bytes(
+                ke_png(f"{d.name}: kinematic error, no load", res, orders, amp, expected, intr))
+            if scan is not None:
+                Path(batch.temp_path(stem.with_name(stem.name + "_install.png"))).write_bytes(
+                    install_png(f"{d.name}: largest KE against installation angle", scan[0], scan[1], scan[2], scan[3], scan[0], scan[4]))
+            s = design.imperfections
+            header, rows = flank_error_table(
+                np.linspace(0.0, 720.0, 1441), z_flex=d.z_flex, z_rigid=d.z_rigid,
+                pressure_angle_deg=design.tooth.pressure_angle_deg, working_pressure_angle_deg=design.tooth.pressure_angle_deg,
+                flex_geometric_um=s.flex_eccentricity_um, rigid_geometric_um=s.rigid_eccentricity_um,
+                flex_kinematic_um=0.5 * s.flex_runout_um, rigid_kinematic_um=0.5 * s.rigid_runout_um,
+                flex_phase_deg=s.flex_runout_phase_deg - s.flex_eccentricity_phase_deg,
+                rigid_phase_deg=s.rigid_runout_phase_deg - s.rigid_eccentricity_phase_deg)
+            Path(batch.temp_path(stem.with_name(stem.name + "_flank.png"))).write_bytes(
+                flank_png(f"{d.name}: double- and single-flank errors of the gears (docs/models.md 6.1)", header, rows))
+    return EXIT_OK
+
+
+def _per_mesh(text: str) -> int:
+    import argparse
+
+    try:
+        n = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"'{text}' is not a whole number") from None
+    if not 1 <= n <= 512:
+        raise argparse.ArgumentTypeError(f"must be 1..512 generator angles per mesh period, got {n}")
+    return n
+
+
+def register(sub) -> None:
+    """Add the subcommand to the ``wgcad`` parser's subparsers."""
+    import argparse
+
+    k = sub.add_parser("ke", help="no-load kinematic error, lost motion and the installation-angle lever of an imperfect drive",
+                       epilog=EPILOG, formatter_class=argparse.RawDescriptionHelpFormatter)
+    k.add_argument("design")
+    k.add_argument("--optimize-install-angle", action="store_true",
+                   help="scan the rigid gear's installation angle (36 angles, then finer) and the flexspline's position")
+    k.add_argument("--json", help="write the figures as JSON here")
+    k.add_argument("--plot", help="PNG path stem: writes STEM_ke.png, STEM_flank.png (and STEM_install.png)")
+    k.add_argument("--per-mesh", type=_per_mesh, default=16, help="generator angles per mesh period (default 16)")
+    k.set_defaults(func=cmd_ke)

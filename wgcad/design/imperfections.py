@@ -1,0 +1,78 @@
+"""``[imperfections]``: gear run-out and eccentricity, cam mounting error, installation angles (docs/models.md 6.1, 6.2)."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, fields
+
+from ..errors import DesignError
+
+__all__ = ["ImperfectionsSpec", "validate_imperfections"]
+
+
+@dataclass(frozen=True)
+class ImperfectionsSpec:
+    """``[imperfections]``: manufacturing and mounting errors of a drive (all optional, default a perfect drive).
+
+    Amplitudes in micrometres, phases and angles in degrees. Phases of a
+    gear's errors are counted in that gear's own frame from its reference
+    tooth (flexspline tooth 0, the rigid gear's space on +x at assembly);
+    the cam phases from the cam's major axis (cam-borne), the flexspline's
+    reference (flexspline-borne) or +x of the housing (stationary).
+    """
+
+    # first-harmonic run-out (docs/models.md 6.2): tooth i deviates along the pitch circle by
+    # (F/2) sin(a_i + xi), a_i its angle in its gear; F is the kinematic-error tolerance F_g, F_b
+    flex_runout_um: float = 0.0  # F_g
+    flex_runout_phase_deg: float = 0.0  # xi_g
+    rigid_runout_um: float = 0.0  # F_b
+    rigid_runout_phase_deg: float = 0.0  # xi_b
+    # geometric eccentricity (docs/models.md 6.1): the gear's pitch circle off its axis
+    flex_eccentricity_um: float = 0.0  # e_yr: tooth ring off the flexspline's bore
+    flex_eccentricity_phase_deg: float = 0.0
+    rigid_eccentricity_um: float = 0.0  # e_br: rigid gear off the drive axis
+    rigid_eccentricity_phase_deg: float = 0.0
+    # cam mounting error, three components (docs/models.md 6.2)
+    cam_offset_cam_um: float = 0.0  # e_h^h, rotating with the cam
+    cam_offset_cam_phase_deg: float = 0.0  # f^h, from the cam's major axis
+    cam_offset_flex_um: float = 0.0  # e_h^g, rotating with the flexspline
+    cam_offset_flex_phase_deg: float = 0.0  # f^g
+    cam_offset_fixed_um: float = 0.0  # e_h^b, stationary
+    cam_offset_fixed_phase_deg: float = 0.0  # f^b
+    # assembly levers: each gear's error pattern turned by this angle (docs/models.md 6.2)
+    rigid_install_angle_deg: float = 0.0
+    flex_install_angle_deg: float = 0.0
+
+    @property
+    def amplitudes_um(self) -> dict:
+        """Every amplitude, by key (um)."""
+        return {f.name: getattr(self, f.name) for f in fields(self) if f.name.endswith("_um")}
+
+    @property
+    def any(self) -> bool:
+        """True if any error amplitude is non-zero (the installation angles alone change nothing)."""
+        return any(v != 0.0 for v in self.amplitudes_um.values())
+
+
+def validate_imperfections(spec: ImperfectionsSpec, module: float) -> ImperfectionsSpec:
+    """Check the rules of ``[imperfections]``; return it unchanged or raise :class:`DesignError`.
+
+    Amplitudes are >= 0 (the phase carries the direction) and below a
+    quarter module: the KE model perturbs the perfect contact linearly
+    (docs/models.md 6.2) and an error of that size is a different drive,
+    not a tolerance. Angles lie in [-360, 360] degrees.
+    """
+    limit_um = 250.0 * module  # a quarter module, in um
+    for f in fields(spec):
+        val = getattr(spec, f.name)
+        where = f"imperfections.{f.name}"
+        if isinstance(val, bool) or not isinstance(val, (int, float)) or not math.isfinite(val):
+            raise DesignError(where, f"must be a finite number, got {val!r}")
+        if f.name.endswith("_um"):
+            if val < 0.0:
+                raise DesignError(where, f"must be >= 0 um (the phase carries the direction), got {val:g}")
+            if val > limit_um:
+                raise DesignError(where, f"must be at most a quarter module ({limit_um:g} um), got {val:g}")
+        elif not -360.0 <= val <= 360.0:
+            raise DesignError(where, f"must be in [-360, 360] degrees, got {val:g}")
+    return spec

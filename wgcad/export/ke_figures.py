@@ -1,0 +1,105 @@
+"""PNG figures of the kinematic error: KE over a revolution with its spectrum, KE against installation angle, double- vs single-flank errors (docs/models.md 6.1, 6.2)."""
+
+from __future__ import annotations
+
+import io
+
+import numpy as np
+
+__all__ = ["ke_png", "install_png", "flank_png"]
+
+_AS = 180.0 / np.pi * 3600.0
+
+
+def _plt():
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    return plt
+
+
+def _png(fig, plt) -> bytes:
+    buf = io.BytesIO()
+    fig.tight_layout()
+    fig.savefig(buf, format="png")
+    plt.close(fig)
+    return buf.getvalue()
+
+
+def ke_png(title: str, res, orders, amp, expected: dict, intrinsic=None) -> bytes:
+    """KE over the record (arcsec against cam turns), its first mesh periods, and its spectrum with the expected orders marked."""
+    plt = _plt()
+    fig, ax = plt.subplots(3, 1, figsize=(11, 10), dpi=90)
+    turns = np.abs(res.phi_h) / (2 * np.pi)
+    ax[0].plot(turns, res.ke * _AS, lw=0.4, color="k", label=f"KE ({res.engagement}), {res.ke_pp * _AS:.2f}'' peak to peak")
+    ax[0].set_xlabel("generator turns (one flexspline revolution)")
+    ax[0].set_ylabel("KE, arcsec")
+    ax[0].legend(fontsize=8, loc="upper right")
+    ax[0].grid(alpha=0.3)
+    # the first three mesh periods: the ripple of the tooth mesh itself
+    n = min(len(res.ke), 3 * res.n_per_mesh * 4)
+    deg = np.degrees(np.abs(res.phi_h[:n]))
+    ax[1].plot(deg, res.ke[:n] * _AS, ".-", ms=3, lw=0.8, color="k", label="KE")
+    if intrinsic is not None:
+        m = min(n, len(intrinsic.ke))
+        ax[1].plot(np.degrees(np.abs(intrinsic.phi_h[:m])), intrinsic.ke[:m] * _AS, ".-", ms=3, lw=0.8,
+                   color="tab:orange", label=f"perfect parts, {intrinsic.ke_pp * _AS:.3f}'' peak to peak")
+    ax[1].set_xlabel("generator angle, deg (the first mesh periods)")
+    ax[1].set_ylabel("KE, arcsec")
+    ax[1].legend(fontsize=8, loc="upper right")
+    ax[1].grid(alpha=0.3)
+    low = {k: v for k, v in expected.items() if k != "mesh"}
+    top = max(low.values()) * 1.6
+    sel = (orders > 0) & (orders <= top)
+    ax[1 + 1].semilogy(orders[sel], np.maximum(amp[sel] * _AS, 1e-6), lw=0.8, color="k")
+    tr = ax[2].get_xaxis_transform()
+    for (name, o), c in zip(low.items(), ["tab:red", "tab:blue", "tab:red", "tab:blue"]):
+        ax[2].axvline(o, color=c, ls="--", lw=0.8, alpha=0.7)
+        ax[2].text(o, 0.97, f" {name} ({o:g})", rotation=90, va="top", fontsize=7, color=c, transform=tr)
+    label = "order, cycles per flexspline revolution"
+    if "mesh" in expected:
+        mo = expected["mesh"]
+        near = np.abs(orders - mo) <= 0.5
+        ma = float(amp[near].max() * _AS) if near.any() else float("nan")
+        label += f"  (mesh order {mo:g}, off the axis: {ma:.3g} arcsec)"
+    ax[2].set_xlabel(label)
+    ax[2].set_ylabel("amplitude, arcsec")
+    ax[2].grid(alpha=0.3, which="both")
+    fig.suptitle(title)
+    return _png(fig, plt)
+
+
+def install_png(title: str, rigid_deg, rigid_pp, best_deg, best_pp, flex_deg=None, flex_pp=None) -> bytes:
+    """Largest KE (arcsec) against the rigid gear's installation angle, and against the flexspline's angular position."""
+    plt = _plt()
+    fig, ax = plt.subplots(figsize=(9, 4.5), dpi=90)
+    ax.plot(rigid_deg, np.asarray(rigid_pp) * _AS, "o-", ms=3, label="rigid gear installation angle")
+    if flex_deg is not None:
+        ax.plot(flex_deg, np.asarray(flex_pp) * _AS, "s-", ms=3, label="flexspline angular position")
+    ax.plot([best_deg], [best_pp * _AS], "r*", ms=12, label=f"best rigid angle {best_deg:.1f} deg: {best_pp * _AS:.1f}''")
+    ax.set_xlabel("angle, deg")
+    ax.set_ylabel("largest KE, arcsec")
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=8)
+    ax.set_title(title)
+    return _png(fig, plt)
+
+
+def flank_png(title: str, header, rows) -> bytes:
+    """dR and dT (um) of both engagement types over the generator angle, from :func:`wgcad.accuracy.flank_error_table`."""
+    plt = _plt()
+    data = np.asarray(rows, dtype=float)
+    fig, ax = plt.subplots(1, 2, figsize=(12, 4.5), dpi=90)
+    x = data[:, 0] / 360.0
+    for col, name in enumerate(header[1:], start=1):
+        a = ax[0] if name.endswith("dR_um") else ax[1]
+        a.plot(x, data[:, col], lw=0.8, label=name.rsplit("_", 2)[0])
+    for a, lab in zip(ax, ("dR (radial), um", "dT (tangential), um")):
+        a.set_xlabel("generator turns")
+        a.set_ylabel(lab)
+        a.grid(alpha=0.3)
+        a.legend(fontsize=8)
+    fig.suptitle(title)
+    return _png(fig, plt)
