@@ -126,9 +126,9 @@ class GeneratorSpec:
                         hi=Rel("r_flex / 2", lambda c: 0.5 * c["r_flex"]), default=0.0, rule="only for the ellipse law",
                         why="the offset is the bearing and half the rim around the cam: a fraction of the radius")
     cone_length: float | None = key("cup length l, diaphragm to open end (coning); none = no coning", unit="mm",
-                                    lo=Rel("face_width", lambda c: c["face_width"]),
-                                    hi=Rel("10 d_flex", lambda c: 10.0 * c["d_flex"]), default=None,
-                                    default_doc="none (no coning)", rule="together with generator_z",
+                                    lo=0.0, lo_open=True, hi=Rel("10 d_flex", lambda c: 10.0 * c["d_flex"]), default=None,
+                                    default_doc="none (no coning)",
+                                    rule="together with generator_z; at least drive.face_width",
                                     why="the toothed face lies on the cup; cups are 0.5-1.3 d long")
     generator_z: float | None = key("generator centre line z_h from the open end", unit="mm", lo=0.0,
                                     hi=Rel("cone_length / 2", lambda c: 0.5 * c["cone_length"]), default=None,
