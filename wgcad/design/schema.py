@@ -106,6 +106,17 @@ class GearSpec:
     fillet_coef: float = key("root fillet radius / m (involute)", lo=0.0, hi=2.0, default=0.25,
                              rule="the fillet must fit the root space" + _P,
                              why="usual 0.25-0.38; the largest fillet that fits is searched in [0, 2]")
+    measure_diameter: float | None = key("diameter at which the report gives the tooth thickness (arc and chordal)",
+                                         unit="mm", lo=Rel("d - 30 m", lambda c: c["d"] - 30 * c["m"]),
+                                         hi=Rel("d + 30 m", lambda c: c["d"] + 30 * c["m"]), default=None,
+                                         default_doc="none (mid-depth only)",
+                                         rule="on the flanks (checked when the report is made)",
+                                         why="as tip_radius, on the diameter")
+    pin_diameter: float | None = key("pin (ball) diameter of the dimension over / between pins", unit="mm",
+                                     lo=Rel("0.1 m", lambda c: 0.1 * c["m"]), hi=Rel("5 m", lambda c: 5.0 * c["m"]),
+                                     default=None, default_doc="chosen: contact nearest mid-flank, pin standing out",
+                                     rule="touches both flanks (checked when the report is made)",
+                                     why="measuring pins are about 1.5-1.9 m; a pin outside [0.1 m, 5 m] cannot touch both flanks")
 
 
 @dataclass(frozen=True)
