@@ -125,28 +125,22 @@ def span_k_rule(gear: Gear) -> int:
     return int(max(1, min(sp.z - 1, round(float(sp.z * K + 0.5)))))
 
 
-def _group(gear: Gear, k: int) -> np.ndarray:
-    """Teeth 0..k-1 of the tooth-frame pitch, turned so their axis of symmetry is +x, ``(k p, 2)``."""
-    per = gear.period
-    gamma = 2.0 * pi / gear.spec.z
-    pts = np.concatenate([rotate(per, i * gamma) for i in range(k)])
-    return rotate(pts, -(k - 1) * gamma / 2.0)
-
-
 def span_numerical(gear: Gear, k: int) -> tuple[float, float]:
     """``(W_k, contact radius)`` measured on the sampled outline: extent of the flank points across the axis of symmetry of ``k`` teeth.
 
     Only points on the flanks count (the jaws reach into the spaces, not
     onto the root lands or fillets), so the result is the distance of two
     parallel lines tangent to the outer flanks when they touch the flanks.
+    The teeth are symmetric, so the extent is twice the largest distance of
+    the outer (upper) flank of tooth ``k - 1`` from the axis.
     """
     lo, hi = flank_zone(gear)
-    pts = _group(gear, k)
-    R = np.hypot(pts[:, 0], pts[:, 1])
+    half = gear.half_period  # tooth centre to the middle of the space: the upper flank
+    R = np.hypot(half[:, 0], half[:, 1])
     on = (R >= lo - 1e-12) & (R <= hi + 1e-12)
-    y = pts[on, 1]
-    i = int(np.argmax(y))
-    return float(y[i] - y.min()), float(R[on][i])
+    pts = rotate(half[on], (k - 1) * pi / gear.spec.z)  # tooth k-1 seen from the axis of the k teeth
+    i = int(np.argmax(pts[:, 1]))
+    return float(2.0 * pts[i, 1]), float(R[on][i])
 
 
 def _span(gear: Gear) -> dict | None:
@@ -256,7 +250,7 @@ def pins_numerical(gear: Gear, d_pin: float) -> dict:
     # external: the space widens outward, the pin sinks until it touches; internal: it widens inward
     lo, hi = sorted((gear.r_a, gear.r_f))
     a, b = lo - 0.5 * d_pin, hi + 1.5 * d_pin
-    grid = np.linspace(a, b, 400)
+    grid = np.linspace(a, b, 120)
     vals = _dists(poly, grid[:, None] * u[None, :]) - 0.5 * d_pin
     # the resting position: coming from outside the teeth (outward for external teeth, from the
     # centre for internal ones), where the pin's clearance to the outline changes sign
@@ -296,7 +290,7 @@ def _pins(gear: Gear, d_pin: float | None) -> dict:
             return pin_diameter_for_contact(gear, rc) if closed else 2.0 * _dist_to_outline(poly, rc * u)
 
         # contact as near mid-flank as the pin allows: first the middle, then outward/inward from it
-        cands = mid + (hi - lo) * np.array([0.0, *np.ravel([[-f, f] for f in np.linspace(0.025, 0.475, 19)])])
+        cands = mid + (hi - lo) * np.array([0.0, *np.ravel([[-f, f] for f in np.linspace(0.05, 0.45, 9)])])
         d_pin = round(pin_at(mid), 3)
         for rc in cands:
             d = round(pin_at(rc), 3)  # gauge pins come in 1 um steps
