@@ -1,8 +1,6 @@
 """Design input (issue 13): bounds on every number, one-line errors naming the field and rule, only regular files read."""
 
-import math
 import os
-import re
 import threading
 from dataclasses import fields
 
@@ -97,10 +95,8 @@ def test_absurd_numbers_are_one_line_errors_naming_the_field(table, key, value, 
         code, out, err = run(cmd, capsys)
         assert code == 2
         one_line(err)
-        # the field itself is named: a tooth count beyond the bound, or the rule it breaks first
-        assert re.search(rf"wgcad: error: (drive|tooth|flexspline|rigid|generator)\.\w+: ", err), err
-        if key not in ("z_flex", "waves"):  # a z_flex of 1e9 breaks z_rigid - z_flex first; a huge waves count too
-            assert f"{table}.{key}" in err, err
+        # the field itself is named: absolute bounds are checked before any rule combining fields
+        assert err.startswith(f"wgcad: error: {table}.{key}: "), err
         assert not (tmp_path / "o").exists() or not any((tmp_path / "o").iterdir())
 
 

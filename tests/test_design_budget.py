@@ -4,13 +4,12 @@ import json
 import subprocess
 import sys
 import tracemalloc
-from math import sqrt
 
 import numpy as np
 import pytest
 from hypothesis import HealthCheck, given, settings
 
-from conftest import ROOT, TEMPLATES, edit_toml
+from conftest import ROOT, TEMPLATES
 from test_stability import designs
 from wgcad.cli import main
 from wgcad.design import load_design, parse_design, with_changes
