@@ -84,3 +84,62 @@ def test_every_template_builds_and_summarises(name):
     if rep["flexspline"]["form"] == "cycloidal":
         # rack vs exact: p * 2 rho / r at the root (see test_profiles), reported in um
         assert rep["flexspline"]["cycloid_rack_vs_exact_um"] == pytest.approx(1e3 * pi * 0.8 * 0.4 / 80, rel=1e-3)
+
+
+# ----------------------------------------------------------------------------- workshop figures (issue 13)
+import re  # noqa: E402
+
+from wgcad.design import with_changes  # noqa: E402
+from wgcad.errors import DesignError  # noqa: E402
+
+
+@pytest.mark.parametrize("name", ["d1_involute", "d1_cycloidal", "d2", "d3_external", "d4_discrete"])
+def test_summary_shows_no_negative_thickness_and_leads_with_workshop_figures(name):
+    rep = drive_report(drive(name))
+    text = format_summary(rep)
+    for line in text.splitlines():
+        if "thickness" in line or "space width" in line or "span" in line or "pins" in line:
+            assert not re.search(r"\s-\d", line), line
+    for label in ("mid-depth diameter", "chordal thickness", "span W_k over k teeth", "pin (ball) diameter",
+                  "dimension over / between pins", "smallest concave radius"):
+        assert label in text
+    for g in ("flexspline", "rigid"):
+        w = rep[g]["workshop"]
+        assert w["mid_depth"]["arc_mm"] > 0 and w["mid_depth"]["chordal_mm"] > 0
+        assert (w["span"] is None) == rep[g]["internal_teeth"]
+        pins = w["pins"]
+        assert ("between_pins_mm" in pins) == rep[g]["internal_teeth"]
+        if not rep[g]["pitch_circle_within_teeth"]:
+            # the virtual pitch figures stay in the data, not in the summary
+            assert "@pitch" not in text or rep["flexspline"]["pitch_circle_within_teeth"] or rep["rigid"]["pitch_circle_within_teeth"]
+
+
+def test_d1_pitch_circles_outside_the_teeth_are_not_shown_as_negative_widths():
+    # issue 13: D1 printed a space width of -0.607 mm at the pitch circle, which lies outside the teeth
+    rep = drive_report(drive("d1_involute"))
+    assert not rep["flexspline"]["pitch_circle_within_teeth"] and not rep["rigid"]["pitch_circle_within_teeth"]
+    assert min(rep["flexspline"]["space_width_pitch_mm"], rep["rigid"]["tooth_thickness_pitch_mm"]) < 0  # virtual
+    text = format_summary(rep)
+    assert "@pitch" not in text and "pitch circle lies outside the teeth" in text
+
+
+def test_chosen_diameter_and_pin_come_from_the_design():
+    d = drive("d4_discrete").design
+    dd = with_changes(d, flexspline={"measure_diameter": 35.3, "pin_diameter": 0.72})
+    rep = drive_report(build_drive(dd))
+    w = rep["flexspline"]["workshop"]
+    assert w["at_chosen_diameter"]["diameter_mm"] == pytest.approx(35.3)
+    assert w["pins"]["pin_diameter_mm"] == 0.72 and w["pins"]["pin_diameter_source"] == "design"
+    assert "chosen diameter" in format_summary(rep)
+
+
+@pytest.mark.parametrize("change,field,words", [
+    ({"measure_diameter": 34.2}, "flexspline.measure_diameter", "off the flanks"),
+    ({"pin_diameter": 0.3}, "flexspline.pin_diameter", "does not stand out of the teeth"),
+    ({"pin_diameter": 2.5}, "flexspline.pin_diameter", "must be in [0.1 m = 0.04, 5 m = 2] mm"),
+])
+def test_measurement_choices_that_cannot_be_measured_are_refused(change, field, words):
+    d = drive("d4_discrete").design
+    with pytest.raises(DesignError) as e:
+        drive_report(build_drive(with_changes(d, flexspline=change)))
+    assert e.value.field == field and words in str(e.value), str(e.value)

@@ -88,7 +88,10 @@ def designs(draw):
     law = "external_ring" if external else draw(st.sampled_from(["harmonic", "disc", "four_force", "ellipse"]))
     waves = 3 if law == "harmonic" and draw(st.integers(0, 3)) == 0 else 2
     k = draw(st.integers(1, 3))
-    gen = {"law": law, "w0_coef": draw(_f(0.6, 1.4))}
+    # W0 grows with the tooth difference k n_w: k n_w m / 2 brings the pitch circles together, and
+    # designers vary it by a fraction of a module; drives whose teeth never meet are refused
+    # (generator.w0_coef / drive.z_rigid, issue 13)
+    gen = {"law": law, "w0_coef": k * waves / 2 + draw(_f(-0.4, 0.4))}
     if law in ("disc", "four_force", "external_ring"):
         gen["beta_deg"] = draw(_f(10.0, 60.0))  # four_force: 40.71..49.29 must be rejected
     if law == "ellipse":

@@ -8,6 +8,7 @@ import numpy as np
 
 from .clearance.engine import AuditResult, AuditSettings, audit
 from .design import load_design
+from .design.budget import DEFAULT_MAX_MEMORY_MB
 from .drive import build_drive
 from .errors import DesignError
 
@@ -27,6 +28,7 @@ class RunSettings:
     use_mirror: bool = True
     cull: bool = True
     bound: bool = True
+    max_memory_mb: float | None = DEFAULT_MAX_MEMORY_MB  # refuse runs estimated above this (None: no limit)
 
     def as_dict(self) -> dict:
         return dict(self.__dict__)
@@ -53,8 +55,11 @@ def run_audit(design_path, rs: RunSettings, progress=None):
     """
     rs.check()
     design = load_design(design_path)
-    drive = build_drive(design, tol=rs.chord_tol_um * 1e-3)
     n = int(round(360.0 / rs.step_deg))
+    # judged before any large allocation: outlines, sample arrays and evaluation batches
+    run = {"angles": n, "sections": rs.sections, "use_period": rs.use_period, "use_waves": rs.use_waves,
+           "use_mirror": rs.use_mirror, "bound": rs.bound, "exports": False}
+    drive = build_drive(design, tol=rs.chord_tol_um * 1e-3, max_memory_mb=rs.max_memory_mb, run=run)
     angles = np.deg2rad(np.arange(n) * (360.0 / n))
     settings = AuditSettings(
         angles=angles,

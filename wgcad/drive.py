@@ -10,8 +10,9 @@ import numpy as np
 from . import constants
 from .deformation import Law, coned_w0, make_law
 from .design import Design
+from .design.budget import DEFAULT_MAX_MEMORY_MB, check_budget, estimate_run
 from .errors import DesignError
-from .profiles.gear import Gear, ToothSpec, make_gear
+from .profiles.gear import Gear, ToothSpec, _radii, make_gear
 
 __all__ = ["Drive", "build_drive", "tooth_spec"]
 
@@ -96,18 +97,54 @@ class Drive:
         return np.array([0.5 * bw]) if k <= 1 else np.linspace(0.0, bw, k)
 
 
-def build_drive(design: Design, tol: float = constants.CHORD_TOL) -> Drive:
+def _check_teeth_meet(design: Design) -> None:
+    """Refuse a drive whose teeth never meet: on the major axis the flexspline tips must reach past the rigid tips (theory.md 2.1, 3)."""
+    f, b = _radii(tooth_spec(design, "flexspline")), _radii(tooth_spec(design, "rigid"))
+    w0 = design.w0
+    g = design.generator
+    if g.cone_length is not None:  # the largest W0 over the face is at the open end (theory.md 3.1, coning)
+        w0 *= g.cone_length / (g.cone_length - g.generator_z)
+    sgn = -1.0 if design.external else 1.0  # +: flexspline teeth point outward
+    depth = sgn * (f[0] + sgn * w0 - b[0])
+    if depth > 0:
+        return
+    need = w0 - depth  # the W0 at which the tips would just touch
+    if need / design.module > 5.0:  # beyond the w0_coef bound: the tooth counts are the cause
+        raise DesignError("drive.z_rigid", f"the teeth never meet: the flexspline tips stay {-depth:.4f} mm short of the rigid "
+                                           f"tips on the major axis, and no W0 within the bound (5 m) closes the gap; "
+                                           "bring z_rigid near z_flex")
+    raise DesignError("generator.w0_coef", f"the teeth never meet: the flexspline tips stay {-depth:.4f} mm short of the rigid "
+                                           f"tips on the major axis; W0 must exceed {need:.4f} mm (w0_coef > {need / design.module:.4f})")
+
+
+def build_drive(design: Design, tol: float = constants.CHORD_TOL, *, max_memory_mb: float | None = DEFAULT_MAX_MEMORY_MB,
+                run: dict | None = None) -> Drive:
     """Build both gears and the deformation law, checking the derived geometry.
+
+    Before any outline is sampled the run is estimated
+    (:func:`wgcad.design.budget.estimate_run`, with ``run`` its audit and
+    export settings) and refused if it would exceed ``max_memory_mb``
+    (None: no limit); an audit is checked again with the built gears' own
+    vertex counts.
 
     Raises
     ------
     DesignError
-        A derived-geometry rule is broken (names the field to change).
+        A derived-geometry rule is broken (names the field to change), or
+        the run exceeds the memory budget (names ``--max-memory-mb``).
     """
     if not tol > 0:
         raise DesignError("chord_tol", f"must be > 0, got {tol:g}")
+    run = dict(run or {"exports": False})
+    # the outlines first, from the upper estimate of their vertex counts; the audit's arrays
+    # (which dwarf the outlines) once the gears give their own counts, before the audit starts
+    check_budget(estimate_run(design, tol, **{**run, "angles": 0}), max_memory_mb)
     flex = make_gear(tooth_spec(design, "flexspline"), tol)
     rigid = make_gear(tooth_spec(design, "rigid"), tol)
+    _check_teeth_meet(design)  # after each gear's own rules, which name the field to change first
+    if run.get("angles"):
+        counts = {"flexspline": len(flex.period) - 1, "rigid": len(rigid.period) - 1}
+        check_budget(estimate_run(design, tol, vertices_per_tooth=counts, **run), max_memory_mb)
     h1 = design.flexspline.rim_thickness
     if design.external:
         # internal-toothed flexspline: rim outside its root circle

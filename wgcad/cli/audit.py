@@ -6,7 +6,7 @@ import json
 import sys
 from pathlib import Path
 
-from .common import EPILOG, EXIT_INTERFERENCE, EXIT_OK, Progress, angle_count, positive_float
+from .common import EPILOG, EXIT_INTERFERENCE, EXIT_OK, Progress, add_memory_flag, angle_count, positive_float
 
 __all__ = ["register", "cmd_audit"]
 
@@ -63,7 +63,8 @@ def cmd_audit(args) -> int:
     if base is not None:
         st = base["settings"]
         rs = RunSettings(step_deg=float(st["step_deg"]), sections=int(st["sections"]),
-                         chord_tol_um=float(st["chord_tol_um"]), interference_tol_um=float(st["interference_tol_um"]))
+                         chord_tol_um=float(st["chord_tol_um"]), interference_tol_um=float(st["interference_tol_um"]),
+                         max_memory_mb=args.max_memory_mb)
     else:
         step = 360.0 / args.angles if args.angles else args.step_deg
         off = args.no_shortcuts
@@ -71,7 +72,7 @@ def cmd_audit(args) -> int:
                          interference_tol_um=args.interference_tol_um,
                          use_period=not (off or args.no_mesh_period), use_waves=not (off or args.no_wave_symmetry),
                          use_mirror=not (off or args.no_mirror), cull=not (off or args.no_culling),
-                         bound=not (off or args.no_bound))
+                         bound=not (off or args.no_bound), max_memory_mb=args.max_memory_mb)
     rs.check()
     for path in (args.json, args.plot, args.write_baseline):
         if path:
@@ -200,6 +201,7 @@ def register(sub) -> None:
     a.add_argument("--no-bound", action="store_true")
     a.add_argument("--progress", action="store_true", help="progress bar on stderr even when it is not a terminal")
     a.add_argument("--quiet", action="store_true")
+    add_memory_flag(a)
     from .load import register_args
 
     register_args(a)

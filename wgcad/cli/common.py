@@ -9,7 +9,7 @@ from pathlib import Path
 from ..errors import WgcadError
 
 __all__ = ["EXIT_OK", "EXIT_INTERFERENCE", "EXIT_INPUT", "EPILOG", "Parser", "angles_deg", "positive_float",
-           "angle_count", "out_dir", "angle_tag", "circle", "Progress"]
+           "angle_count", "add_memory_flag", "out_dir", "angle_tag", "circle", "Progress"]
 
 EXIT_OK = 0
 EXIT_INTERFERENCE = 1  # reserved for `wgcad audit`: interference found
@@ -71,6 +71,14 @@ def angle_count(text: str) -> int:
     if not 4 <= n <= 3_600_000:
         raise argparse.ArgumentTypeError(f"must be 4..3600000 angles per revolution, got {n}")
     return n
+
+
+def add_memory_flag(parser) -> None:
+    """``--max-memory-mb``: the memory budget a run is judged against before it starts (wgcad.design.budget)."""
+    from ..design.budget import DEFAULT_MAX_MEMORY_MB
+
+    parser.add_argument("--max-memory-mb", type=positive_float(0.0, 1e7, "MB"), default=DEFAULT_MAX_MEMORY_MB,
+                        help=f"refuse a run whose estimated memory exceeds this, MB (default {DEFAULT_MAX_MEMORY_MB:g})")
 
 
 def out_dir(args, design_path: str) -> Path:

@@ -6,7 +6,7 @@ import json
 import time
 from pathlib import Path
 
-from .common import EPILOG, EXIT_OK, angles_deg, circle, out_dir, angle_tag, positive_float
+from .common import EPILOG, EXIT_OK, add_memory_flag, angles_deg, circle, out_dir, angle_tag, positive_float
 
 __all__ = ["register", "cmd_generate", "deformed_scene"]
 
@@ -88,7 +88,7 @@ def cmd_generate(args) -> int:
 
     design = load_design(args.design)
     tol = args.chord_tol_um * 1e-3
-    drive = build_drive(design, tol=tol)
+    drive = build_drive(design, tol=tol, max_memory_mb=args.max_memory_mb, run={"exports": True})
     out = out_dir(args, args.design)
     ensure_writable_dir(out)
     import numpy as np
@@ -172,4 +172,5 @@ def register(sub) -> None:
     g.add_argument("--no-stl", action="store_true", help="skip the STL solids")
     g.add_argument("--json", action="store_true", help="print report.json to stdout instead of the summary")
     g.add_argument("--quiet", action="store_true", help="print nothing on success")
+    add_memory_flag(g)
     g.set_defaults(func=cmd_generate)

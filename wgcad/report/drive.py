@@ -8,10 +8,12 @@ import numpy as np
 
 from .. import __version__
 from ..kinematics import gear_ratios
+from ..errors import DesignError
 from ..placement import place_points, place_points_first_order, tooth_angles
 from ..profiles import cycloid as cy
+from ..profiles import measure
 
-__all__ = ["gear_figures", "mesh_figures", "drive_report", "format_summary"]
+__all__ = ["gear_figures", "workshop", "mesh_figures", "drive_report", "format_summary"]
 
 
 def _r(x, nd=6):
@@ -28,9 +30,49 @@ def cycloid_rack_error(gear, n: int = 2001) -> float:
     return float(np.max(np.abs(2.0 * R * (exact - rack))))
 
 
-def gear_figures(gear, rim_radius: float) -> dict:
-    """Radii and thicknesses of one gear (theory.md 2)."""
+def _rounded(x, nd=6):
+    """Floats of nested dicts rounded for the report."""
+    if isinstance(x, dict):
+        return {k: _rounded(v, nd) for k, v in x.items()}
+    if isinstance(x, float):
+        return _r(x, nd)
+    return x
+
+
+def workshop(gear, gs=None) -> dict:
+    """What a workshop measures on one gear (:mod:`wgcad.profiles.measure`), checked against the design's own choices.
+
+    Raises
+    ------
+    DesignError
+        ``measure_diameter`` off the flanks, or a ``pin_diameter`` that does
+        not stand out of the teeth or touches the root.
+    """
+    which = gear.spec.field
+    dm = None if gs is None else gs.measure_diameter
+    dp = None if gs is None else gs.pin_diameter
+    if dm is not None:
+        lo, hi = measure.flank_zone(gear)
+        if not 2 * lo <= dm <= 2 * hi:
+            raise DesignError(f"{which}.measure_diameter", f"{dm:g} mm is off the flanks, which run from "
+                                                           f"{2 * lo:.4f} to {2 * hi:.4f} mm in diameter")
+    try:
+        w = measure.workshop_figures(gear, dm, dp)
+    except ArithmeticError:
+        if dp is None:
+            raise
+        raise DesignError(f"{which}.pin_diameter", f"a pin of {dp:g} mm does not touch both flanks of a space") from None
+    p = w["pins"]
+    if dp is not None and not (p["pin_stands_out_of_the_teeth"] and p["pin_clear_of_the_root"]):
+        why = "does not stand out of the teeth" if not p["pin_stands_out_of_the_teeth"] else "touches the root"
+        raise DesignError(f"{which}.pin_diameter", f"a pin of {dp:g} mm {why}; choose another (or omit it for the default)")
+    return _rounded(w)
+
+
+def gear_figures(gear, rim_radius: float, gs=None) -> dict:
+    """Radii, thicknesses and the workshop's measurements of one gear (theory.md 2); ``gs`` its design table."""
     sp = gear.spec
+    within = bool(min(gear.r_a, gear.r_f) <= gear.r <= max(gear.r_a, gear.r_f))
     out = {
         "teeth": sp.z,
         "internal_teeth": sp.internal,
@@ -43,7 +85,9 @@ def gear_figures(gear, rim_radius: float) -> dict:
         "rim_radius_mm": _r(rim_radius),
         # with large profile shifts the pitch circle lies outside the teeth: the
         # figures there are those of the extended involutes ("virtual")
-        "pitch_circle_within_teeth": bool(min(gear.r_a, gear.r_f) <= gear.r <= max(gear.r_a, gear.r_f)),
+        "pitch_circle_within_teeth": within,
+        # virtual when the pitch circle lies outside the teeth (then one of them is negative): kept as
+        # design figures of the extended flanks, not shown as measurements
         "tooth_thickness_pitch_mm": _r(gear.tooth_thickness(gear.r)),
         "space_width_pitch_mm": _r(gear.space_width(gear.r)),
         "tip_thickness_mm": _r(gear.tip_thickness),
@@ -53,6 +97,7 @@ def gear_figures(gear, rim_radius: float) -> dict:
     }
     if sp.form == "cycloidal":
         out["cycloid_rack_vs_exact_um"] = _r(1e3 * cycloid_rack_error(gear), 4)
+    out["workshop"] = workshop(gear, gs)
     return out
 
 
@@ -122,8 +167,8 @@ def drive_report(drive) -> dict:
             "w0_mm": _r(des.w0),
             "neutral_radius_mm": _r(drive.r_m),
         },
-        "flexspline": gear_figures(drive.flex, drive.flex_rim_radius),
-        "rigid": gear_figures(drive.rigid, drive.rigid_rim_radius),
+        "flexspline": gear_figures(drive.flex, drive.flex_rim_radius, des.flexspline),
+        "rigid": gear_figures(drive.rigid, drive.rigid_rim_radius, des.rigid),
         "mesh": mesh_figures(drive),
         "placement": placement_check(drive),
     }
@@ -144,29 +189,61 @@ def format_summary(rep: dict) -> str:
         f"{d['deformation']} deformation, {d['law']} law, W0 {d['w0_mm']} mm",
         f"  ratio u_hg (rigid fixed) {d['ratio_rigid_fixed']:g}, u_hb (flexspline fixed) {d['ratio_flexspline_fixed']:g}",
         "",
-        f"  {'':28s}{'flexspline':>14s}{'rigid':>14s}",
+        f"  {'':38s}{'flexspline':>20s}{'rigid':>20s}",
     ]
-    rows = [
-        ("pitch radius, mm", "pitch_radius_mm"),
-        ("tip radius, mm", "tip_radius_mm"),
-        ("root radius, mm", "root_radius_mm"),
-        ("base radius, mm", "base_radius_mm"),
-        ("rim radius, mm", "rim_radius_mm"),
-        ("tooth thickness @pitch, mm", "tooth_thickness_pitch_mm"),
-        ("space width @pitch, mm", "space_width_pitch_mm"),
-        ("tip thickness, mm", "tip_thickness_mm"),
-        ("outline vertices", "outline_vertices"),
-    ]
+
+    def fmt(v):
+        return "-" if v is None else f"{v:.4f}" if isinstance(v, float) else str(v)
+
+    def row(label, fv, bv):
+        lines.append(f"  {label:38s}{fmt(fv):>20s}{fmt(bv):>20s}")
+
+    for label, key in (("pitch radius, mm", "pitch_radius_mm"), ("tip radius, mm", "tip_radius_mm"),
+                       ("root radius, mm", "root_radius_mm"), ("base radius, mm", "base_radius_mm"),
+                       ("rim radius, mm", "rim_radius_mm"), ("tip thickness, mm", "tip_thickness_mm"),
+                       ("outline vertices", "outline_vertices")):
+        row(label, f.get(key), b.get(key))
     if "cycloid_rack_vs_exact_um" in f:
-        rows.append(("rack vs exact cycloid, um", "cycloid_rack_vs_exact_um"))
-    for label, key in rows:
-        fv, bv = f.get(key), b.get(key)
-        fs = "-" if fv is None else f"{fv:.4f}" if isinstance(fv, float) else str(fv)
-        bs = "-" if bv is None else f"{bv:.4f}" if isinstance(bv, float) else str(bv)
-        lines.append(f"  {label:28s}{fs:>14s}{bs:>14s}")
-    for key, g in (("flexspline", f), ("rigid", b)):
-        if not g["pitch_circle_within_teeth"]:
-            lines.append(f"  ({key}: the pitch circle lies outside the teeth; its thickness/space figures are virtual)")
+        row("rack vs exact cycloid, um", f.get("cycloid_rack_vs_exact_um"), b.get("cycloid_rack_vs_exact_um"))
+    # the pitch-circle figures only where the pitch circle crosses the teeth: outside them they are
+    # figures of the extended flanks (one of them negative), not something to measure
+    if f["pitch_circle_within_teeth"] or b["pitch_circle_within_teeth"]:
+        for label, key in (("tooth thickness @pitch, mm", "tooth_thickness_pitch_mm"), ("space width @pitch, mm", "space_width_pitch_mm")):
+            row(label, *(g[key] if g["pitch_circle_within_teeth"] else None for g in (f, b)))
+    wf, wb = f["workshop"], b["workshop"]
+    lines += ["", "  workshop measurements (undeformed gears)"]
+    row("flanks between diameters, mm", f"{wf['flank_from_diameter_mm']:.3f}-{wf['flank_to_diameter_mm']:.3f}",
+        f"{wb['flank_from_diameter_mm']:.3f}-{wb['flank_to_diameter_mm']:.3f}")
+    row("mid-depth diameter, mm", wf["mid_depth"]["diameter_mm"], wb["mid_depth"]["diameter_mm"])
+    row("  thickness there: arc, mm", wf["mid_depth"]["arc_mm"], wb["mid_depth"]["arc_mm"])
+    row("  chordal thickness, mm", wf["mid_depth"]["chordal_mm"], wb["mid_depth"]["chordal_mm"])
+    row("  chordal height from the tip, mm", wf["mid_depth"]["chordal_height_mm"], wb["mid_depth"]["chordal_height_mm"])
+    if "at_chosen_diameter" in wf or "at_chosen_diameter" in wb:
+        cf, cb = wf.get("at_chosen_diameter", {}), wb.get("at_chosen_diameter", {})
+        row("chosen diameter, mm", cf.get("diameter_mm"), cb.get("diameter_mm"))
+        row("  thickness there: arc, mm", cf.get("arc_mm"), cb.get("arc_mm"))
+        row("  chordal thickness, mm", cf.get("chordal_mm"), cb.get("chordal_mm"))
+        row("  chordal height from the tip, mm", cf.get("chordal_height_mm"), cb.get("chordal_height_mm"))
+
+    def span(w):
+        sp = w["span"]
+        if sp is None:
+            return "internal teeth"
+        return "none fits" if sp.get("k") is None else f"{sp['w_k_mm']:.4f} (k={sp['k']})"
+
+    row("span W_k over k teeth, mm", span(wf), span(wb))
+    row("pin (ball) diameter, mm", wf["pins"]["pin_diameter_mm"], wb["pins"]["pin_diameter_mm"])
+    row("dimension over / between pins, mm", *(w["pins"].get("over_pins_mm", w["pins"].get("between_pins_mm")) for w in (wf, wb)))
+    row("smallest concave radius, mm", wf["smallest_concave_radius_mm"], wb["smallest_concave_radius_mm"])
+    methods = sorted({w["span"]["method"] for w in (wf, wb) if w["span"] and w["span"].get("method")} | {w["pins"]["method"] for w in (wf, wb)})
+    lines.append(f"  (span and pins: {'; '.join(methods)}; thicknesses and concave radii: closed form;"
+                 " external teeth over pins, internal between pins)")
+    if any(w["smallest_concave_radius_mm"] == 0.0 for w in (wf, wb)):
+        lines.append("  (a concave radius of 0: sharp root corner, or the cycloid's curvature at the pitch point)")
+    outside = [key for key, g in (("flexspline", f), ("rigid", b)) if not g["pitch_circle_within_teeth"]]
+    if outside:
+        lines.append(f"  ({' and '.join(outside)}: the pitch circle lies outside the teeth, so no thickness is given there; "
+                     "report.json keeps the virtual values of the extended flanks)")
     lines += [
         "",
         f"  depth of engagement on the major axis: {m['depth_of_engagement_mm']:.4f} mm (w = {m['w_major_mm']:.4f} mm)",

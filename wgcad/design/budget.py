@@ -1,0 +1,147 @@
+"""The work and memory a run will need, estimated from the design before any large allocation, and the budget it must fit.
+
+The estimate is closed-form in the design's sizes: outline vertices per
+tooth from the chord tolerance (the sagitta of a chord of length ``c`` on a
+curve of radius ``R`` is ``c^2 / (8 R)``, so a curve of a given shape needs
+a number of chords proportional to ``sqrt(m / tol)``), audit samples from the
+generator-angle step, the tooth count and the sections. Its coefficients were
+fitted to measured runs (``tests/test_design_budget.py`` checks the vertex
+counts against built gears, ``benchmarks/`` the memory against peak RSS) and
+err on the high side.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from math import ceil, sqrt
+
+from .. import constants
+from ..errors import DesignError
+
+__all__ = ["DEFAULT_MAX_MEMORY_MB", "RunEstimate", "outline_vertices_per_tooth", "estimate_run", "check_budget"]
+
+#: Memory a run may use by default, MB. The bundled templates need 0.1-0.2 GB
+#: for ``generate`` and a default ``audit``; 2 GB fits beside other work on a
+#: small machine and is raised with ``--max-memory-mb``.
+DEFAULT_MAX_MEMORY_MB = 2048.0
+
+# vertices of one pitch of outline ~ A + B sqrt(m / tol): fitted on 1000 built
+# gears of random designs (tests/test_stability.py's generator) at chord
+# tolerances 0.01-10 um: the upper envelope of the counts plus ~20 % (the floor A comes
+# from the fixed minimum of sampled pieces)
+_VERTS_A = 16.0
+_VERTS_B = {"involute": 2.2, "cycloidal": 2.6}
+# bytes, measured (peak RSS, D1 at several tolerances/steps): interpreter and
+# imports; per outline vertex written to DXF + STL (both gears, with the solids'
+# triangles); per audit sample (generator angle x tooth: angle arrays, folding,
+# sorting); per distinct tooth angle and section (search state); per vertex of a
+# tooth evaluated in one batch (placed copies, polygons, distances)
+_BASE_B = 120e6
+_PER_EXPORT_VERTEX_B = 2.8e3
+_PER_SAMPLE_B = 64.0
+_PER_UNIQUE_SECTION_B = 40.0
+_PER_BATCH_VERTEX_B = 100.0
+# the branch-and-bound's coarse pass evaluates every 256th distinct tooth angle of
+# large sweeps and the finer passes only the few whose bound is below the minimum
+_BOUND_BATCH_DIVISOR = 256
+
+
+@dataclass(frozen=True)
+class RunEstimate:
+    """What a run is expected to need.
+
+    Attributes
+    ----------
+    vertices_per_tooth : dict
+        ``{"flexspline": n, "rigid": n}``, one pitch of outline.
+    outline_vertices : int
+        Both gears' whole outlines.
+    audit_samples : int
+        Generator angles x flexspline teeth x sections (0 without an audit).
+    memory_mb : float
+        Estimated peak memory, MB.
+    """
+
+    vertices_per_tooth: dict
+    outline_vertices: int
+    audit_samples: int
+    memory_mb: float
+
+    def as_dict(self) -> dict:
+        return {"vertices_per_tooth": dict(self.vertices_per_tooth), "outline_vertices": self.outline_vertices,
+                "audit_samples": self.audit_samples, "memory_mb": round(self.memory_mb, 1)}
+
+
+def outline_vertices_per_tooth(form: str, module: float, tol: float) -> int:
+    """Upper estimate of the vertices of one pitch of a sampled outline (tip, flanks, fillets, root)."""
+    return int(ceil(_VERTS_A + _VERTS_B.get(form, max(_VERTS_B.values())) * sqrt(module / tol)))
+
+
+def estimate_run(design, tol: float = constants.CHORD_TOL, *, angles: int = 0, sections: int = 1,
+                 use_period: bool = True, use_waves: bool = True, use_mirror: bool = True,
+                 bound: bool = True, exports: bool = True, vertices_per_tooth: dict | None = None) -> RunEstimate:
+    """Estimate the outline sizes, audit samples and peak memory of a run, from the design alone.
+
+    Parameters
+    ----------
+    design : Design
+        A validated design (field bounds hold, so every product below is finite).
+    tol : float
+        Chord tolerance, mm.
+    angles, sections : int
+        Generator angles over a revolution and cross-sections of an audit
+        (``angles=0``: no audit). Without coning one section is computed.
+    use_period, use_waves, use_mirror, bound : bool
+        The audit's shortcuts (:class:`wgcad.clearance.engine.AuditSettings`):
+        without them far more samples are kept and evaluated at once.
+    exports : bool
+        Whether DXF/STL files of the outlines are written (``generate``).
+    vertices_per_tooth : dict, optional
+        Measured vertices of one pitch (``{"flexspline": n, "rigid": n}``) of
+        gears already built, instead of the upper estimate.
+    """
+    if not tol > 0:
+        raise DesignError("chord_tol", f"must be > 0, got {tol:g}")
+    dr = design.drive
+    form = design.tooth.form
+    per = outline_vertices_per_tooth(form, dr.module, tol)
+    verts = dict(vertices_per_tooth) if vertices_per_tooth else {"flexspline": per, "rigid": per}
+    n_out = verts["flexspline"] * dr.z_flex + verts["rigid"] * dr.z_rigid
+    mem = _BASE_B + n_out * 16.0 * 6  # outline arrays and their intermediates (angles, radii, polar)
+    if exports:
+        mem += n_out * _PER_EXPORT_VERTEX_B
+    samples = 0
+    if angles > 0:
+        secs = sections if design.generator.cone_length is not None else 1
+        n_s = angles * dr.z_flex
+        samples = n_s * secs
+        fold = 1
+        if use_period:
+            fold *= 2 if use_mirror else 1
+            fold *= dr.waves if (use_waves and dr.z_flex % dr.waves == 0) else 1
+        n_u = n_s // fold if use_period else n_s
+        batch = n_u * secs if not bound else max(1, n_u * secs // _BOUND_BATCH_DIVISOR)
+        p = verts["flexspline"] + 2  # a tooth polygon: one pitch closed through the body
+        mem += (n_s * _PER_SAMPLE_B + n_u * secs * _PER_UNIQUE_SECTION_B
+                + n_u * 0.5 * p * 16.0  # radial bound: the tip half of every distinct tooth angle, placed
+                + batch * p * _PER_BATCH_VERTEX_B)
+    return RunEstimate(verts, int(n_out), int(samples), mem / 1e6)
+
+
+def check_budget(est: RunEstimate, max_memory_mb: float | None = DEFAULT_MAX_MEMORY_MB,
+                 flag: str = "--max-memory-mb") -> RunEstimate:
+    """Refuse a run whose estimated memory exceeds ``max_memory_mb`` (None: no limit).
+
+    Raises
+    ------
+    DesignError
+        One line: the estimate, what drives it, the budget and the flag that raises it.
+    """
+    if max_memory_mb is not None and est.memory_mb > max_memory_mb:
+        what = f"{est.outline_vertices} outline vertices"
+        if est.audit_samples:
+            what += f", {est.audit_samples} audit samples"
+        raise DesignError(flag, f"this run needs about {est.memory_mb:.0f} MB ({what}), more than the budget of "
+                                f"{max_memory_mb:g} MB; raise {flag}, or coarsen --chord-tol-um / --step-deg, "
+                                "or reduce the tooth counts")
+    return est
