@@ -37,12 +37,12 @@ from math import pi
 
 import numpy as np
 import shapely
-from scipy.optimize import brentq
 
 from .. import constants
 from ..kinematics import gear_ratios
 from ..placement import pose_from_displacements, tooth_frames, tooth_pose, transform
 from .distance import Template, signed_clearance
+from .refine import ExactTooth, refine_pairs
 
 __all__ = ["AuditSettings", "AuditResult", "Scene", "tooth_clearance", "audit", "brute_force_min"]
 
@@ -61,6 +61,9 @@ class AuditSettings:
         The work-skipping shortcuts (module docstring); all on by default.
     interference_tol : float
         Penetration (mm) reported as contact rather than interference.
+    refine : bool
+        Refine the figures on the exact tooth curves (:mod:`wgcad.clearance.refine`);
+        off: the polygons' figures (within about twice the chord tolerance).
     """
 
     angles: np.ndarray
@@ -71,6 +74,7 @@ class AuditSettings:
     cull: bool = True
     bound: bool = True
     interference_tol: float = constants.INTERFERENCE_TOL
+    refine: bool = True
 
 
 class Scene:
@@ -107,6 +111,15 @@ class Scene:
         # through the flank that faces against that motion: the working flank.
         rel = rot / self.ratios["u_hg"]
         self.working = "upper" if rel < 0 else "lower"
+        # exact pieces of both teeth, and how far a polygon figure can be from the curves' one:
+        # every vertex is on its curve and every chord within tol of it, so a distance, and a
+        # depth measured from vertices, moves by at most tol per tooth (docs/models.md 5)
+        self.flex_exact = ExactTooth(drive.flex, self.flex.local)
+        self.rigid_exact = ExactTooth(drive.rigid, self.rigid.local)
+        self.chord_gap = 2.0 * drive.tol
+        tip = [p for p in drive.flex.pieces if p.kind == "arc" and np.allclose(p.center, 0.0, atol=1e-12)
+               and abs(p.radius - drive.flex.r_a) <= 1e-9 * drive.flex.r_a]
+        self.tip_arc = tip[0] if tip else None
         self.entry_sign = rot  # teeth enter engagement on the side the generator turns toward
         self._laws = {}
 
@@ -188,30 +201,100 @@ class Scene:
         R = np.hypot(pts[..., 0], pts[..., 1])
         return R.min(axis=1) - self.r_tip_b if self.external else self.r_tip_b - R.max(axis=1)
 
+    def tip_radial(self, rot: np.ndarray, shift: np.ndarray) -> np.ndarray:
+        """Exact radial gap ``(K,)`` between the placed tip arc and the rigid tip circle (> 0: radially clear).
+
+        The tip arc is centred on the tooth frame's origin, which lands on
+        ``shift``: its farthest (nearest) point from the gear axis lies along
+        (against) ``shift`` if that direction falls within the arc, else at
+        an end (docs/models.md 5, entry gap).
+        """
+        arc = self.tip_arc
+        if arc is None:  # no tip arc (never for the built-in forms): fall back to the tip vertices
+            return self.radial_bound(transform(self.flex_tip_local, rot, shift))
+        c = np.hypot(shift[:, 0], shift[:, 1])
+        psi = np.arctan2(shift[:, 1], shift[:, 0])
+        lo_t, hi_t = sorted((arc.t0, arc.t1))
+        want = psi if not self.external else psi + pi  # outermost point (internal deformation), innermost (external)
+        rel = (want - rot - lo_t) % (2 * pi)
+        inside = rel <= hi_t - lo_t
+        ends = []
+        for t in (lo_t, hi_t):
+            ends.append(np.hypot(shift[:, 0] + arc.radius * np.cos(rot + t), shift[:, 1] + arc.radius * np.sin(rot + t)))
+        if self.external:
+            R = np.where(inside, np.abs(arc.radius - c), np.minimum(*ends))
+            return R - self.r_tip_b
+        R = np.where(inside, c + arc.radius, np.maximum(*ends))
+        return self.r_tip_b - R
+
     def clearance_to(self, rot, shift, j, area: bool = False, flex_geoms=None):
-        """Signed clearance of flexspline teeth at poses ``(rot, shift)`` to rigid teeth ``j``."""
+        """Signed clearance of flexspline teeth at poses ``(rot, shift)`` to rigid teeth ``j`` (polygons)."""
         return signed_clearance(self.flex, rot, shift, self.rigid, self.rigid_rot[j], self.rigid_shift[j],
                                 b_geoms=self.rigid_geoms[j], area=area, a_geoms=flex_geoms)
 
+    def exact_to(self, rot, shift, j):
+        """Signed clearance of flexspline teeth at poses ``(rot, shift)`` to rigid teeth ``j`` on the exact curves.
 
-def tooth_clearance(scene: Scene, phi, z=None, third: bool = True, area: bool = False) -> dict:
+        Returns ``(value (K,), side (K,), point (K, 2))`` of :func:`wgcad.clearance.refine.refine_pairs`.
+        """
+        j = np.atleast_1d(j)
+        return refine_pairs(self.flex_exact, self.flex.local, self.flex.polygon, rot, shift,
+                            self.rigid_exact, self.rigid.local, self.rigid.polygon, self.rigid_rot[j], self.rigid_shift[j],
+                            margin=2.0 * self.chord_gap)
+
+
+def tooth_clearance(scene: Scene, phi, z=None, third: bool = True, area: bool = False, exact: bool = False) -> dict:
     """Signed clearance of a tooth at angles ``phi`` to the rigid teeth below and above it (and the third nearest).
 
     Returns
     -------
     dict of (K,) arrays: ``lower``, ``upper``, ``third`` (mm, negative =
     penetration depth), ``min``, ``lo``/``up`` rigid tooth indices, and with
-    ``area`` the overlap areas ``lower_area``, ``upper_area``.
+    ``area`` the overlap areas ``lower_area``, ``upper_area``. With
+    ``exact`` the figures of every pair that can hold the minimum are
+    refined on the exact curves (:func:`refine_min`).
     """
     phi = np.atleast_1d(np.asarray(phi, dtype=float))
     rot, shift = scene.pose(phi, z)
-    return clearance_at_poses(scene, rot, shift, third=third, area=area)
+    out = clearance_at_poses(scene, rot, shift, third=third, area=area)
+    return refine_min(scene, rot, shift, out) if exact else out
 
 
-def tooth_clearance_sections(scene: Scene, phi: np.ndarray, zi: np.ndarray, zs: list) -> np.ndarray:
+def tooth_clearance_sections(scene: Scene, phi: np.ndarray, zi: np.ndarray, zs: list, exact: bool = False) -> np.ndarray:
     """Smallest clearance of teeth at angles ``phi[k]`` in sections ``zs[zi[k]]``, in one batch, ``(K,)``."""
     rot, shift = scene.pose_sections(phi, zi, zs)
-    return clearance_at_poses(scene, rot, shift)["min"]
+    out = clearance_at_poses(scene, rot, shift)
+    return refine_min(scene, rot, shift, out)["min"] if exact else out["min"]
+
+
+def refine_min(scene: Scene, rot: np.ndarray, shift: np.ndarray, det: dict) -> dict:
+    """Refine on the exact curves every pair of :func:`clearance_at_poses` that can hold a tooth's minimum.
+
+    A pair's exact figure is within ``scene.chord_gap`` of its polygon one,
+    so only pairs whose polygon figure is within twice that of the tooth's
+    smallest are refined; the others keep their polygon figures (they
+    cannot be the minimum). Adds ``refined_lower``/``_upper``/``_third``
+    (bool) and ``point_lower``... (the extremal point, rigid-tooth frame
+    for side 0) to ``det`` and updates the figures and ``min``.
+    """
+    out = dict(det)
+    gap = scene.chord_gap
+    best = det["min"]
+    idx = {"lower": det["lo"], "upper": det["up"]}
+    if "th" in det:
+        idx["third"] = det["th"]
+    for key, j in idx.items():
+        val = np.asarray(det[key], dtype=float).copy()
+        need = np.nonzero(np.isfinite(val) & (val <= best + 2.0 * gap))[0]
+        done = np.zeros(len(val), dtype=bool)
+        if need.size:
+            ex, _, _ = scene.exact_to(rot[need], shift[need], j[need])
+            val[need] = ex
+            done[need] = True
+        out[key] = val
+        out[f"refined_{key}"] = done
+    out["min"] = np.minimum(np.minimum(out["lower"], out["upper"]), out.get("third", np.inf))
+    return out
 
 
 def clearance_at_poses(scene: Scene, rot: np.ndarray, shift: np.ndarray, third: bool = True, area: bool = False) -> dict:
@@ -237,11 +320,12 @@ def clearance_at_poses(scene: Scene, rot: np.ndarray, shift: np.ndarray, third: 
         gap = np.abs((ang - tc[:, None] + pi) % (2 * pi) - pi).min(axis=1) - pi / scene.z_b
         r_lo = np.minimum(R.min(axis=1), scene.rigid_r_min)
         lb = 2.0 * r_lo * np.sin(np.clip(gap, 0.0, None) / 2.0)
-        need = np.nonzero(lb < best)[0]
+        # polygons lie within the chord tolerance of the curves: the bound is widened by that
+        need = np.nonzero(lb < best + scene.chord_gap)[0]
         if need.size:
             out["third"][need] = scene.clearance_to(rot[need], shift[need], th[need], flex_geoms=geoms[need])
     out["min"] = np.minimum(best, out["third"])
-    out["lo"], out["up"] = lo, up
+    out["lo"], out["up"], out["th"] = lo, up, th
     return out
 
 
@@ -271,6 +355,9 @@ class _SectionSearch:
         self.zone = np.nonzero(zone)[0]
         self.culled = 0
         self.V = 0.0
+        # a sample whose polygon figure is within twice the polygon-curve difference of the
+        # best may still be the exact minimum: nothing within that margin is skipped
+        self.margin = 2.0 * scene.chord_gap if settings.refine else 0.0
 
     def prepare_bound(self) -> None:
         """Speed bound for branch and bound (only worth it with many samples)."""
@@ -305,22 +392,32 @@ class _SectionSearch:
         vr = self.value[zi[right]] - self.V * np.abs(pz[right] - pz[cand])
         lb = np.maximum(np.maximum(vl, vr), self.lower[zi[cand]])
         self.lower[zi[cand]] = lb
-        return zi[cand[lb < best]]
+        return zi[cand[lb < best + self.margin]]
 
     def culled_needed(self, best: float) -> np.ndarray:
         """Culled samples whose radial bound does not clear ``best``: they must be evaluated."""
         out = np.nonzero(~self.zone_mask)[0]
-        need = out[self.radial[out] < best]
+        need = out[self.radial[out] < best + self.margin]
         self.culled = int(out.size - need.size)
         return need
 
 
-def _evaluate(scene: Scene, searches: list, picks: list, zs: list) -> float:
-    """Evaluate the picked samples of every section in one batch; return the best value so far."""
+#: samples evaluated per batch: large enough to amortise the per-call cost, small enough for
+#: the progress bar to move every few tens of milliseconds
+_CHUNK = 4096
+
+
+def _evaluate(scene: Scene, searches: list, picks: list, zs: list, done=None) -> float:
+    """Evaluate the picked samples of every section in batches; return the best value so far."""
     phis = np.concatenate([r.phi[ix] for r, ix in zip(searches, picks)])
     if phis.size:
         zi = np.concatenate([np.full(len(ix), i) for i, ix in enumerate(picks)])
-        vals = tooth_clearance_sections(scene, phis, zi, zs)
+        vals = np.empty(len(phis))
+        for a in range(0, len(phis), _CHUNK):
+            b = min(a + _CHUNK, len(phis))
+            vals[a:b] = tooth_clearance_sections(scene, phis[a:b], zi[a:b], zs)
+            if done is not None:
+                done(b / len(phis))
         at = 0
         for r, ix in zip(searches, picks):
             n = len(ix)
@@ -399,13 +496,17 @@ def _classify(scene: Scene, pts: np.ndarray, rigid_idx: int, phi: float, z) -> s
     return "working flank" if side == scene.working else "non-working flank"
 
 
-def entry_crossings(scene: Scene, zs: list) -> list[tuple[float, float]]:
-    """Entry gap (theory.md 5) of each section: the clearance when the tooth's tip crosses the rigid tip circle on the entry side.
+def entry_crossings(scene: Scene, zs: list, exact: bool = True) -> list[tuple[float, float]]:
+    """Entry gap (docs/models.md 5) of each section: the clearance when the tooth's tip crosses the rigid tip circle on the entry side.
 
-    All sections at once: the crossing is bracketed on a 1 deg grid, the
-    brackets are shrunk 32-fold twice by vectorised grids, and the root of
-    the chord across the last bracket is taken (f is smooth there: within
-    ~1e-10 rad, so the clearance moves by less than ``V * 1e-10``, ~3e-10 mm).
+    The tip arc's radial gap to the rigid tip circle is exact
+    (:meth:`Scene.tip_radial`); it is sampled over the whole entry half-wave
+    (1 deg grid), the first crossing from radial overlap (near the major
+    axis) to separation is bracketed, shrunk 32-fold twice by vectorised
+    grids, and the root of the chord across the last bracket taken (f is
+    smooth there: within ~1e-10 rad, the clearance moves by less than
+    ``V * 1e-10``, ~3e-10 mm). The gap itself is refined on the exact curves
+    (``exact``).
 
     Returns
     -------
@@ -413,12 +514,11 @@ def entry_crossings(scene: Scene, zs: list) -> list[tuple[float, float]]:
     """
     sgn = scene.entry_sign
     half = pi / scene.n_w
-    tip = scene.flex_tip_local
     m = len(zs)
 
     def f(p, zi):
         rot, shift = scene.pose_sections(sgn * p, zi, zs)
-        return scene.radial_bound(transform(tip, rot, shift))
+        return scene.tip_radial(rot, shift)
 
     grid = np.linspace(0.0, half, int(round(np.rad2deg(half))) + 1)
     n = len(grid)
@@ -444,9 +544,8 @@ def entry_crossings(scene: Scene, zs: list) -> list[tuple[float, float]]:
         flo, fhi = v[rows, first - 1], v[rows, first]
     out = [(float("nan"), float("nan"))] * m
     if ok.size:
-        # f is smooth across such a bracket: the chord's root is within f''/f' h^2/8 ~ 1e-10 rad
         p_star = lo[ok] - flo * (hi[ok] - lo[ok]) / (fhi - flo)
-        gaps = tooth_clearance_sections(scene, sgn * p_star, ok, zs)
+        gaps = tooth_clearance_sections(scene, sgn * p_star, ok, zs, exact=exact)
         for j, k in enumerate(ok):
             out[k] = (float(gaps[j]), float(sgn * p_star[j]))
     return out
@@ -481,7 +580,6 @@ def lipschitz_min(f, lo: np.ndarray, hi: np.ndarray, V: np.ndarray, tol: float, 
     vs = f(xs, ks)
     i = int(np.argmin(vs))
     best = (float(vs[i]), float(xs[i]), int(ks[i]))
-    # cells between neighbouring grid points of the same function
     same = ks[:-1] == ks[1:]
     a, b, fa, fb, kc = xs[:-1][same], xs[1:][same], vs[:-1][same], vs[1:][same], ks[:-1][same]
     for _ in range(60):
@@ -490,7 +588,6 @@ def lipschitz_min(f, lo: np.ndarray, hi: np.ndarray, V: np.ndarray, tol: float, 
         if not keep.any():
             break
         a, b, fa, fb, kc = a[keep], b[keep], fa[keep], fb[keep], kc[keep]
-        # split each kept cell in SPLIT: one batched call per round (the calls, not the points, cost most)
         t = np.arange(1, SPLIT) / SPLIT
         xi = a[:, None] + (b - a)[:, None] * t[None, :]  # (C, SPLIT-1)
         vi = f(xi.ravel(), np.repeat(kc, SPLIT - 1)).reshape(xi.shape)
@@ -505,35 +602,67 @@ def lipschitz_min(f, lo: np.ndarray, hi: np.ndarray, V: np.ndarray, tol: float, 
     return best
 
 
-def entry_pinch(scene: Scene, crossings, window_deg: float = 6.0, tol: float | None = None):
-    """Smallest clearance near the entry crossing (theory.md 5: the pinch), over sections.
+#: grid step (rad) on which the entry pinch is looked for: 0.25 deg, a quarter of the narrowest
+#: pinch seen on the templates (D1: 0.85 deg from the crossing to the pinch)
+PINCH_STEP = np.deg2rad(0.25)
+
+
+def entry_pinch(scene: Scene, crossings, tol: float | None = None, exact: bool = True):
+    """The pinch (docs/models.md 5): the first local minimum of the clearance after the entry crossing, wherever it lies.
+
+    Each section's clearance is followed from its own crossing toward the
+    major axis on a :data:`PINCH_STEP` grid up to the major axis; the first
+    local minimum of the smallest over the sections is bracketed by its
+    grid neighbours and found within ``tol`` on the polygons
+    (:func:`lipschitz_min` with :meth:`Scene.speed_bound`), then refined on
+    the exact curves by nested grids (``exact``).
 
     Parameters
     ----------
     crossings : list of (phi_star, z)
-        Each section's own crossing angle; searched over ``phi_star +- window``.
     tol : float, optional
-        The result is within ``tol`` mm of the true smallest clearance in
-        the windows (:func:`lipschitz_min` with the speed bound of
-        :meth:`Scene.speed_bound`). Default: a tenth of the chord tolerance;
-        the outlines themselves are only within that tolerance of the
-        curves, so a finer search would be false precision.
+        Default a tenth of the chord tolerance.
 
     Returns ``(clearance mm, phi rad, z, location)``, or None when the
-    smallest value lies at the edge of the window (no pinch).
+    clearance falls without a local minimum all the way to the major axis
+    (no pinch: the tip runs straight into flank engagement).
     """
     tol = 0.1 * scene.drive.tol if tol is None else tol
-    w = np.deg2rad(window_deg)
     zs = [z for _, z in crossings]
-    lo = np.array([p - w for p, _ in crossings])
-    hi = np.array([p + w for p, _ in crossings])
-    V = np.array([scene.speed_bound(np.linspace(a, b, 49), z) for a, b, z in zip(lo, hi, zs)])
-    c_min, p_min, k = lipschitz_min(lambda x, kk: tooth_clearance_sections(scene, x, kk, zs), lo, hi, V, tol)
-    z_min = zs[k]
-    if min(p_min - lo[k], hi[k] - p_min) < 0.5 * (hi[k] - lo[k]) / 24:
-        # smallest at the window's edge: no local minimum near the entry (the clearance
-        # keeps falling into flank engagement, or rises from the crossing on)
+    sgn = scene.entry_sign
+    starts = np.array([abs(p) for p, _ in crossings])
+    n = int(np.ceil(starts.max() / PINCH_STEP)) + 1
+    grid = np.linspace(0.0, 1.0, n)[None, :] * starts[:, None]  # (m, n): 0 .. crossing, per section
+    m = len(zs)
+    vals = tooth_clearance_sections(scene, sgn * grid.ravel(), np.repeat(np.arange(m), n), zs).reshape(m, n)
+    c = vals.min(axis=0)[::-1]  # smallest over sections, walking from the crossing toward the axis
+    phis = grid[:, ::-1]
+    first = None
+    for i in range(1, n - 1):
+        if c[i] < c[i - 1] and c[i] <= c[i + 1]:
+            first = i
+            break
+    if first is None:
         return None
+    lo = np.minimum(phis[:, first - 1], phis[:, first + 1])
+    hi = np.maximum(phis[:, first - 1], phis[:, first + 1])
+    V = np.array([scene.speed_bound(sgn * np.linspace(a, b, 9), z) for a, b, z in zip(lo, hi, zs)])
+    c_min, p_min, k = lipschitz_min(lambda x, kk: tooth_clearance_sections(scene, sgn * x, kk, zs), lo, hi, V, tol)
+    if exact:
+        # the exact curves' minimum near the polygon's: nested 9-point grids, each a quarter of the last
+        w = 2.0 * (hi[k] - lo[k]) / 8
+        p_c = p_min
+        c_min = np.inf
+        for _ in range(4):
+            g = np.clip(p_c + np.linspace(-w, w, 9), lo[k], hi[k])
+            v = tooth_clearance_sections(scene, sgn * g, np.full(9, k), zs, exact=True)
+            j = int(np.argmin(v))
+            if v[j] < c_min:
+                c_min, p_c = float(v[j]), float(g[j])
+            w /= 4.0
+        p_min = p_c
+    z_min = zs[k]
+    p_min = sgn * p_min
     det = tooth_clearance(scene, np.array([p_min]), z_min)
     side = "lower" if det["lower"][0] <= det["upper"][0] else "upper"
     rot, shift = scene.pose(np.array([p_min]), z_min)
@@ -593,6 +722,8 @@ def backlash(scene: Scene, phi_h: float, z=None) -> float:
             fb = f(b)
         if np.sign(fb) == np.sign(f0):
             return float("inf")
+        from scipy.optimize import brentq  # lazy: scipy.optimize costs 0.4-0.8 s to import (issue 13)
+
         return brentq(f, min(a, b), max(a, b), xtol=1e-13)
 
     sides = []
@@ -615,13 +746,63 @@ def backlash(scene: Scene, phi_h: float, z=None) -> float:
     return float(total)
 
 
-def audit(drive, settings: AuditSettings, progress=None) -> AuditResult:
-    """Clearance audit of a drive over generator angles and sections (2D engine).
+def _ticker(progress):
+    """``tick(fraction, stage)`` -> ``progress(done, total, stage)`` in thousandths of the whole audit's work."""
+    if progress is None:
+        return lambda frac, stage: None
+    return lambda frac, stage: progress(int(round(1000 * min(max(frac, 0.0), 1.0))), 1000, stage)
 
-    ``progress``, if given, is called as ``progress(done, total, stage)``.
+
+#: share of an audit's run time spent in each stage (measured on D1, full revolution, 3 sections):
+#: the progress fractions follow the work, not the stage count
+_STAGES = {"clearance": (0.0, 0.70), "refine": (0.70, 0.80), "entry gap": (0.80, 0.86), "pinch": (0.86, 0.95), "backlash": (0.95, 1.0)}
+
+
+def _stage(tick, name):
+    a, b = _STAGES[name]
+    return lambda f: tick(a + (b - a) * f, name)
+
+
+def _canonical(scene: Scene, phi_all: np.ndarray, period: float, phi_w: float, z, exact: bool):
+    """The worst spot folded to the nearest major axis: ``(phi >= 0, location, mirror location, sample index)``.
+
+    Teeth and laws are symmetric: the tooth at ``-phi`` is the mirror image
+    of the one at ``+phi`` with its flanks swapped, so both are named and
+    the spot is reported at ``+|phi|`` whichever sample the search met
+    first (issue 13: the printed spot no longer depends on the shortcuts).
+    The sample is the first (generator angle, tooth) in order whose tooth
+    angle folds to ``+|phi|`` (else ``-|phi|``).
+    """
+    a = abs(float(_fold(np.array([phi_w]), 2 * pi / scene.n_w)[0]))
+    folded = _fold(phi_all.ravel(), 2 * pi / scene.n_w)
+    hit = np.nonzero(np.abs(folded - a) <= 1e-9)[0]
+    sgn = 1.0
+    if hit.size == 0:
+        hit = np.nonzero(np.abs(folded + a) <= 1e-9)[0]
+        sgn = -1.0
+    flat = int(hit[0]) if hit.size else int(np.argmin(np.abs(np.abs(folded) - a)))
+    locs = []
+    for p in (a, -a):
+        det = tooth_clearance(scene, np.array([p]), z, exact=exact)
+        side = min(("lower", "upper", "third"), key=lambda k: det[k][0])
+        ridx = det["up"][0] if side == "upper" else det["lo"][0] if side == "lower" else det["th"][0]
+        pts = scene.place(np.array([p]), z)[0]
+        locs.append(_classify(scene, pts, int(ridx), p, z))
+    return a, locs[0], locs[1], flat, sgn
+
+
+def audit(drive, settings: AuditSettings, progress=None) -> AuditResult:
+    """Clearance audit of a drive over generator angles and sections (2D engine, docs/models.md 5, 7).
+
+    The polygons find the tightest samples (branch and bound with a margin
+    for the polygon-curve difference); every sample that can be the
+    minimum is then refined on the exact curves (``settings.refine``), and
+    so are the entry gap and the pinch. ``progress``, if given, is called as
+    ``progress(done, total, stage)`` with ``done/total`` the fraction of the
+    audit's work done so far.
     """
     t0 = time.perf_counter()
-    tick = progress or (lambda done, total, stage: None)
+    tick = _ticker(progress)
     scene = Scene(drive)
     angles = np.asarray(settings.angles, dtype=float)
     sections = [None] if not drive.coned else [float(z) for z in settings.sections]
@@ -637,51 +818,81 @@ def audit(drive, settings: AuditSettings, progress=None) -> AuditResult:
         phi_u, inverse = key.ravel(), np.arange(key.size)
     order = np.argsort(phi_u, kind="stable")
     phi_sorted = phi_u[order]
-    rank = np.empty_like(order)
-    rank[order] = np.arange(len(order))
     results = [_SectionSearch(scene, phi_sorted, z, settings) for z in sections]
     for r in results:
         r.prepare_bound()
+    st = _stage(tick, "clearance")
+    st(0.0)
     # coarse pass over every section first: the best of any prunes all; then finer strides
-    best = _evaluate(scene, results, [r.coarse() for r in results], sections)
+    best = _evaluate(scene, results, [r.coarse() for r in results], sections, lambda f: st(0.3 * f))
     for step, stride in enumerate((64, 16, 4, 1)):
-        tick(step + 1, 6, "clearance")
-        best = _evaluate(scene, results, [r.candidates(stride, best) for r in results], sections)
-    best = _evaluate(scene, results, [r.culled_needed(best) for r in results], sections)
-    # global minimum and where
-    best, where = np.inf, None
+        best = _evaluate(scene, results, [r.candidates(stride, best) for r in results], sections,
+                         lambda f, s=step: st(0.3 + 0.15 * (s + f)))
+    best = _evaluate(scene, results, [r.culled_needed(best) for r in results], sections, lambda f: st(0.9 + 0.1 * f))
+    best_poly = best
+    # refinement on the exact curves of every sample that can hold the minimum
+    stg = _stage(tick, "refine")
+    stg(0.0)
+    cand_s, cand_i, cand_v = [], [], []
     for si, r in enumerate(results):
-        if np.any(r.evaluated):
-            i = int(np.nanargmin(r.value))
-            if r.value[i] < best:
-                best, where = float(r.value[i]), (si, i)
+        ev = np.nonzero(r.evaluated)[0]
+        lim = best_poly + (2.0 * scene.chord_gap if settings.refine else 0.0)
+        keep = ev[r.value[ev] <= lim]
+        cand_s.append(np.full(keep.size, si))
+        cand_i.append(keep)
+        cand_v.append(r.value[keep])
+    cand_s, cand_i, cand_v = np.concatenate(cand_s), np.concatenate(cand_i), np.concatenate(cand_v)
+    o = np.argsort(cand_v, kind="stable")
+    cand_s, cand_i, cand_v = cand_s[o], cand_i[o], cand_v[o]
+    n_refined = 0
+    if settings.refine:
+        exact_best, where = np.inf, (int(cand_s[0]), int(cand_i[0]))
+        at = 0
+        while at < len(cand_v):
+            # a sample whose polygon figure less the polygon-curve difference is not below the best exact
+            # figure cannot hold the minimum: stop there (candidates are in increasing order)
+            if cand_v[at] - scene.chord_gap >= exact_best:
+                break
+            # the 16 lowest first (they set the bar), then every remaining candidate in one batch:
+            # the refinement's cost is per call, not per sample
+            live = np.nonzero(cand_v[at:] - scene.chord_gap < exact_best)[0] + at if at else np.arange(min(16, len(cand_v)))
+            if live.size == 0:
+                break
+            sl = live
+            vals = tooth_clearance_sections(scene, phi_sorted[cand_i[sl]], cand_s[sl], sections, exact=True)
+            n_refined += len(vals)
+            j = int(np.argmin(vals))
+            if vals[j] < exact_best:
+                exact_best, where = float(vals[j]), (int(cand_s[sl][j]), int(cand_i[sl][j]))
+            at = int(sl[-1]) + 1 if at == 0 else len(cand_v)
+            stg(at / len(cand_v))
+        best = exact_best
+    else:
+        where = (int(cand_s[0]), int(cand_i[0]))
     si, i = where
-    phi_w = float(phi_sorted[i])
-    # a sample (generator angle, tooth) that realises it
-    flat = np.nonzero(rank[inverse.ravel()] == i)[0][0] if settings.use_period else int(order[i])
-    ai, k = divmod(int(flat), scene.z_g)
-    # the sample's own angle (before mirror folding): flanks are labelled on it
-    phi_w = float(_fold(phi_all.ravel()[flat], period))
     z_w = sections[si]
-    detail = tooth_clearance(scene, np.array([phi_w]), z_w, area=True)
+    phi_c, loc, mirror_loc, flat, sgn_c = _canonical(scene, phi_all, period, float(phi_sorted[i]), z_w, settings.refine)
+    ai, k = divmod(flat, scene.z_g)
+    phi_rep = sgn_c * phi_c
+    detail = tooth_clearance(scene, np.array([phi_rep]), z_w, area=True)
     side_val = {"lower": detail["lower"][0], "upper": detail["upper"][0], "third": detail["third"][0]}
     side = min(side_val, key=side_val.get)
-    pts = scene.place(np.array([phi_w]), z_w)[0]
-    ridx = {"lower": detail["lo"][0], "upper": detail["up"][0]}.get(side, detail["lo"][0])
-    location = _classify(scene, pts, int(ridx), phi_w, z_w)
     area = detail.get(f"{side}_area", np.zeros(1))[0] if side != "third" else 0.0
     worst = {
         "clearance_um": round(1e3 * best, 4),
         "tooth": int(k),
         "generator_angle_deg": round(float(np.rad2deg(angles[ai])), 6),
-        "tooth_angle_deg": round(float(np.rad2deg(phi_w)), 6),
+        "tooth_angle_deg": round(float(np.rad2deg(phi_c)), 6),
         "section_z_mm": None if z_w is None else round(z_w, 6),
-        "location": location,
+        "location": loc,
+        "mirror": {"tooth_angle_deg": round(float(np.rad2deg(-phi_c)), 6), "location": mirror_loc},
+        "sample_tooth_angle_deg": round(float(np.rad2deg(phi_rep)), 6),
         "overlap_area_um2": round(1e6 * float(area), 4),
+        "polygon_clearance_um": round(1e3 * best_poly, 4),
     }
-    tick(5, 6, "entry gap")
-    # entry gap: exact crossing per section
-    gaps = list(zip(entry_crossings(scene, sections), sections))
+    ste = _stage(tick, "entry gap")
+    ste(0.0)
+    gaps = list(zip(entry_crossings(scene, sections, exact=settings.refine), sections))
     (eg, ephi), ez = min(gaps, key=lambda t: (np.inf if np.isnan(t[0][0]) else t[0][0]))
     crossed = bool(np.isfinite(eg))  # NaN: the tips never cross the rigid tip circle (no angle, no section)
     entry = {
@@ -689,11 +900,9 @@ def audit(drive, settings: AuditSettings, progress=None) -> AuditResult:
         "section_z_mm": None if ez is None or not crossed else round(ez, 6),
         "side": "entry (+phi)" if scene.entry_sign > 0 else "entry (-phi)",
     }
-    if np.isfinite(eg):
-        # the pinch: smallest clearance around each section's own crossing
-        pinch = entry_pinch(scene, [(g[1], z) for g, z in gaps if np.isfinite(g[0])])
-    else:
-        pinch = None
+    stp = _stage(tick, "pinch")
+    stp(0.0)
+    pinch = entry_pinch(scene, [(g[1], z) for g, z in gaps if np.isfinite(g[0])], exact=settings.refine) if crossed else None
     if pinch is None:
         pp = None
         entry.update({"pinch_um": None, "pinch_tooth_angle_deg": None, "pinch_section_z_mm": None,
@@ -708,10 +917,11 @@ def audit(drive, settings: AuditSettings, progress=None) -> AuditResult:
             # tip-to-tip jamming: the tooth tip meets a rigid tooth before its flank engages
             "tip_to_tip_risk": bool(pc < settings.interference_tol and ploc == "tip"),
         })
-    tick(6, 6, "backlash")
+    _stage(tick, "backlash")(0.0)
     # backlash at the first requested generator angle, middle section
     z_mid = sections[len(sections) // 2]
     bl = [backlash(scene, float(angles[0]), z_mid)]
+    tick(1.0, "done")
     evaluated = int(sum(r.evaluated.sum() for r in results))
     counts = {
         "samples": int(n_samples),
@@ -719,19 +929,29 @@ def audit(drive, settings: AuditSettings, progress=None) -> AuditResult:
         "sections": len(sections),
         "evaluated": evaluated,
         "culled": int(sum(r.culled for r in results)),
+        "refined": int(n_refined),
     }
+    bw = drive.design.drive.face_width
+    ends = (not drive.coned) or (min(sections) <= 1e-9 and max(sections) >= bw - 1e-9)
     rs = {
         "engine": "2d",
         "angles": int(len(angles)),
         "angle_step_deg": round(float(np.rad2deg(np.median(np.diff(angles)))), 6) if len(angles) > 1 else None,
         "sections_z_mm": [None if z is None else round(z, 6) for z in sections],
-        "sections_note": "identical sections (no coning): one computed" if not drive.coned else "coned: every section computed",
+        "sections_note": ("identical sections (no coning): one computed" if not drive.coned else
+                          "coned: every section computed" + ("" if ends else "; the face ends were NOT checked")),
+        "face_ends_checked": bool(ends),
         "mesh_period": bool(settings.use_period),
         "identical_waves": bool(settings.use_waves),
         "mirror_symmetry": bool(settings.use_mirror),
         "culling": bool(settings.cull),
         "branch_and_bound": bool(settings.bound),
         "chord_tol_um": round(1e3 * drive.tol, 6),
+        "refined": bool(settings.refine),
+        "refine_tol_um": round(1e3 * constants.REFINE_TOL, 6) if settings.refine else None,
+        "error_side": ("figures on the exact curves, within refine_tol_um either side" if settings.refine else
+                       "polygon figures: chords lie inside convex and outside concave curve parts, "
+                       "so each figure is within 2 x chord_tol_um of the exact one, either side"),
         "working_flank": scene.working,
         "rigid_pitch_radius_mm": drive.rigid.r,
     }
@@ -747,7 +967,7 @@ def audit(drive, settings: AuditSettings, progress=None) -> AuditResult:
         interference_tol=settings.interference_tol,
         counts=counts,
         settings_angles=angles,
-        raw={"worst_phi": phi_w, "entry_phi": ephi, "pinch_phi": pp},
+        raw={"worst_phi": phi_rep, "entry_phi": ephi, "pinch_phi": pp, "min_clearance_polygon": best_poly},
     )
     res.elapsed_s = time.perf_counter() - t0
     return res

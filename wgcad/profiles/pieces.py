@@ -13,8 +13,10 @@ Kinds and parameters (``params``)
 ``"line"``         ``(x0, y0, dx, dy)``: ``P0 + t D``, ``t`` in ``[0, 1]``.
 ``"involute"``     ``(psi_base, r_base)``: ``r_b sqrt(1+t^2) (cos a, sin a)``,
                    ``a = psi_base - (t - atan t)``, ``t`` the roll parameter.
-``"epicycloid"``   ``(r, rho)``: :func:`wgcad.profiles.cycloid.epicycloid` of roll angle ``t``.
-``"hypocycloid"``  ``(r, rho)``: :func:`wgcad.profiles.cycloid.hypocycloid` of roll angle ``t``.
+``"epicycloid"``   ``(r, rho)``: :func:`wgcad.profiles.cycloid.epicycloid` of roll angle
+                   ``phi``, with ``t = 1 - cos(phi/2)`` (constant speed: no stationary
+                   parameter at the pitch-point cusp, see :func:`roll_to_u`).
+``"hypocycloid"``  ``(r, rho)``: :func:`wgcad.profiles.cycloid.hypocycloid`, same parameter.
 
 Non-arc, non-line kinds are then mirrored (``flip = -1``: ``y -> -y``) and
 turned by ``rot`` about the origin: ``point = R(rot) diag(1, flip) base(t)``.
@@ -26,7 +28,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-__all__ = ["Piece", "arc", "line", "involute", "cycloid", "mirror_path", "merge_arcs", "path_points"]
+__all__ = ["Piece", "arc", "line", "involute", "cycloid", "roll_to_u", "mirror_path", "merge_arcs", "path_points"]
 
 
 def _rot(v: np.ndarray, a: float) -> np.ndarray:
@@ -95,6 +97,22 @@ class Piece:
     def deriv2(self, t) -> np.ndarray:
         """Second derivatives ``d2P/dt2``, ``(n, 2)``."""
         return self._eval(np.atleast_1d(np.asarray(t, dtype=float)), 2)
+
+    def jet(self, t) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """``(point, deriv, deriv2)`` at ``t``, each ``(n, 2)``, in one evaluation."""
+        t = np.atleast_1d(np.asarray(t, dtype=float))
+        k = self.kind
+        if k in ("arc", "line"):
+            return self._eval(t, 0), self._eval(t, 1), self._eval(t, 2)
+        if k == "involute":
+            out = _involute(self.params, t, -1)
+        else:
+            out = _cycloid(self.params, t, -1, 1.0 if k == "epicycloid" else -1.0)
+        if self.flip < 0:
+            out = [o * np.array([1.0, -1.0]) for o in out]
+        if self.rot:
+            out = [_rot(o, self.rot) for o in out]
+        return tuple(out)
 
     def length(self, n: int = 64) -> float:
         """Arc length (Gauss-Legendre on ``n`` nodes; exact for arcs and lines), mm."""
@@ -182,26 +200,50 @@ def _involute(params, t, order):
         return rad1[:, None] * u + (rad * a1)[:, None] * n
     rad2 = rb / (s2 * s)
     a2 = -2.0 * t / (s2 * s2)
-    return (rad2 - rad * a1 * a1)[:, None] * u + (2.0 * rad1 * a1 + rad * a2)[:, None] * n
+    second = (rad2 - rad * a1 * a1)[:, None] * u + (2.0 * rad1 * a1 + rad * a2)[:, None] * n
+    if order == 2:
+        return second
+    return rad[:, None] * u, rad1[:, None] * u + (rad * a1)[:, None] * n, second  # order -1: all three
 
 
-def _cycloid(params, phi, order, sgn):
-    """Epicycloid (``sgn = +1``) or hypocycloid (``-1``) of roll angle ``phi`` and its derivatives (docs/models.md 2.2).
+def _cycloid(params, u, order, sgn):
+    """Epicycloid (``sgn = +1``) or hypocycloid (``-1``) at ``u = 1 - cos(phi/2)`` and its derivatives in ``u`` (docs/models.md 2.2).
 
-    ``P = (r + s rho) e(th) - s rho e(th + s phi)``, ``th = rho phi / r``.
+    ``P = (r + s rho) e(th) - s rho e(th + s phi)``, ``th = rho phi / r``,
+    ``phi`` the roll angle. In ``u`` the speed is constant,
+    ``|dP/du| = 4 rho (1 + s rho / r)`` (``u`` is proportional to the arc
+    length from the cusp on the pitch circle), so the parameter has no
+    stationary point at the pitch point where the two flank pieces meet;
+    the curvature there is infinite (a cusp of either cycloid), and
+    ``d2P/du2`` grows like ``1/sqrt(u)`` toward it.
     """
     r, rho = params
     k = rho / r
     A = r + sgn * rho
-    B = -sgn * rho
-    w1, w2 = k, k + sgn  # angular rates of the two terms
-    a1, a2 = w1 * phi, w2 * phi
-    if order == 0:
-        return np.stack([A * np.cos(a1) + B * np.cos(a2), A * np.sin(a1) + B * np.sin(a2)], axis=-1)
+    u = np.clip(u, 0.0, 2.0)
+    phi = 4.0 * np.arcsin(np.sqrt(0.5 * u))
+    if order in (0, -1):
+        a1, a2 = k * phi, (k + sgn) * phi
+        p0 = np.stack([A * np.cos(a1) - sgn * rho * np.cos(a2), A * np.sin(a1) - sgn * rho * np.sin(a2)], axis=-1)
+        if order == 0:
+            return p0
+    m = 0.5 * (2.0 * k + sgn) * phi
+    cm, sm = np.cos(m), np.sin(m)
+    speed = 4.0 * A * k * sgn
+    p1 = np.stack([speed * cm, speed * sm], axis=-1)
     if order == 1:
-        return np.stack([-A * w1 * np.sin(a1) - B * w2 * np.sin(a2), A * w1 * np.cos(a1) + B * w2 * np.cos(a2)], axis=-1)
-    return np.stack([-A * w1 * w1 * np.cos(a1) - B * w2 * w2 * np.cos(a2),
-                     -A * w1 * w1 * np.sin(a1) - B * w2 * w2 * np.sin(a2)], axis=-1)
+        return p1
+    half = np.maximum(np.sin(0.5 * phi), 1e-12)
+    mu = (2.0 * k + sgn) / half
+    p2 = np.stack([-speed * mu * sm, speed * mu * cm], axis=-1)
+    if order == 2:
+        return p2
+    return p0, p1, p2
+
+
+def roll_to_u(phi):
+    """Cycloid piece parameter ``u = 1 - cos(phi / 2)`` of roll angle ``phi`` (0 at the pitch circle, 1 at ``phi = pi``)."""
+    return 2.0 * np.sin(0.25 * np.asarray(phi, dtype=float)) ** 2
 
 
 # -- constructors ------------------------------------------------------------------
@@ -223,8 +265,11 @@ def involute(psi_base: float, r_base: float, t0: float, t1: float) -> Piece:
 
 
 def cycloid(kind: str, r: float, rho: float, phi0: float, phi1: float, rot: float = 0.0, flip: float = 1.0) -> Piece:
-    """Epi/hypocycloid (``kind``) on pitch radius ``r``, rolling radius ``rho``, roll angle ``phi0 -> phi1``."""
-    return Piece(kind, float(phi0), float(phi1), (float(r), float(rho)), float(rot), float(flip))
+    """Epi/hypocycloid (``kind``) on pitch radius ``r``, rolling radius ``rho``, from roll angle ``phi0`` to ``phi1``.
+
+    The piece's parameter is ``u = 1 - cos(phi/2)`` (:func:`roll_to_u`), not the roll angle.
+    """
+    return Piece(kind, float(roll_to_u(phi0)), float(roll_to_u(phi1)), (float(r), float(rho)), float(rot), float(flip))
 
 
 # -- paths -------------------------------------------------------------------------
