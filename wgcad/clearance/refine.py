@@ -71,19 +71,87 @@ class ExactTooth:
         shapely.prepare(self.polygon)
         self.tol = float(gear.tol)
 
+    def _tables(self):
+        """Per-piece parameters as arrays, so one call evaluates many pieces of one kind (by kind, not by piece)."""
+        n = self.n
+        self.kind = np.array([{"arc": 0, "line": 1, "involute": 2, "epicycloid": 3, "hypocycloid": 3}[p.kind] for p in self.pieces])
+        par = np.zeros((n, 4))
+        for i, p in enumerate(self.pieces):
+            if p.kind == "arc":
+                par[i, :3] = p.params
+            elif p.kind == "line":
+                par[i] = p.params
+            elif p.kind == "involute":
+                par[i, :2] = p.params
+            else:
+                par[i, :3] = (p.params[0], p.params[1], 1.0 if p.kind == "epicycloid" else -1.0)
+        self.par = par
+        self.rot = np.array([p.rot for p in self.pieces])
+        self.flip = np.array([p.flip for p in self.pieces])
+        self.kinds = np.unique(self.kind)
+
     def eval(self, idx: np.ndarray, t: np.ndarray, order: int = 2):
         """Point, first and second derivative ``(K, 2)`` each, for pieces ``idx`` at parameters ``t``."""
-        P = np.empty((len(t), 2))
-        D1 = np.empty((len(t), 2))
-        D2 = np.empty((len(t), 2))
-        for i in np.unique(idx):
-            sel = idx == i
-            p = self.pieces[i]
-            tt = t[sel]
-            if order == 0:
-                P[sel] = p.point(tt)
-            else:
-                P[sel], D1[sel], D2[sel] = p.jet(tt)
+        if not hasattr(self, "par"):
+            self._tables()
+        K = len(t)
+        P = np.empty((K, 2))
+        D1 = np.empty((K, 2))
+        D2 = np.empty((K, 2))
+        kind = self.kind[idx]
+        for kd in self.kinds:
+            sel = kind == kd
+            if not sel.any():
+                continue
+            ii, tt = idx[sel], t[sel]
+            pr = self.par[ii]
+            if kd == 0:  # arc
+                c, s_ = np.cos(tt), np.sin(tt)
+                R = pr[:, 2]
+                P[sel, 0], P[sel, 1] = pr[:, 0] + R * c, pr[:, 1] + R * s_
+                D1[sel, 0], D1[sel, 1] = -R * s_, R * c
+                D2[sel, 0], D2[sel, 1] = -R * c, -R * s_
+                continue
+            if kd == 1:  # line
+                P[sel, 0], P[sel, 1] = pr[:, 0] + tt * pr[:, 2], pr[:, 1] + tt * pr[:, 3]
+                D1[sel, 0], D1[sel, 1] = pr[:, 2], pr[:, 3]
+                D2[sel] = 0.0
+                continue
+            if kd == 2:  # involute, polar form (docs/models.md 2.1)
+                psi, rb = pr[:, 0], pr[:, 1]
+                s2 = 1.0 + tt * tt
+                sq = np.sqrt(s2)
+                a = psi - (tt - np.arctan(tt))
+                ca, sa = np.cos(a), np.sin(a)
+                rad, rad1, rad2 = rb * sq, rb * tt / sq, rb / (s2 * sq)
+                a1, a2 = -tt * tt / s2, -2.0 * tt / (s2 * s2)
+                cu, cn = rad, 0.0
+                du, dn = rad1, rad * a1
+                eu, en = rad2 - rad * a1 * a1, 2.0 * rad1 * a1 + rad * a2
+                px, py = cu * ca, cu * sa
+                qx, qy = du * ca - dn * sa, du * sa + dn * ca
+                rx, ry = eu * ca - en * sa, eu * sa + en * ca
+            else:  # epi/hypocycloid in u = 1 - cos(phi/2) (pieces._cycloid)
+                r, rho, sg = pr[:, 0], pr[:, 1], pr[:, 2]
+                k = rho / r
+                A = r + sg * rho
+                uu = np.clip(tt, 0.0, 2.0)
+                phi = 4.0 * np.arcsin(np.sqrt(0.5 * uu))
+                b1, b2 = k * phi, (k + sg) * phi
+                px = A * np.cos(b1) - sg * rho * np.cos(b2)
+                py = A * np.sin(b1) - sg * rho * np.sin(b2)
+                m = 0.5 * (2.0 * k + sg) * phi
+                cm, sm = np.cos(m), np.sin(m)
+                sp = 4.0 * A * k * sg
+                qx, qy = sp * cm, sp * sm
+                mu = (2.0 * k + sg) / np.maximum(np.sin(0.5 * phi), 1e-12)
+                rx, ry = -sp * mu * sm, sp * mu * cm
+            fl = self.flip[ii]
+            ro = self.rot[ii]
+            c, s_ = np.cos(ro), np.sin(ro)
+            for out, x, y in ((P, px, py), (D1, qx, qy), (D2, rx, ry)):
+                y = fl * y
+                out[sel, 0], out[sel, 1] = c * x - s_ * y, s_ * x + c * y
         return P, D1, D2
 
     def outward(self, idx: np.ndarray, d1: np.ndarray) -> np.ndarray:
@@ -303,11 +371,11 @@ def _one_side(A: ExactTooth, B: ExactTooth, polyA: np.ndarray, ringB, rot, shift
             break
         A_ = active
         # Newton on the reduced F(s) = |D|^2 / 2: minimum when outside (sgn +1), maximum inside (sgn -1);
-        # the reduced curvature kept to [1e-4, 100] x |P'|^2 with the sign of the extremum sought
+        # the reduced curvature kept to [1e-2, 1e4] x |P'|^2 with the sign of the extremum sought
         # (unbounded at a cycloid's pitch-point cusp; the line search keeps every step an improvement)
         gn = np.maximum(a1n[A_], 1e-300)
         with np.errstate(over="ignore", invalid="ignore"):
-            red_c = sgn[A_] * np.clip(sgn[A_] * red[A_], 1e-4 * gn, 100.0 * gn)
+            red_c = sgn[A_] * np.clip(sgn[A_] * red[A_], 1e-2 * gn, 1e4 * gn)
         ds = -g0[A_] / red_c
         # near a crossing of the curves F = |D|^2/2 is flat (D -> 0) while the signed distance is not:
         # step 0.1 um down its slope (the line search halves it as needed)
@@ -316,6 +384,7 @@ def _one_side(A: ExactTooth, B: ExactTooth, polyA: np.ndarray, ringB, rot, shift
             fp = -red[A_][cross] / 1e300
             ds[cross] = -np.sign(fp) * 1e-4 / np.sqrt(gn[cross])
         moved = np.zeros(len(A_))
+        f_before = f[A_].copy()
         todo = np.arange(len(A_))
         for _h in range(8):  # backtrack until the signed value does not rise
             if todo.size == 0:
@@ -334,7 +403,15 @@ def _one_side(A: ExactTooth, B: ExactTooth, polyA: np.ndarray, ringB, rot, shift
             ds[todo] *= 0.5
         # at a stationary point the value is second order in the position: 1e-8 mm of position is
         # ~1e-16 mm of clearance on these curvatures (radii > 1e-3 mm)
-        active = A_[moved > 1e-8]
+        # and a row whose value no longer improves by 1e-12 mm is done whatever its position does
+        # (flat, conformal contact): the figure, not the spot, is what is refined
+        keep = (moved > 1e-8) & (f_before - f[A_] > 1e-12)
+        # rows of one pair that have reached the same spot on the same pieces are one row
+        key = np.stack([kk[A_], ia[A_], ib[A_], np.round(s[A_] * 1e7)], axis=1)
+        _, first = np.unique(key, axis=0, return_index=True)
+        dup = np.ones(len(A_), dtype=bool)
+        dup[first] = False
+        active = A_[keep & ~dup]
     # each candidate measured exactly against the whole of B: a true signed distance of a true curve point
     Pa = _rotate(A.eval(ia, s, order=0)[0], r_k) + sh_k
     val = point_signed_distance(B, Pa)
