@@ -620,8 +620,10 @@ def entry_pinch(scene: Scene, crossings, tol: float | None = None, exact: bool =
 
     Each section's clearance is followed from its own crossing toward the
     major axis on a :data:`PINCH_STEP` grid up to the major axis; the first
-    local minimum of the smallest over the sections is bracketed by its
-    grid neighbours and found within ``tol`` on the polygons
+    minimum of the smallest over the sections that the clearance rises
+    from again by more than the polygons' noise is bracketed (the grid
+    points within that noise of it, and one more each side) and found
+    within ``tol`` on the polygons
     (:func:`lipschitz_min` with :meth:`Scene.speed_bound`), then refined on
     the exact curves by nested grids (``exact``).
 
@@ -645,23 +647,38 @@ def entry_pinch(scene: Scene, crossings, tol: float | None = None, exact: bool =
     vals = tooth_clearance_sections(scene, sgn * grid.ravel(), np.repeat(np.arange(m), n), zs).reshape(m, n)
     c = vals.min(axis=0)[::-1]  # smallest over sections, walking from the crossing toward the axis
     phis = grid[:, ::-1]
+    # the first minimum the clearance rises from again by more than the polygons' noise (twice the
+    # polygon-curve difference): a dip the chord tolerance cannot have made or hidden
+    noise = 2.0 * scene.chord_gap
     first = None
-    for i in range(1, n - 1):
-        if c[i] < c[i - 1] and c[i] <= c[i + 1]:
-            first = i
+    m_i = 0
+    for i in range(1, n):
+        if c[i] < c[m_i]:
+            m_i = i
+        elif c[i] > c[m_i] + noise and m_i > 0:
+            first = m_i
             break
     if first is None:
         return None
-    lo = np.minimum(phis[:, first - 1], phis[:, first + 1])
-    hi = np.maximum(phis[:, first - 1], phis[:, first + 1])
+    # bracket: the run of grid points within the noise of the minimum, and one more each side
+    a_i = first
+    while a_i > 0 and c[a_i - 1] <= c[first] + noise:
+        a_i -= 1
+    b_i = first
+    while b_i < n - 1 and c[b_i + 1] <= c[first] + noise:
+        b_i += 1
+    a_i, b_i = max(a_i - 1, 0), min(b_i + 1, n - 1)
+    lo = np.minimum(phis[:, a_i], phis[:, b_i])
+    hi = np.maximum(phis[:, a_i], phis[:, b_i])
     V = np.array([scene.speed_bound(sgn * np.linspace(a, b, 9), z) for a, b, z in zip(lo, hi, zs)])
     c_min, p_min, k = lipschitz_min(lambda x, kk: tooth_clearance_sections(scene, sgn * x, kk, zs), lo, hi, V, tol)
     if exact:
-        # the exact curves' minimum near the polygon's: nested 9-point grids, each a quarter of the last
-        w = 2.0 * (hi[k] - lo[k]) / 8
-        p_c = p_min
+        # the exact curves' minimum in the bracket: nested 9-point grids, each a quarter of the last,
+        # the first across the whole bracket (the polygons' minimum can sit elsewhere in it)
+        w = 0.5 * (hi[k] - lo[k])
+        p_c = 0.5 * (hi[k] + lo[k])
         c_min = np.inf
-        for _ in range(4):
+        for _ in range(6):
             g = np.clip(p_c + np.linspace(-w, w, 9), lo[k], hi[k])
             v = tooth_clearance_sections(scene, sgn * g, np.full(9, k), zs, exact=True)
             j = int(np.argmin(v))
