@@ -456,21 +456,10 @@ class AuditResult:
     elapsed_s: float = 0.0
 
     def to_json(self) -> dict:
-        r_b = self.settings["rigid_pitch_radius_mm"]
-        return {
-            "min_clearance_um": round(1e3 * self.min_clearance, 4),
-            "entry_gap_um": round(1e3 * self.entry_gap, 4) if np.isfinite(self.entry_gap) else None,
-            "backlash_arcmin": None if not np.isfinite(self.backlash) else round(float(np.rad2deg(self.backlash) * 60.0), 5),
-            "backlash_um_at_pitch": None if not np.isfinite(self.backlash) else round(1e3 * self.backlash * r_b, 4),
-            "backlash_at": self.backlash_range,
-            "interference": bool(self.interference),
-            "interference_tol_um": round(1e3 * self.interference_tol, 4),
-            "worst": self.worst,
-            "entry": self.entry,
-            "settings": self.settings,
-            "counts": self.counts,
-            "elapsed_s": round(self.elapsed_s, 4),
-        }
+        """The JSON document (shaped in :func:`wgcad.report.audit.audit_json`)."""
+        from ..report.audit import audit_json
+
+        return audit_json(self)
 
 
 def _classify(scene: Scene, pts: np.ndarray, rigid_idx: int, phi: float, z) -> str:
