@@ -203,8 +203,9 @@ def test_verify_worst_agrees(name):
     assert out["summary"].startswith("agree") and "\n" not in out["summary"]
     w = out["pairs"][0]
     assert w["tooth_angle_deg"] == pytest.approx(result.worst["tooth_angle_deg"])
-    # the loft's sections include the audit's; 1e-2 um for the angle's rounding to 1e-6 deg (~1 nm at 80 mm)
-    assert w["clearance_2d_um"] <= result.worst["clearance_um"] + 1e-2
+    # the loft's sections include the audit's; the 2D check is on polygons, the audit's figure on the
+    # exact curves: they differ by at most the polygon-curve difference (2 x the chord tolerance)
+    assert w["clearance_2d_um"] <= result.worst["clearance_um"] + 2.0 * result.settings["chord_tol_um"] + 1e-2
     if result.min_clearance < 0:
         assert w["fcl_overlap"]
     else:

@@ -1003,7 +1003,7 @@ def audit(drive, settings: AuditSettings, progress=None) -> AuditResult:
         interference_tol=settings.interference_tol,
         counts=counts,
         settings_angles=angles,
-        raw={"worst_phi": phi_rep, "entry_phi": ephi, "pinch_phi": pp, "min_clearance_polygon": best_poly},
+        raw={"worst_phi": phi_c, "entry_phi": ephi, "pinch_phi": pp, "min_clearance_polygon": best_poly},
     )
     res.elapsed_s = time.perf_counter() - t0
     return res
