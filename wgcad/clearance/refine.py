@@ -125,7 +125,7 @@ class ExactTooth:
                 ca, sa = np.cos(a), np.sin(a)
                 rad, rad1, rad2 = rb * sq, rb * tt / sq, rb / (s2 * sq)
                 a1, a2 = -tt * tt / s2, -2.0 * tt / (s2 * s2)
-                cu, cn = rad, 0.0
+                cu = rad
                 du, dn = rad1, rad * a1
                 eu, en = rad2 - rad * a1 * a1, 2.0 * rad1 * a1 + rad * a2
                 px, py = cu * ca, cu * sa
