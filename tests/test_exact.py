@@ -35,9 +35,9 @@ def _design(name, coned):
 
 
 def _angles(design):
-    """One mesh period at 0.25 deg: every tooth angle the audit meets repeats with this period."""
+    """One mesh period at 0.5 deg: every tooth angle the audit meets repeats with this period."""
     z_b = design.drive.z_rigid
-    n = int(np.ceil(360.0 / z_b / 0.25))
+    n = int(np.ceil(360.0 / z_b / 0.5))
     return np.arange(n) * (2 * pi / z_b) / n
 
 

@@ -118,12 +118,13 @@ def _canonical(scene: Scene, phi_all: np.ndarray, period: float, phi_w: float, z
         sgn = -1.0
     flat = int(hit[0]) if hit.size else int(np.argmin(np.abs(np.abs(folded) - a)))
     locs = []
-    for p in (a, -a):
-        det = tooth_clearance(scene, np.array([p]), z, exact=exact)
-        side = min(("lower", "upper", "third"), key=lambda k: det[k][0])
-        ridx = det["up"][0] if side == "upper" else det["lo"][0] if side == "lower" else det["th"][0]
-        pts = scene.place(np.array([p]), z)[0]
-        locs.append(_classify(scene, pts, int(ridx), p, z))
+    both = np.array([a, -a])
+    det = tooth_clearance(scene, both, z, exact=exact)  # the spot and its mirror image in one call
+    placed = scene.place(both, z)
+    for i, p in enumerate(both):
+        side = min(("lower", "upper", "third"), key=lambda k: det[k][i])
+        ridx = det["up"][i] if side == "upper" else det["lo"][i] if side == "lower" else det["th"][i]
+        locs.append(_classify(scene, placed[i], int(ridx), float(p), z))
     return a, locs[0], locs[1], flat, sgn
 
 
