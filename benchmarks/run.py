@@ -69,14 +69,20 @@ def peak_memory_mb() -> float:
 def bench_audit(quick: bool) -> dict:
     """Issue 4 acceptance: full revolution at 0.5 deg and 3 sections vs the brute force; one mesh period; memory."""
     drive = build_drive(load_design(D1))
-    t_fast, fast = best_of(lambda: audit_of(drive, 0.5, 3), 5)
+    t_fast, fast = best_of(lambda: audit_of(drive, 0.5, 3), 3)
+    t_poly, poly = best_of(lambda: audit_of(drive, 0.5, 3, refine=False), 3)
     mesh = 360.0 / drive.design.drive.z_rigid
     angles_1p = np.deg2rad(np.arange(0.0, mesh, 0.5))
-    t_1p, one = best_of(lambda: audit(drive, AuditSettings(angles=angles_1p, sections=drive.sections(3))), 15)
+    t_1p, one = best_of(lambda: audit(drive, AuditSettings(angles=angles_1p, sections=drive.sections(3))), 5)
+    t_1pp, _ = best_of(lambda: audit(drive, AuditSettings(angles=angles_1p, sections=drive.sections(3), refine=False)), 5)
     out = {
         "machine": machine(),
         "full_revolution_s": t_fast,
+        "full_revolution_polygon_only_s": t_poly,
+        "one_period_polygon_only_s": t_1pp,
+        "refined_samples": fast.counts.get("refined", 0),
         "min_clearance_um": 1e3 * fast.min_clearance,
+        "min_clearance_polygon_um": 1e3 * poly.min_clearance,
         "samples": fast.counts["samples"],
         "evaluated": fast.counts["evaluated"],
         "one_period_s": t_1p,
@@ -117,28 +123,56 @@ TEMPLATES = sorted((ROOT / "templates").glob("*.toml"))
 
 
 def bench_chord_tol(quick: bool) -> list[dict]:
-    """Chord tolerance of the outlines: audit figures against a converged reference (0.01 um outlines), every template."""
+    """Chord tolerance: time against error of the refined engine and of the polygon-only engine (issue 8).
+
+    The reference is the polygon engine on 0.01 um outlines (its own error is below 0.02 um);
+    D1 involute and cycloidal without coning, one mesh period at 0.25 deg (every tooth angle
+    the full revolution meets), where the figures differ between chord tolerances.
+    """
+    from wgcad.design import with_changes
+
     rows = []
-    tols_um = [10.0, 1.0, 0.3] if quick else [30.0, 10.0, 3.0, 1.0, 0.3, 0.1, 0.03]
-    step = 2.0
-    for path in TEMPLATES:
-        design = load_design(path)
-        ref = audit_of(build_drive(design, tol=1e-5), step, 3)
-        t_base = None
-        for tol_um in tols_um:
-            t, (drive, res) = best_of(lambda: (lambda d: (d, audit_of(d, step, 3)))(build_drive(design, tol=tol_um * 1e-3)), 2)
-            t_base = t_base or t
-            eg = abs(res.entry_gap - ref.entry_gap) if np.isfinite(ref.entry_gap) else 0.0
-            rows.append({
-                "template": path.stem,
-                "chord_tol_um": tol_um,
-                "vertices_per_tooth": len(drive.flex.period),
-                "time_s": t,
-                "ratio": t / t_base,
-                "min_clearance_error_um": 1e3 * abs(res.min_clearance - ref.min_clearance),
-                "entry_gap_error_um": 1e3 * eg,
-            })
+    tols_um = [10.0, 1.0, 0.3] if quick else [10.0, 3.0, 1.0, 0.3, 0.1, 0.03]
+    for name in ("d1_involute", "d1_cycloidal"):
+        design = with_changes(load_design(ROOT / "templates" / f"{name}.toml"), generator={"cone_length": None, "generator_z": None})
+        z_b = design.drive.z_rigid
+        n = int(np.ceil(360.0 / z_b / 0.25))
+        angles = np.arange(n) * (2 * pi / z_b) / n
+
+        def run(drive, refine):
+            return audit(drive, AuditSettings(angles=angles, sections=drive.sections(1), refine=refine))
+
+        ref = run(build_drive(design, tol=1e-5), False)
+        for refine in (False, True):
+            t_base = None
+            for tol_um in tols_um:
+                drive = build_drive(design, tol=tol_um * 1e-3)
+                t, res = best_of(lambda: run(drive, refine), 1 if refine else 3)
+                t_base = t_base or t
+                rows.append({
+                    "template": f"{name} ({'refined' if refine else 'polygon'})",
+                    "chord_tol_um": tol_um,
+                    "vertices_per_tooth": len(drive.flex.period),
+                    "time_s": t,
+                    "ratio": t / t_base,
+                    "min_clearance_um": 1e3 * res.min_clearance,
+                    "interference": bool(res.interference),
+                    "min_clearance_error_um": 1e3 * abs(res.min_clearance - ref.min_clearance),
+                    "entry_gap_error_um": 1e3 * abs(res.entry_gap - ref.entry_gap),
+                })
     return rows
+
+
+def bench_process(quick: bool) -> dict:
+    """Whole-process wall time of ``wgcad audit`` on D1 against the in-process audit time (issue 13)."""
+    from wgcad.audit import RunSettings, run_audit
+
+    t_in, _ = best_of(lambda: run_audit(D1, RunSettings()), 1 if quick else 3)
+    cmd = [sys.executable, "-m", "wgcad", "audit", str(D1), "--quiet"]
+    t_proc, _ = best_of(lambda: subprocess.run(cmd, capture_output=True, cwd=ROOT, env={**os.environ, "PYTHONPATH": str(ROOT)}), 1 if quick else 3)
+    t_poly, _ = best_of(lambda: run_audit(D1, RunSettings(refine=False)), 1 if quick else 3)
+    return {"machine": machine(), "in_process_s": t_in, "in_process_polygon_only_s": t_poly, "whole_process_s": t_proc,
+            "import_and_startup_s": t_proc - t_in}
 
 
 def bench_angle_step(quick: bool) -> list[dict]:
@@ -261,13 +295,14 @@ def plot(rows, x, title, path, y="min_clearance_error_um"):
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--quick", action="store_true")
-    ap.add_argument("--only", choices=["audit", "templates", "shortcuts", "chord", "step", "sections", "engines"])
+    ap.add_argument("--only", choices=["audit", "process", "templates", "shortcuts", "chord", "step", "sections", "engines"])
     args = ap.parse_args(argv)
     OUT.mkdir(parents=True, exist_ok=True)
     report = {"machine": machine()}
     md = [f"# wgcad benchmarks\n\nMachine: {machine()}. Designs: the bundled templates (D1 involute where one is named).\n"]
     jobs = [
         ("audit", bench_audit, None),
+        ("process", bench_process, None),
         ("templates", bench_templates, None),
         ("shortcuts", bench_shortcuts, None),
         ("engines", bench_engines, None),

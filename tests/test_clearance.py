@@ -97,6 +97,9 @@ SHORTCUTS = ["use_period", "use_waves", "use_mirror", "cull", "bound"]
 
 
 def _audit(drive, step_deg, k, **kw):
+    # the polygon engine (refine=False) unless a test asks: these tests are about the search,
+    # tests/test_exact.py about the figures on the exact curves
+    kw.setdefault("refine", False)
     angles = np.deg2rad(np.arange(0, 360, step_deg))
     return audit(drive, AuditSettings(angles=angles, sections=drive.sections(k), **kw))
 
@@ -119,7 +122,7 @@ def test_each_shortcut_gives_the_full_answer(name, step, k):
 
 def test_engine_equals_brute_force(d4):
     angles = np.deg2rad(np.arange(0, 360, 5.0))
-    fast = audit(d4, AuditSettings(angles=angles, sections=d4.sections(1)))
+    fast = audit(d4, AuditSettings(angles=angles, sections=d4.sections(1), refine=False))
     assert fast.min_clearance == pytest.approx(brute_force_min(d4, angles, None), abs=1e-11)
 
 
@@ -127,12 +130,12 @@ def test_odd_tooth_counts_interleave_the_waves(d1):
     # 201/203: the waves are offset by half a pitch; folding still holds (theory.md 7)
     odd = build_drive(with_changes(d1.design, drive={"z_flex": 201, "z_rigid": 203}))
     angles = np.deg2rad(np.arange(0, 360, 4.0))
-    fast = audit(odd, AuditSettings(angles=angles, sections=odd.sections(2)))
+    fast = audit(odd, AuditSettings(angles=angles, sections=odd.sections(2), refine=False))
     assert fast.min_clearance == pytest.approx(brute_force_min(odd, angles, odd.sections(2)), abs=1e-11)
     # at one generator angle the two waves hold the same tooth angles with even counts
     # (the fold halves them) and interleaved ones with odd counts (nothing merges)
     def unique(drive, waves):
-        r = audit(drive, AuditSettings(angles=np.array([0.1]), sections=drive.sections(1), use_waves=waves, use_mirror=False))
+        r = audit(drive, AuditSettings(angles=np.array([0.1]), sections=drive.sections(1), use_waves=waves, use_mirror=False, refine=False))
         return r.counts["unique_tooth_angles"]
 
     assert unique(odd, True) == unique(odd, False) == 201
@@ -171,18 +174,25 @@ def test_d1_cycloidal_entry_gap_much_larger_than_involute():
 
 def test_entry_gap_is_clearance_at_the_tip_circle_crossing(d1):
     scene = Scene(d1)
-    res = _audit(d1, 30.0, 3)
+    res = _audit(d1, 30.0, 3, refine=True)
     phi = np.deg2rad(res.entry["tooth_angle_deg"])
     z = res.entry["section_z_mm"]
-    pts = scene.place(np.array([phi]), z)[0]
-    # at the crossing the outermost tooth point is on the rigid tip circle. The reported
-    # angle is rounded to 1e-6 deg (1.7e-8 rad); points move < 3 mm/rad, so < 1e-7 mm
-    assert np.hypot(pts[:, 0], pts[:, 1]).max() == pytest.approx(d1.rigid.r_a, abs=1e-7)
-    assert tooth_clearance(scene, np.array([phi]), z)["min"][0] == pytest.approx(res.entry_gap, abs=1e-7)
-    # the pinch is the smallest clearance near it, to its search tolerance (a tenth of the
-    # chord tolerance) plus the JSON rounding (1e-4 um)
-    near = np.linspace(phi - np.deg2rad(6), phi + np.deg2rad(6), 2401)
-    assert res.entry["pinch_um"] <= 1e3 * tooth_clearance(scene, near, z)["min"].min() + 1e3 * 0.1 * d1.tol + 1e-4
+    rot, shift = scene.pose(np.array([phi]), z)
+    # at the crossing the outermost point of the tip arc is on the rigid tip circle; checked on
+    # a dense sampling of the arc (1e5 points: sagitta 1e-9 mm). The reported angle is rounded
+    # to 1e-6 deg (1.7e-8 rad); points move < 3 mm/rad, so < 1e-7 mm
+    arc = scene.tip_arc
+    p = arc.point(np.linspace(arc.t0, arc.t1, 100001))
+    c, s = np.cos(rot[0]), np.sin(rot[0])
+    placed = p @ np.array([[c, s], [-s, c]]) + shift[0]
+    assert np.hypot(placed[:, 0], placed[:, 1]).max() == pytest.approx(d1.rigid.r_a, abs=1e-7)
+    assert tooth_clearance(scene, np.array([phi]), z, exact=True)["min"][0] == pytest.approx(res.entry_gap, abs=1e-7)
+    # the pinch is no higher than the polygons' smallest clearance near it less their
+    # difference from the curves (2 x chord tolerance per pair), plus the JSON rounding (1e-4 um)
+    pphi = np.deg2rad(res.entry["pinch_tooth_angle_deg"])
+    near = np.linspace(pphi - np.deg2rad(1), pphi + np.deg2rad(1), 401)
+    pz = res.entry["pinch_section_z_mm"]
+    assert res.entry["pinch_um"] <= 1e3 * tooth_clearance(scene, near, pz)["min"].min() + 1e3 * scene.chord_gap + 1e-4
 
 
 def test_backlash_of_a_clean_design_by_rotation(d4):
@@ -207,3 +217,40 @@ def test_backlash_of_a_clean_design_by_rotation(d4):
 def test_interfering_backlash_is_undefined(d1):
     res = _audit(d1, 30.0, 3)
     assert res.interference and res.to_json()["backlash_arcmin"] is None
+
+
+def test_worst_spot_is_canonical_whatever_the_shortcuts(d1):
+    # issue 13: default D1 reported the non-working flank of one tooth at +5.16 deg and
+    # --no-shortcuts the working flank of another at +174.84 deg (mirror images, equal depth):
+    # the spot is now folded to the nearest major axis and reported with its mirror image
+    fast = _audit(d1, 3.0, 3)
+    full = _audit(d1, 3.0, 3, **{s: False for s in SHORTCUTS})
+    for key in ("tooth_angle_deg", "location", "mirror", "section_z_mm", "tooth", "generator_angle_deg"):
+        assert fast.worst[key] == full.worst[key], key
+    assert fast.worst["tooth_angle_deg"] >= 0 and abs(fast.worst["tooth_angle_deg"]) <= 90.0
+    assert fast.worst["mirror"]["tooth_angle_deg"] == -fast.worst["tooth_angle_deg"]
+    flanks = {"working flank", "non-working flank"}
+    if fast.worst["location"] in flanks:
+        assert {fast.worst["location"], fast.worst["mirror"]["location"]} == flanks
+
+
+def test_pinch_is_found_beyond_six_degrees_of_the_crossing():
+    # issue 13, D3: the working-flank clearance falls to about -150 um 7.2 deg after the
+    # crossing, outside the old fixed 6 deg window ("entry pinch: none")
+    d3 = build_drive(load_design(TEMPLATES / "d3_external.toml"))
+    res = _audit(d3, 30.0, 1)
+    e = res.entry
+    assert e["pinch_um"] is not None and e["pinch_um"] < -100.0
+    assert abs(e["pinch_tooth_angle_deg"] - e["tooth_angle_deg"]) > 6.0
+
+
+def test_progress_moves_with_the_work(d1):
+    # issue 13: fine-grained fractions of the actual work, not six fixed stages at the end
+    calls = []
+    angles = np.deg2rad(np.arange(0, 360, 0.5))
+    audit(d1, AuditSettings(angles=angles, sections=d1.sections(3), refine=False), progress=lambda d, t, s: calls.append((d, t, s)))
+    done = [d / t for d, t, _ in calls]
+    assert done == sorted(done) and done[-1] == 1.0
+    assert len(calls) >= 10 and len({round(x, 3) for x in done}) >= 8
+    stages = [s for _, _, s in calls]
+    assert stages.index("entry gap") > stages.index("clearance")

@@ -198,13 +198,18 @@ def test_d1_loft_error_orders(d1):
 def test_verify_worst_agrees(name):
     drive, result = run_audit(TEMPLATES / f"{name}.toml", RunSettings(step_deg=1.0))
     out = fcl3d.verify_worst(drive, result)
-    assert [p["what"] for p in out["pairs"]] == ["tightest", "entry pinch"]
+    # the pinch is checked where the audit finds one (D4: none - its clearance never rises again
+    # from a minimum between the entry crossing and the major axis)
+    has_pinch = result.entry["pinch_um"] is not None
+    assert [p["what"] for p in out["pairs"]] == ["tightest"] + (["entry pinch"] if has_pinch else [])
+    assert has_pinch == (name == "d1_involute")
     assert out["agree"] and all(p["agree"] for p in out["pairs"])
     assert out["summary"].startswith("agree") and "\n" not in out["summary"]
     w = out["pairs"][0]
     assert w["tooth_angle_deg"] == pytest.approx(result.worst["tooth_angle_deg"])
-    # the loft's sections include the audit's; 1e-2 um for the angle's rounding to 1e-6 deg (~1 nm at 80 mm)
-    assert w["clearance_2d_um"] <= result.worst["clearance_um"] + 1e-2
+    # the loft's sections include the audit's; the 2D check is on polygons, the audit's figure on the
+    # exact curves: they differ by at most the polygon-curve difference (2 x the chord tolerance)
+    assert w["clearance_2d_um"] <= result.worst["clearance_um"] + 2.0 * result.settings["chord_tol_um"] + 1e-2
     if result.min_clearance < 0:
         assert w["fcl_overlap"]
     else:

@@ -266,7 +266,7 @@ def independent_clearance(drive, phi_h: float, z) -> np.ndarray:
 
 def check_audit(drive, n_sections: int, picks: list) -> None:
     secs = drive.sections(n_sections)
-    res = audit(drive, AuditSettings(angles=AUDIT_ANGLES, sections=secs))
+    res = audit(drive, AuditSettings(angles=AUDIT_ANGLES, sections=secs, refine=False))
     out = res.to_json()
     json.dumps(out, allow_nan=False)
     assert math.isfinite(res.min_clearance)
@@ -409,7 +409,7 @@ def _raw_figures(data, monkeypatch) -> tuple[dict, dict]:
                 flat[path + k] = v
 
     walk(rep, "")
-    res = audit(drive, AuditSettings(angles=np.deg2rad(np.arange(72) * 5.0), sections=drive.sections(2)))
+    res = audit(drive, AuditSettings(angles=np.deg2rad(np.arange(72) * 5.0), sections=drive.sections(2), refine=False))
     flat["audit.min_clearance_mm"] = res.min_clearance
     flat["audit.entry_gap_mm"] = res.entry_gap
     flat["audit.backlash_at_pitch_mm"] = res.backlash * drive.rigid.r if math.isfinite(res.backlash) else None

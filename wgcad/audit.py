@@ -29,6 +29,7 @@ class RunSettings:
     cull: bool = True
     bound: bool = True
     max_memory_mb: float | None = DEFAULT_MAX_MEMORY_MB  # refuse runs estimated above this (None: no limit)
+    refine: bool = True  # figures on the exact tooth curves (issue 8)
 
     def as_dict(self) -> dict:
         return dict(self.__dict__)
@@ -43,6 +44,13 @@ class RunSettings:
         if not 0.0 <= self.interference_tol_um <= 1000.0:
             raise DesignError("--interference-tol-um", f"must be in [0, 1000] um, got {self.interference_tol_um:g}")
         return self
+
+
+def _sections(drive, k: int) -> np.ndarray:
+    """``k`` sections over the face width, and always both face ends (issue 13: ``--sections 1``
+    checked only mid-face, -14.6 um where the open end was at -58.8 um)."""
+    bw = drive.design.drive.face_width
+    return np.unique(np.concatenate([drive.sections(k), [0.0, bw]]))
 
 
 def run_audit(design_path, rs: RunSettings, progress=None):
@@ -63,12 +71,13 @@ def run_audit(design_path, rs: RunSettings, progress=None):
     angles = np.deg2rad(np.arange(n) * (360.0 / n))
     settings = AuditSettings(
         angles=angles,
-        sections=drive.sections(rs.sections),
+        sections=_sections(drive, rs.sections),
         use_period=rs.use_period,
         use_waves=rs.use_waves,
         use_mirror=rs.use_mirror,
         cull=rs.cull,
         bound=rs.bound,
         interference_tol=rs.interference_tol_um * 1e-3,
+        refine=rs.refine,
     )
     return drive, audit(drive, settings, progress=progress)

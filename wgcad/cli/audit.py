@@ -12,42 +12,9 @@ __all__ = ["register", "cmd_audit"]
 
 
 def _audit_summary(name: str, res: dict) -> str:
-    w = res["worst"]
-    where = f"tooth {w['tooth']} at generator angle {w['generator_angle_deg']:.3f} deg (tooth {w['tooth_angle_deg']:+.3f} deg from the major axis)"
-    if w["section_z_mm"] is not None:
-        where += f", section z = {w['section_z_mm']:g} mm"
-    lines = [f"{name}: clearance audit ({res['settings']['engine']} engine)"]
-    lines.append(f"  minimum clearance: {res['min_clearance_um']:.3f} um, {w['location']}, {where}")
-    if res["interference"]:
-        lines.append(f"  INTERFERENCE: penetration {-res['min_clearance_um']:.3f} um deeper than the tolerance "
-                     f"{res['interference_tol_um']:g} um (overlap area {w['overlap_area_um2']:.1f} um^2)")
-    elif res["min_clearance_um"] < res["interference_tol_um"]:
-        lines.append(f"  contact within the tolerance ({res['interference_tol_um']:g} um): no interference")
-    else:
-        lines.append("  no interference")
-    e = res["entry"]
-    if res["entry_gap_um"] is not None:
-        sec = "" if e["section_z_mm"] is None else f", section z = {e['section_z_mm']:g} mm"
-        lines.append(f"  entry gap: {res['entry_gap_um']:.3f} um at tooth angle {e['tooth_angle_deg']:+.3f} deg{sec} "
-                     "(flexspline tip crossing the rigid tip circle)")
-        if e["pinch_um"] is None:
-            lines.append("  entry pinch: none (no local minimum within 6 deg of the crossing)")
-        else:
-            psec = "" if e["pinch_section_z_mm"] is None else f", section z = {e['pinch_section_z_mm']:g} mm"
-            lines.append(f"  entry pinch: {e['pinch_um']:.3f} um at tooth angle {e['pinch_tooth_angle_deg']:+.3f} deg{psec}, {e['pinch_location']}"
-                         + ("  TIP-TO-TIP RISK" if e["tip_to_tip_risk"] else ""))
-    else:
-        lines.append("  entry gap: none (the tips never cross the rigid tip circle)")
-    b = res["backlash_at"]
-    if res["backlash_arcmin"] is None:
-        lines.append(f"  backlash: none, teeth interfere at generator angle {b['generator_angle_deg']:g} deg")
-    else:
-        lines.append(f"  backlash: {res['backlash_arcmin']:.4f} arcmin = {res['backlash_um_at_pitch']:.2f} um at the rigid pitch circle "
-                     f"(generator angle {b['generator_angle_deg']:g} deg)")
-    c = res["counts"]
-    lines.append(f"  computed {c['evaluated']} of {c['samples']} tooth samples exactly "
-                 f"({c['unique_tooth_angles']} distinct tooth angles, {c['culled']} culled by radius) in {res['elapsed_s']:.3f} s")
-    return "\n".join(lines)
+    from ..report.audit import audit_summary  # shaped in the report layer (issue 8)
+
+    return audit_summary(name, res)
 
 
 def cmd_audit(args) -> int:

@@ -1,0 +1,468 @@
+"""Signed clearance of two placed teeth on their exact curves, refined from the polygon answer (docs/models.md 5).
+
+The polygons find where two teeth come closest; this module computes the
+figure on the analytic pieces (:mod:`wgcad.profiles.pieces`). The signed
+clearance of teeth A and B is ``min(min_s sd_B(P_A(s)), min_t sd_A(P_B(t)))``
+with ``sd_X`` the signed distance to X's boundary (> 0 outside its
+material): the distance when apart, minus the deepest penetration of either
+boundary into the other when overlapping - the polygon engine's definition
+(:func:`wgcad.clearance.distance.signed_clearance`), on the curves.
+
+How: every polygon vertex lies on a piece with a known parameter. The
+vertices whose polygon signed distance is within a margin of the polygon
+minimum seed a Newton iteration on the stationarity conditions of
+``|P(s) - Q(t)|^2`` (a minimum when apart, a saddle - max over s, min over
+t - when overlapping), for the vertex's piece against every piece of the
+other tooth, clamped to the pieces' ranges. Each end point ``P(s)`` is then
+measured exactly against the whole other boundary (projection on every
+piece): every candidate is a true signed distance of a true curve point, so
+the smallest is an upper bound of the exact figure, reached when a seed lies
+in the basin of the true extremum (the polygon's own extremum is within a
+vertex spacing of it). Converged to :data:`wgcad.constants.REFINE_TOL` or
+better (Newton: quadratic; the stop is at 1e-12 mm steps).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import shapely
+
+__all__ = ["ExactTooth", "refine_pairs", "point_signed_distance"]
+
+_NEWTON_STEPS = 40
+_SEED_GRID = 48  # samples per piece to seed the projection of a point
+
+
+class ExactTooth:
+    """One tooth's exact pieces in its own frame, oriented like its (counter-clockwise) polygon.
+
+    Parameters
+    ----------
+    gear : wgcad.profiles.gear.Gear
+    polygon : (N, 2) float
+        ``gear.tooth_polygon()``: the period (reversed for internal gears)
+        closed through the body by two points.
+    """
+
+    def __init__(self, gear, polygon: np.ndarray):
+        pcs = list(gear.pieces)
+        internal = gear.spec.internal
+        if internal:  # the tooth polygon runs the period backwards
+            pcs = [p.reversed() for p in reversed(pcs)]
+        self.pieces = pcs
+        self.n = len(pcs)
+        self.lo = np.array([min(p.t0, p.t1) for p in pcs])
+        self.hi = np.array([max(p.t0, p.t1) for p in pcs])
+        # travel direction of the counter-clockwise polygon along increasing t
+        self.sense = np.array([1.0 if p.t1 >= p.t0 else -1.0 for p in pcs])
+        grid = [np.linspace(lo, hi, _SEED_GRID) for lo, hi in zip(self.lo, self.hi)]
+        self.grid_t = np.array(grid)  # (n, G)
+        self.grid_p = np.stack([p.point(g) for p, g in zip(pcs, grid)])  # (n, G, 2)
+        # longest step between grid points of each piece: bounds how far the nearest grid point can be
+        self.grid_step = np.hypot(*np.diff(self.grid_p, axis=1).transpose(2, 0, 1)).max(axis=1)
+        # every vertex of the period part of the polygon: its piece and parameter
+        n_per = len(gear.period)
+        verts = polygon[:n_per]
+        self.vert_piece, self.vert_t = self._locate(verts)
+        self.n_vert = n_per
+        # farther than the chord tolerance from the curves, the polygon tells inside from outside
+        # exactly; it also closes the tooth through the body where no piece runs
+        self.polygon = shapely.Polygon(polygon)
+        shapely.prepare(self.polygon)
+        self.tol = float(gear.tol)
+
+    def _tables(self):
+        """Per-piece parameters as arrays, so one call evaluates many pieces of one kind (by kind, not by piece)."""
+        n = self.n
+        self.kind = np.array([{"arc": 0, "line": 1, "involute": 2, "epicycloid": 3, "hypocycloid": 3}[p.kind] for p in self.pieces])
+        par = np.zeros((n, 4))
+        for i, p in enumerate(self.pieces):
+            if p.kind == "arc":
+                par[i, :3] = p.params
+            elif p.kind == "line":
+                par[i] = p.params
+            elif p.kind == "involute":
+                par[i, :2] = p.params
+            else:
+                par[i, :3] = (p.params[0], p.params[1], 1.0 if p.kind == "epicycloid" else -1.0)
+        self.par = par
+        self.rot = np.array([p.rot for p in self.pieces])
+        self.flip = np.array([p.flip for p in self.pieces])
+        self.kinds = np.unique(self.kind)
+
+    def eval(self, idx: np.ndarray, t: np.ndarray, order: int = 2):
+        """Point, first and second derivative ``(K, 2)`` each, for pieces ``idx`` at parameters ``t``."""
+        if not hasattr(self, "par"):
+            self._tables()
+        K = len(t)
+        P = np.empty((K, 2))
+        D1 = np.empty((K, 2))
+        D2 = np.empty((K, 2))
+        kind = self.kind[idx]
+        for kd in self.kinds:
+            sel = kind == kd
+            if not sel.any():
+                continue
+            ii, tt = idx[sel], t[sel]
+            pr = self.par[ii]
+            if kd == 0:  # arc
+                c, s_ = np.cos(tt), np.sin(tt)
+                R = pr[:, 2]
+                P[sel, 0], P[sel, 1] = pr[:, 0] + R * c, pr[:, 1] + R * s_
+                D1[sel, 0], D1[sel, 1] = -R * s_, R * c
+                D2[sel, 0], D2[sel, 1] = -R * c, -R * s_
+                continue
+            if kd == 1:  # line
+                P[sel, 0], P[sel, 1] = pr[:, 0] + tt * pr[:, 2], pr[:, 1] + tt * pr[:, 3]
+                D1[sel, 0], D1[sel, 1] = pr[:, 2], pr[:, 3]
+                D2[sel] = 0.0
+                continue
+            if kd == 2:  # involute, polar form (docs/models.md 2.1)
+                psi, rb = pr[:, 0], pr[:, 1]
+                s2 = 1.0 + tt * tt
+                sq = np.sqrt(s2)
+                a = psi - (tt - np.arctan(tt))
+                ca, sa = np.cos(a), np.sin(a)
+                rad, rad1, rad2 = rb * sq, rb * tt / sq, rb / (s2 * sq)
+                a1, a2 = -tt * tt / s2, -2.0 * tt / (s2 * s2)
+                cu = rad
+                du, dn = rad1, rad * a1
+                eu, en = rad2 - rad * a1 * a1, 2.0 * rad1 * a1 + rad * a2
+                px, py = cu * ca, cu * sa
+                qx, qy = du * ca - dn * sa, du * sa + dn * ca
+                rx, ry = eu * ca - en * sa, eu * sa + en * ca
+            else:  # epi/hypocycloid in u = 1 - cos(phi/2) (pieces._cycloid)
+                r, rho, sg = pr[:, 0], pr[:, 1], pr[:, 2]
+                k = rho / r
+                A = r + sg * rho
+                uu = np.clip(tt, 0.0, 2.0)
+                phi = 4.0 * np.arcsin(np.sqrt(0.5 * uu))
+                b1, b2 = k * phi, (k + sg) * phi
+                px = A * np.cos(b1) - sg * rho * np.cos(b2)
+                py = A * np.sin(b1) - sg * rho * np.sin(b2)
+                m = 0.5 * (2.0 * k + sg) * phi
+                cm, sm = np.cos(m), np.sin(m)
+                sp = 4.0 * A * k * sg
+                qx, qy = sp * cm, sp * sm
+                mu = (2.0 * k + sg) / np.maximum(np.sin(0.5 * phi), 1e-12)
+                rx, ry = -sp * mu * sm, sp * mu * cm
+            fl = self.flip[ii]
+            ro = self.rot[ii]
+            c, s_ = np.cos(ro), np.sin(ro)
+            for out, x, y in ((P, px, py), (D1, qx, qy), (D2, rx, ry)):
+                y = fl * y
+                out[sel, 0], out[sel, 1] = c * x - s_ * y, s_ * x + c * y
+        return P, D1, D2
+
+    def outward(self, idx: np.ndarray, d1: np.ndarray) -> np.ndarray:
+        """Unit normals ``(K, 2)`` pointing out of the material (right of the counter-clockwise travel)."""
+        s = self.sense[idx][:, None]
+        n = s * np.stack([d1[:, 1], -d1[:, 0]], axis=-1)
+        return n / np.maximum(np.hypot(n[:, 0], n[:, 1]), 1e-300)[:, None]
+
+    def _locate(self, pts: np.ndarray):
+        """Piece index and parameter of points that lie on the pieces (the polygon's vertices)."""
+        d2 = ((pts[:, None, None, :] - self.grid_p[None]) ** 2).sum(-1)  # (V, n, G)
+        flat = d2.reshape(len(pts), -1).argmin(axis=1)
+        idx, g = np.divmod(flat, _SEED_GRID)
+        t = self.grid_t[idx, g]
+        t = self._project(pts, idx, t)
+        return idx, t
+
+    def _project(self, pts, idx, t, steps: int = 40):
+        """Newton on ``(P(t) - x) . P'(t) = 0`` within each piece's range."""
+        lo, hi = self.lo[idx], self.hi[idx]
+        for _ in range(steps):
+            P, d1, d2 = self.eval(idx, t)
+            r = P - pts
+            g = (r * d1).sum(-1)
+            t_new = np.clip(t - g / _curv_h(d1, r, d2), lo, hi)
+            done = np.abs(t_new - t) <= 1e-15 * np.maximum(1.0, np.abs(t))
+            t = t_new
+            if done.all():
+                break
+        return t
+
+
+def point_signed_distance(tooth: ExactTooth, pts: np.ndarray) -> np.ndarray:
+    """Exact signed distance ``(K,)`` of points ``(K, 2)`` (tooth frame) to the tooth's boundary: > 0 outside its material.
+
+    Each point is projected on every piece (grid seed, clamped Newton); the
+    nearest projection gives the distance, the outward normal there the sign
+    (at a corner shared by two pieces, the piece whose normal is more nearly
+    along the offset decides).
+    """
+    K = len(pts)
+    n = tooth.n
+    d2 = ((pts[:, None, None, :] - tooth.grid_p[None]) ** 2).sum(-1)  # (K, n, G)
+    g = d2.argmin(axis=2)  # (K, n)
+    gmin = np.sqrt(d2.min(axis=2))  # (K, n): nearest grid point of each piece
+    # a piece can hold the nearest point only if its nearest grid point is within one grid step of the best
+    cand = gmin <= gmin.min(axis=1, keepdims=True) + tooth.grid_step[None, :]
+    kk, idx = np.nonzero(cand)
+    t0 = tooth.grid_t[idx, g[kk, idx]]
+    rep = pts[kk]
+    t = tooth._project(rep, idx, t0)
+    P, d1, _ = tooth.eval(idx, t, order=1)
+    D = rep - P
+    dist = np.full((K, n), np.inf)
+    dist[kk, idx] = np.hypot(D[:, 0], D[:, 1])
+    nrm = tooth.outward(idx, d1)
+    cos = np.zeros((K, n))
+    cos[kk, idx] = (D * nrm).sum(-1) / np.maximum(np.hypot(D[:, 0], D[:, 1]), 1e-300)
+    best = dist.min(axis=1)
+    # among pieces whose distance ties the nearest (a corner), trust the most normal offset
+    tie = dist <= best[:, None] + 1e-12
+    c = np.where(tie, cos, 0.0)
+    j = np.abs(c).argmax(axis=1)
+    sign = np.sign(c[np.arange(K), j])
+    sign[sign == 0] = 1.0
+    # away from the curves (or off the ends of the period, where the nearest curve point is an end
+    # and the offset runs along the curve) the polygon decides
+    far = best > 1.5 * tooth.tol
+    if far.any():
+        ins = shapely.contains_xy(tooth.polygon, pts[far, 0], pts[far, 1])
+        sign[far] = np.where(ins, -1.0, 1.0)
+    return sign * best
+
+
+def _curv_h(d1, r, d2):
+    """Second derivative of ``|P(t) - x|^2 / 2`` (``r = P - x``), kept within [0.1, 100] times the Gauss-Newton term.
+
+    Newton's curvature term ``r . P''`` is unbounded at the pitch-point cusp of
+    cycloidal flanks (``P''`` ~ ``1/sqrt(u)``) and negative beyond a centre of
+    curvature; the clamp keeps every step a descent step of bounded length.
+    """
+    gn = np.maximum((d1 * d1).sum(-1), 1e-300)
+    return np.clip(gn + (r * d2).sum(-1), 0.1 * gn, 100.0 * gn)
+
+
+def _rel(rot_a, shift_a, rot_b, shift_b):
+    """Pose of A in B's frame."""
+    rel = rot_a - rot_b
+    d = shift_a - shift_b
+    c, s = np.cos(-rot_b), np.sin(-rot_b)
+    return rel, np.stack([c * d[:, 0] - s * d[:, 1], s * d[:, 0] + c * d[:, 1]], axis=-1)
+
+
+def _rotate(v, rot):
+    c, s = np.cos(rot), np.sin(rot)
+    return np.stack([c * v[:, 0] - s * v[:, 1], s * v[:, 0] + c * v[:, 1]], axis=-1)
+
+
+def _one_side(A: ExactTooth, B: ExactTooth, polyA: np.ndarray, ringB, rot, shift, margin):
+    """``min_s sd_B(P_A(s))`` for each pair (A placed in B's frame by ``rot, shift``), exact; with where it is.
+
+    Returns value (K,), the A piece and parameter, and the point (B frame).
+    """
+    K = len(rot)
+    nv = A.n_vert
+    # polygon signed distance of A's (period) vertices to B's polygon, every pair
+    va = np.einsum("kij,nj->kni", _rotmat(rot), polyA[:nv]) + shift[:, None, :]  # (K, nv, 2)
+    flat = va.reshape(-1, 2)
+    pts = shapely.points(flat)
+    d = shapely.distance(ringB.exterior, pts)
+    inside = shapely.contains_xy(ringB, flat[:, 0], flat[:, 1])
+    sd = np.where(inside, -d, d).reshape(K, nv)
+    lo = sd.min(axis=1)
+    # seeds: local minima of the vertex sequence within the margin of the pair's minimum (the
+    # curve's extrema lie between a vertex and its neighbours; one seed per basin is enough)
+    pad = np.pad(sd, ((0, 0), (1, 1)), constant_values=np.inf)
+    local = (sd <= pad[:, :-2]) & (sd <= pad[:, 2:])
+    # and the two vertices either side: where vertices are sparse (coarse chords, a cycloid's
+    # pitch-point cusp) the curve's extremum can lie a chord or two away from the polygon's
+    near = local.copy()
+    for sh in (1, 2):
+        near[:, sh:] |= local[:, :-sh]
+        near[:, :-sh] |= local[:, sh:]
+    seed_k, seed_v = np.nonzero(near & (sd <= lo[:, None] + margin))
+    # each seed: its vertex's piece (and the neighbouring piece at a junction) against every B piece
+    ia = A.vert_piece[seed_v]
+    sa = A.vert_t[seed_v]
+    rows_k, rows_ia, rows_sa = [seed_k], [ia], [sa]
+    at_end = np.isclose(sa, np.where(A.sense[ia] > 0, A.hi[ia], A.lo[ia]), rtol=0, atol=1e-12) & (ia + 1 < A.n)
+    if at_end.any():
+        nxt = ia[at_end] + 1
+        rows_k.append(seed_k[at_end])
+        rows_ia.append(nxt)
+        rows_sa.append(np.where(A.sense[nxt] > 0, A.lo[nxt], A.hi[nxt]))
+    kk = np.concatenate(rows_k)
+    ia = np.concatenate(rows_ia)
+    s = np.concatenate(rows_sa)
+    # the B pieces that can hold the nearest point to the seed (as in point_signed_distance)
+    P0 = _rotate(A.eval(ia, s, order=0)[0], rot[kk]) + shift[kk]
+    d2 = ((P0[:, None, None, :] - B.grid_p[None]) ** 2).sum(-1)  # (m, nB, G)
+    gmin = np.sqrt(d2.min(axis=2))
+    cand = gmin <= gmin.min(axis=1, keepdims=True) + B.grid_step[None, :]
+    row, ib = np.nonzero(cand)
+    t = B.grid_t[ib, d2[row, ib].argmin(axis=1)]
+    kk, ia, s = kk[row], ia[row], s[row]
+    r_k, sh_k = rot[kk], shift[kk]
+    def project(ib, t, Pa):
+        for _ in range(3):  # warm-started from the last iterate: Newton converges in a few steps
+            Qb, b1, b2 = B.eval(ib, t)
+            D = Pa - Qb
+            t = np.clip(t + (D * b1).sum(-1) / _curv_h(b1, -D, b2), B.lo[ib], B.hi[ib])
+        Qb = B.eval(ib, t, order=0)[0]
+        return t, np.hypot(*(Pa - Qb).T)
+
+    def inner(ia, s, ib, t, r_k, sh_k):
+        """A's point at (ia, s); its projection on B's piece ib, or the neighbouring piece when it runs off an end."""
+        Pa, a1, a2 = A.eval(ia, s)
+        Pa, a1, a2 = _rotate(Pa, r_k) + sh_k, _rotate(a1, r_k), _rotate(a2, r_k)
+        t, dist = project(ib, t, Pa)
+        for step in (1, -1):  # off the end (start) in travel direction: try the next (previous) piece
+            end = np.where(B.sense[ib] * step > 0, B.hi[ib], B.lo[ib])
+            nb = ib + step
+            off = (t == end) & (nb >= 0) & (nb < B.n)
+            if off.any():
+                j = np.nonzero(off)[0]
+                nbj = nb[j]
+                start = np.where(B.sense[nbj] * step > 0, B.lo[nbj], B.hi[nbj])
+                tj, dj = project(nbj, start, Pa[j])
+                better = dj < dist[j]
+                jb = j[better]
+                ib = ib.copy()
+                ib[jb], t[jb], dist[jb] = nbj[better], tj[better], dj[better]
+        Qb, b1, b2 = B.eval(ib, t)
+        D = Pa - Qb
+        sgn = np.where((D * B.outward(ib, b1)).sum(-1) < 0, -1.0, 1.0)
+        far = dist > 1.5 * B.tol  # as in point_signed_distance: the polygon decides away from the curves
+        if far.any():
+            sgn[far] = np.where(shapely.contains_xy(B.polygon, Pa[far, 0], Pa[far, 1]), -1.0, 1.0)
+        g0 = (D * a1).sum(-1)
+        h00 = (a1 * a1).sum(-1) + (D * a2).sum(-1)
+        h11 = (b1 * b1).sum(-1) - (D * b2).sum(-1)
+        h01 = -(a1 * b1).sum(-1)
+        interior = (t > B.lo[ib]) & (t < B.hi[ib])
+        red = h00 - np.where(interior & (h11 > 0), h01 * h01 / np.where(h11 > 0, h11, 1.0), 0.0)
+        red = np.where(dist < 1e-5, np.nan, red)  # at (or 10 nm from) a crossing: see the step below
+        fprime = (B.outward(ib, b1) * a1).sum(-1)  # derivative of the signed distance (envelope theorem)
+        red = np.where(np.isnan(red), -fprime * 1e300, red)  # marks the rows; read back in the loop
+        return ib, t, sgn * dist, g0, red, sgn, (a1 * a1).sum(-1)
+
+    def advance(ia, s_new):
+        """Clamp to the piece, or continue on the next/previous piece of A past a junction."""
+        ia = ia.copy()
+        hi_end = s_new > A.hi[ia]
+        lo_end = s_new < A.lo[ia]
+        fwd = (hi_end & (A.sense[ia] > 0)) | (lo_end & (A.sense[ia] < 0))
+        back = (hi_end & (A.sense[ia] < 0)) | (lo_end & (A.sense[ia] > 0))
+        over = np.abs(s_new - np.clip(s_new, A.lo[ia], A.hi[ia]))  # parameter left beyond the end
+        s_new = np.clip(s_new, A.lo[ia], A.hi[ia])
+        for mask, step in ((fwd, 1), (back, -1)):
+            nxt = ia + step
+            go = mask & (nxt >= 0) & (nxt < A.n)
+            if go.any():
+                n = nxt[go]
+                # carry on along the next piece by the same length (speeds at the junction)
+                v_old = np.hypot(*A.eval(ia[go], s_new[go], order=1)[1].T)
+                start = np.where(A.sense[n] * step > 0, A.lo[n], A.hi[n])
+                v_new = np.maximum(np.hypot(*A.eval(n, start, order=1)[1].T), 1e-300)
+                s_go = start + step * A.sense[n] * over[go] * v_old / v_new
+                s_new[go] = np.clip(s_go, A.lo[n], A.hi[n])
+                ia[go] = n
+        return ia, s_new
+
+    ib, t, f, g0, red, sgn, a1n = inner(ia, s, ib, t, r_k, sh_k)
+    active = np.arange(len(s))
+    for _ in range(_NEWTON_STEPS):
+        if active.size == 0:
+            break
+        A_ = active
+        # Newton on the reduced F(s) = |D|^2 / 2: minimum when outside (sgn +1), maximum inside (sgn -1);
+        # the reduced curvature kept to [1e-2, 1e4] x |P'|^2 with the sign of the extremum sought
+        # (unbounded at a cycloid's pitch-point cusp; the line search keeps every step an improvement)
+        gn = np.maximum(a1n[A_], 1e-300)
+        with np.errstate(over="ignore", invalid="ignore"):
+            red_c = sgn[A_] * np.clip(sgn[A_] * red[A_], 1e-2 * gn, 1e4 * gn)
+        ds = -g0[A_] / red_c
+        # near a crossing of the curves F = |D|^2/2 is flat (D -> 0) while the signed distance is not:
+        # step 0.1 um down its slope (the line search halves it as needed)
+        cross = np.abs(red[A_]) > 1e200
+        if cross.any():
+            fp = -red[A_][cross] / 1e300
+            ds[cross] = -np.sign(fp) * 1e-4 / np.sqrt(gn[cross])
+        moved = np.zeros(len(A_))
+        f_before = f[A_].copy()
+        todo = np.arange(len(A_))
+        for _h in range(8):  # backtrack until the signed value does not rise
+            if todo.size == 0:
+                break
+            rows = A_[todo]
+            ia_try, s_try = advance(ia[rows], s[rows] + ds[todo])
+            res = inner(ia_try, s_try, ib[rows], t[rows], r_k[rows], sh_k[rows])
+            ok = res[2] <= f[rows] + 1e-15
+            good = rows[ok]
+            # how far the point moved (mm); a hop to another piece always counts
+            moved[todo[ok]] = np.where(ia_try[ok] == ia[good], np.abs(s_try[ok] - s[good]) * np.sqrt(a1n[good]), np.inf)
+            ia[good], s[good] = ia_try[ok], s_try[ok]
+            for arr, val in zip((ib, t, f, g0, red, sgn, a1n), res):
+                arr[good] = val[ok]
+            todo = todo[~ok]
+            ds[todo] *= 0.5
+        # at a stationary point the value is second order in the position: 1e-8 mm of position is
+        # ~1e-16 mm of clearance on these curvatures (radii > 1e-3 mm)
+        # and a row whose value no longer improves by 1e-12 mm is done whatever its position does
+        # (flat, conformal contact): the figure, not the spot, is what is refined
+        keep = (moved > 1e-8) & (f_before - f[A_] > 1e-12)
+        # rows of one pair that have reached the same spot on the same pieces are one row
+        key = np.stack([kk[A_], ia[A_], ib[A_], np.round(s[A_] * 1e7)], axis=1)
+        _, first = np.unique(key, axis=0, return_index=True)
+        dup = np.ones(len(A_), dtype=bool)
+        dup[first] = False
+        active = A_[keep & ~dup]
+    # each candidate measured exactly against the whole of B: a true signed distance of a true curve point
+    Pa = _rotate(A.eval(ia, s, order=0)[0], r_k) + sh_k
+    val = point_signed_distance(B, Pa)
+    out = np.full(K, np.inf)
+    order = np.lexsort((val, kk))
+    first = np.ones(len(order), dtype=bool)
+    first[1:] = kk[order][1:] != kk[order][:-1]
+    pick = order[first]
+    out[kk[pick]] = val[pick]
+    where_piece = np.full(K, -1)
+    where_t = np.full(K, np.nan)
+    where_pt = np.full((K, 2), np.nan)
+    where_piece[kk[pick]], where_t[kk[pick]], where_pt[kk[pick]] = ia[pick], s[pick], Pa[pick]
+    return out, where_piece, where_t, where_pt
+
+
+def _rotmat(rot):
+    c, s = np.cos(rot), np.sin(rot)
+    m = np.empty((len(rot), 2, 2))
+    m[:, 0, 0], m[:, 0, 1], m[:, 1, 0], m[:, 1, 1] = c, -s, s, c
+    return m
+
+
+def refine_pairs(A: ExactTooth, polyA, geomA, rot_a, shift_a, B: ExactTooth, polyB, geomB, rot_b, shift_b, margin: float):
+    """Exact signed clearance ``(K,)`` of pairs of placed teeth (A_k at ``rot_a, shift_a``, B_k at ``rot_b, shift_b``).
+
+    ``polyA``/``polyB`` are the teeth's polygons (own frames), ``geomA``/
+    ``geomB`` prepared shapely polygons of them. ``margin`` (mm): vertices
+    whose polygon signed distance is within it of the polygon minimum seed
+    the refinement (module docstring); at least twice the polygons' distance
+    from the curves.
+
+    Returns
+    -------
+    value : (K,) float, mm
+    side : (K,) int
+        0 when the extremum is a point of A's boundary (measured against B),
+        1 when it is a point of B's.
+    point : (K, 2) float
+        That point, in B's frame for side 0 and A's frame for side 1.
+    """
+    rot_a = np.atleast_1d(np.asarray(rot_a, dtype=float))
+    K = len(rot_a)
+    rot_b = np.broadcast_to(np.asarray(rot_b, dtype=float), (K,))
+    shift_a = np.atleast_2d(np.asarray(shift_a, dtype=float))
+    shift_b = np.broadcast_to(np.asarray(shift_b, dtype=float), (K, 2))
+    r1, t1 = _rel(rot_a, shift_a, rot_b, shift_b)
+    v1, _, _, p1 = _one_side(A, B, polyA, geomB, r1, t1, margin)
+    r2, t2 = _rel(rot_b, shift_b, rot_a, shift_a)
+    v2, _, _, p2 = _one_side(B, A, polyB, geomA, r2, t2, margin)
+    side = (v2 < v1).astype(int)
+    value = np.minimum(v1, v2)
+    point = np.where(side[:, None] == 0, p1, p2)
+    return value, side, point

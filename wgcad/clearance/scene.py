@@ -1,0 +1,309 @@
+"""A drive's static data for clearance queries, and the signed clearance of placed teeth on polygons and exact curves (docs/models.md 5)."""
+
+from __future__ import annotations
+
+from math import pi
+
+import numpy as np
+import shapely
+
+from ..kinematics import gear_ratios
+from ..placement import pose_from_displacements, tooth_frames, tooth_pose, transform
+from .distance import Template, signed_clearance
+from .refine import ExactTooth, refine_pairs
+
+__all__ = ["Scene", "tooth_clearance", "tooth_clearance_sections", "clearance_at_poses", "refine_min", "classify"]
+
+
+class Scene:
+    """Static data of a drive for clearance queries: tooth templates and rigid teeth (rigid-gear frame)."""
+
+    def __init__(self, drive):
+        self.drive = drive
+        d = drive.design.drive
+        self.z_g, self.z_b, self.n_w = d.z_flex, d.z_rigid, d.waves
+        self.gamma_b = 2.0 * pi / self.z_b
+        self.flex = Template(drive.flex.tooth_polygon())
+        self.flex_local = self.flex.local
+        # the vertices that can be a tooth's outermost (innermost, external deformation)
+        # point: enough for the radial bound, which is then exact for the polygon
+        R_loc = np.hypot(self.flex_local[:, 0], self.flex_local[:, 1])
+        g = drive.flex
+        near_tip = np.abs(R_loc - g.r_a) <= 0.5 * abs(g.r_a - g.r_f)
+        self.flex_tip_local = np.ascontiguousarray(self.flex_local[near_tip])
+        self.rigid = Template(drive.rigid.tooth_polygon())
+        self.rigid_rot = (np.arange(self.z_b) + 0.5) * self.gamma_b  # tooth centres: the space is on +x
+        self.rigid_shift = np.zeros((self.z_b, 2))
+        self.rigid_pts = transform(self.rigid.local, self.rigid_rot, self.rigid_shift)
+        self.rigid_pts.setflags(write=False)
+        self.rigid_geoms = shapely.polygons(self.rigid_pts)
+        shapely.prepare(self.rigid_geoms)
+        self.external = drive.external
+        self.r_tip_b = drive.rigid.r_a
+        # smallest radius of a rigid tooth polygon (its tip inward, or its body closure for external teeth)
+        self.rigid_r_min = float(np.hypot(self.rigid.local[:, 0], self.rigid.local[:, 1]).min())
+        self.ratios = gear_ratios(self.z_g, self.z_b)
+        rot = 1.0 if d.rotation == "ccw" else -1.0
+        # Relative motion of the flexspline against the rigid gear has the sign of
+        # rot / u_hg. The rigid teeth drive the flexspline (or are driven by it)
+        # through the flank that faces against that motion: the working flank.
+        rel = rot / self.ratios["u_hg"]
+        self.working = "upper" if rel < 0 else "lower"
+        # exact pieces of both teeth, and how far a polygon figure can be from the curves' one:
+        # every vertex is on its curve and every chord within tol of it, so a distance, and a
+        # depth measured from vertices, moves by at most tol per tooth (docs/models.md 5)
+        self.flex_exact = ExactTooth(drive.flex, self.flex.local)
+        self.rigid_exact = ExactTooth(drive.rigid, self.rigid.local)
+        self.chord_gap = 2.0 * drive.tol
+        tip = [p for p in drive.flex.pieces if p.kind == "arc" and np.allclose(p.center, 0.0, atol=1e-12)
+               and abs(p.radius - drive.flex.r_a) <= 1e-9 * drive.flex.r_a]
+        self.tip_arc = tip[0] if tip else None
+        self.entry_sign = rot  # teeth enter engagement on the side the generator turns toward
+        self._laws = {}
+
+    def law(self, z):
+        if z is None:
+            return self.drive.law
+        if z not in self._laws:
+            self._laws[z] = self.drive.law_at(z)
+        return self._laws[z]
+
+    def pose(self, phi: np.ndarray, z=None):
+        """Pose (rotation, shift) of a tooth at angle ``phi`` from the major axis, rigid frame.
+
+        The generator angle is the one that brings a tooth to ``phi`` with its
+        material angle at ``phi (z_b - z_g)/z_b``: by the mesh period every
+        tooth at ``phi`` is congruent to this one relative to the rigid teeth.
+        """
+        phi = np.atleast_1d(np.asarray(phi, dtype=float))
+        mat = phi * (self.z_b - self.z_g) / self.z_b
+        return tooth_pose(self.law(z), phi, self.drive.r_m, frame_angle=mat - phi)
+
+    def pose_sections(self, phi: np.ndarray, zi: np.ndarray, zs: list):
+        """Poses of teeth at angles ``phi[k]`` in sections ``zs[zi[k]]``, in one go.
+
+        For laws linear in W0 (all but the exact ellipse) a coned section's
+        displacements are the centre section's scaled by ``W0(z)/W0``: one
+        evaluation of the law serves every section.
+        """
+        phi = np.atleast_1d(np.asarray(phi, dtype=float))
+        zi = np.asarray(zi)
+        mat = phi * (self.z_b - self.z_g) / self.z_b
+        base = self.drive.law
+        if base.linear_in_w0:
+            st = base.state(phi)
+            f = np.array([self.law(z).w0 / base.w0 for z in zs])[zi]
+            return pose_from_displacements(phi, f * st.w, f * st.v, f * st.theta, self.drive.r_m, mat - phi)
+        rot = np.empty(len(phi))
+        shift = np.empty((len(phi), 2))
+        for i, z in enumerate(zs):
+            sel = zi == i
+            if sel.any():
+                rot[sel], shift[sel] = self.pose(phi[sel], z)
+        return rot, shift
+
+    def place(self, phi: np.ndarray, z=None, local=None) -> np.ndarray:
+        """Tooth polygons at tooth angles ``phi``, rigid frame, ``(K, N, 2)``."""
+        return transform(self.flex_local if local is None else local, *self.pose(phi, z))
+
+    def neighbours(self, shift: np.ndarray, rot: np.ndarray):
+        """Indices of the rigid teeth below and above each placed tooth (by the angle of its centre line), and the third nearest."""
+        c = self.drive.r_m  # a point on the tooth's centre line
+        x = shift[:, 0] + c * np.cos(rot)
+        y = shift[:, 1] + c * np.sin(rot)
+        a = np.arctan2(y, x)
+        f = a / self.gamma_b - 0.5
+        lo = np.floor(f).astype(int)
+        third = np.where(f - lo < 0.5, lo - 1, lo + 2)
+        return lo % self.z_b, (lo + 1) % self.z_b, third % self.z_b
+
+    def speed_bound(self, phi: np.ndarray, z=None) -> float:
+        """Largest speed (mm per rad of ``phi``) of any tooth point relative to the rigid gear.
+
+        A tooth point is ``P = R(beta)(p - (r_m, 0)) + R(mat)(r_m + w, v)``
+        with ``mat = phi (z_b - z_g)/z_b`` and ``beta = mat + theta``, so
+        ``|dP/dphi| <= |beta'| max|p - (r_m, 0)| + |mat'| |(r_m + w, v)| + |(w', v')|``
+        exactly, from the law's derivatives. Taken at every sample, with 10 %
+        for the variation between neighbouring samples (they are < 1e-3 rad
+        apart; the derivatives change by far less than 10 % over that).
+        """
+        st = self.law(z).state(np.asarray(phi, dtype=float))
+        r_m = self.drive.r_m
+        m1 = (self.z_b - self.z_g) / self.z_b
+        lever = float(np.hypot(self.flex_local[:, 0] - r_m, self.flex_local[:, 1]).max())
+        v = np.abs(m1 + st.dtheta) * lever + abs(m1) * np.hypot(r_m + st.w, st.v) + np.hypot(st.dw, st.dv)
+        return 1.1 * float(v.max())
+
+    def radial_bound(self, pts: np.ndarray) -> np.ndarray:
+        """Lower bound of the clearance from radii alone: > 0 when the tooth cannot reach rigid material."""
+        R = np.hypot(pts[..., 0], pts[..., 1])
+        return R.min(axis=1) - self.r_tip_b if self.external else self.r_tip_b - R.max(axis=1)
+
+    def tip_radial(self, rot: np.ndarray, shift: np.ndarray) -> np.ndarray:
+        """Exact radial gap ``(K,)`` between the placed tip arc and the rigid tip circle (> 0: radially clear).
+
+        The tip arc is centred on the tooth frame's origin, which lands on
+        ``shift``: its farthest (nearest) point from the gear axis lies along
+        (against) ``shift`` if that direction falls within the arc, else at
+        an end (docs/models.md 5, entry gap).
+        """
+        arc = self.tip_arc
+        if arc is None:  # no tip arc (never for the built-in forms): fall back to the tip vertices
+            return self.radial_bound(transform(self.flex_tip_local, rot, shift))
+        c = np.hypot(shift[:, 0], shift[:, 1])
+        psi = np.arctan2(shift[:, 1], shift[:, 0])
+        lo_t, hi_t = sorted((arc.t0, arc.t1))
+        want = psi if not self.external else psi + pi  # outermost point (internal deformation), innermost (external)
+        rel = (want - rot - lo_t) % (2 * pi)
+        inside = rel <= hi_t - lo_t
+        ends = []
+        for t in (lo_t, hi_t):
+            ends.append(np.hypot(shift[:, 0] + arc.radius * np.cos(rot + t), shift[:, 1] + arc.radius * np.sin(rot + t)))
+        if self.external:
+            R = np.where(inside, np.abs(arc.radius - c), np.minimum(*ends))
+            return R - self.r_tip_b
+        R = np.where(inside, c + arc.radius, np.maximum(*ends))
+        return self.r_tip_b - R
+
+    def clearance_to(self, rot, shift, j, area: bool = False, flex_geoms=None):
+        """Signed clearance of flexspline teeth at poses ``(rot, shift)`` to rigid teeth ``j`` (polygons)."""
+        return signed_clearance(self.flex, rot, shift, self.rigid, self.rigid_rot[j], self.rigid_shift[j],
+                                b_geoms=self.rigid_geoms[j], area=area, a_geoms=flex_geoms)
+
+    def exact_to(self, rot, shift, j):
+        """Signed clearance of flexspline teeth at poses ``(rot, shift)`` to rigid teeth ``j`` on the exact curves.
+
+        Returns ``(value (K,), side (K,), point (K, 2))`` of :func:`wgcad.clearance.refine.refine_pairs`.
+        """
+        j = np.atleast_1d(j)
+        return refine_pairs(self.flex_exact, self.flex.local, self.flex.polygon, rot, shift,
+                            self.rigid_exact, self.rigid.local, self.rigid.polygon, self.rigid_rot[j], self.rigid_shift[j],
+                            margin=2.0 * self.chord_gap)
+
+
+def tooth_clearance(scene: Scene, phi, z=None, third: bool = True, area: bool = False, exact: bool = False) -> dict:
+    """Signed clearance of a tooth at angles ``phi`` to the rigid teeth below and above it (and the third nearest).
+
+    Returns
+    -------
+    dict of (K,) arrays: ``lower``, ``upper``, ``third`` (mm, negative =
+    penetration depth), ``min``, ``lo``/``up`` rigid tooth indices, and with
+    ``area`` the overlap areas ``lower_area``, ``upper_area``. With
+    ``exact`` the figures of every pair that can hold the minimum are
+    refined on the exact curves (:func:`refine_min`).
+    """
+    phi = np.atleast_1d(np.asarray(phi, dtype=float))
+    rot, shift = scene.pose(phi, z)
+    out = clearance_at_poses(scene, rot, shift, third=third, area=area)
+    return refine_min(scene, rot, shift, out) if exact else out
+
+
+def tooth_clearance_sections(scene: Scene, phi: np.ndarray, zi: np.ndarray, zs: list, exact: bool = False) -> np.ndarray:
+    """Smallest clearance of teeth at angles ``phi[k]`` in sections ``zs[zi[k]]``, in one batch, ``(K,)``."""
+    rot, shift = scene.pose_sections(phi, zi, zs)
+    out = clearance_at_poses(scene, rot, shift)
+    return refine_min(scene, rot, shift, out)["min"] if exact else out["min"]
+
+
+def refine_min(scene: Scene, rot: np.ndarray, shift: np.ndarray, det: dict) -> dict:
+    """Refine on the exact curves every pair of :func:`clearance_at_poses` that can hold a tooth's minimum.
+
+    A pair's exact figure is within ``scene.chord_gap`` of its polygon one,
+    so only pairs whose polygon figure is within twice that of the tooth's
+    smallest are refined; the others keep their polygon figures (they
+    cannot be the minimum). Adds ``refined_lower``/``_upper``/``_third``
+    (bool) and ``point_lower``... (the extremal point, rigid-tooth frame
+    for side 0) to ``det`` and updates the figures and ``min``.
+    """
+    out = dict(det)
+    gap = scene.chord_gap
+    best = det["min"]
+    idx = {"lower": det["lo"], "upper": det["up"]}
+    if "th" in det:
+        idx["third"] = det["th"]
+    needs = {}
+    for key in idx:
+        val = np.asarray(det[key], dtype=float)
+        needs[key] = np.nonzero(np.isfinite(val) & (val <= best + 2.0 * gap))[0]
+    # every pair of every kind in one call: the refinement's cost is per call more than per pair
+    allk = np.concatenate([needs[k] for k in idx])
+    allj = np.concatenate([idx[k][needs[k]] for k in idx])
+    ex = scene.exact_to(rot[allk], shift[allk], allj)[0] if allk.size else np.zeros(0)
+    at = 0
+    for key in idx:
+        val = np.asarray(det[key], dtype=float).copy()
+        need = needs[key]
+        val[need] = ex[at : at + need.size]
+        at += need.size
+        done = np.zeros(len(val), dtype=bool)
+        done[need] = True
+        out[key] = val
+        out[f"refined_{key}"] = done
+    out["min"] = np.minimum(np.minimum(out["lower"], out["upper"]), out.get("third", np.inf))
+    return out
+
+
+def clearance_at_poses(scene: Scene, rot: np.ndarray, shift: np.ndarray, third: bool = True, area: bool = False) -> dict:
+    """:func:`tooth_clearance` for teeth given by their poses (rigid frame)."""
+    lo, up, th = scene.neighbours(shift, rot)
+    pts = transform(scene.flex_local, rot, shift)
+    geoms = shapely.polygons(pts)  # built once, measured against every neighbour
+    out = {}
+    for key, idx in (("lower", lo), ("upper", up)):
+        res = scene.clearance_to(rot, shift, idx, area=area, flex_geoms=geoms)
+        if area:
+            out[key], out[f"{key}_area"] = res
+        else:
+            out[key] = res
+    best = np.minimum(out["lower"], out["upper"])
+    out["third"] = np.full(len(rot), np.inf)
+    if third:
+        # the third tooth lies beyond a bracketing one: 2 R sin(dphi/2) bounds its distance,
+        # with dphi the angular gap between the tooth and the third tooth's flank extent
+        R = np.hypot(pts[..., 0], pts[..., 1])
+        ang = np.arctan2(pts[..., 1], pts[..., 0])
+        tc = scene.rigid_rot[th]
+        gap = np.abs((ang - tc[:, None] + pi) % (2 * pi) - pi).min(axis=1) - pi / scene.z_b
+        r_lo = np.minimum(R.min(axis=1), scene.rigid_r_min)
+        lb = 2.0 * r_lo * np.sin(np.clip(gap, 0.0, None) / 2.0)
+        # polygons lie within the chord tolerance of the curves: the bound is widened by that
+        need = np.nonzero(lb < best + scene.chord_gap)[0]
+        if need.size:
+            out["third"][need] = scene.clearance_to(rot[need], shift[need], th[need], flex_geoms=geoms[need])
+    out["min"] = np.minimum(best, out["third"])
+    out["lo"], out["up"], out["th"] = lo, up, th
+    return out
+
+
+def classify(scene: Scene, pts: np.ndarray, rigid_idx: int, phi: float, z) -> str:
+    """Where on the flexspline tooth the closest approach lies: tip, working/non-working flank, root."""
+    a = shapely.Polygon(pts)
+    b = scene.rigid_geoms[rigid_idx]
+    if a.intersects(b):
+        inter = a.intersection(b)
+        p = np.asarray(inter.representative_point().coords[0]) if not inter.is_empty else np.asarray(pts[0])
+    else:
+        p = np.asarray(shapely.shortest_line(a, b).coords[0])
+    # back to the tooth frame: undo the frame rotation, the tooth rotation and translation
+    law = scene.law(z)
+    mat = phi * (scene.z_b - scene.z_g) / scene.z_b
+    origin, ang = tooth_frames(law, np.array([phi]), scene.drive.r_m)
+    fr = mat - phi
+    c, s = np.cos(-fr), np.sin(-fr)
+    q = np.array([c * p[0] - s * p[1], s * p[0] + c * p[1]]) - origin[0]
+    c, s = np.cos(-ang[0]), np.sin(-ang[0])
+    loc = np.array([c * q[0] - s * q[1], s * q[0] + c * q[1]]) + [scene.drive.r_m, 0.0]
+    R = float(np.hypot(*loc))
+    g = scene.drive.flex
+    m = g.spec.module
+    tip_zone = abs(R - g.r_a) < 0.05 * m
+    root_zone = abs(R - g.r_f) < (g.spec.fillet_coef + 0.05) * m if g.spec.form == "involute" else abs(R - g.r_f) < 0.05 * m
+    if tip_zone:
+        return "tip"
+    if root_zone:
+        return "root"
+    side = "upper" if loc[1] > 0 else "lower"
+    return "working flank" if side == scene.working else "non-working flank"
+
+
+_classify = classify

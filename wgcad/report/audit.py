@@ -1,0 +1,87 @@
+"""Audit findings shaped for people and programs: the JSON document and the printed summary (docs/models.md 5)."""
+
+from __future__ import annotations
+
+import numpy as np
+
+__all__ = ["audit_json", "audit_summary"]
+
+
+def audit_json(result) -> dict:
+    """The JSON document of an :class:`~wgcad.clearance.engine.AuditResult` (units in the key names)."""
+    r = result
+    r_b = r.settings["rigid_pitch_radius_mm"]
+    finite_bl = np.isfinite(r.backlash)
+    return {
+        "min_clearance_um": round(1e3 * r.min_clearance, 4),
+        "entry_gap_um": round(1e3 * r.entry_gap, 4) if np.isfinite(r.entry_gap) else None,
+        "backlash_arcmin": None if not finite_bl else round(float(np.rad2deg(r.backlash) * 60.0), 5),
+        "backlash_um_at_pitch": None if not finite_bl else round(1e3 * r.backlash * r_b, 4),
+        "backlash_at": r.backlash_range,
+        "interference": bool(r.interference),
+        "interference_tol_um": round(1e3 * r.interference_tol, 4),
+        "worst": r.worst,
+        "entry": r.entry,
+        "settings": r.settings,
+        "counts": r.counts,
+        "elapsed_s": round(r.elapsed_s, 4),
+    }
+
+
+def _spot(w: dict) -> str:
+    """The worst spot folded to the nearest major axis, with its mirror image when that is the other flank."""
+    s = f"{w['location']} at {w['tooth_angle_deg']:+.3f} deg from the nearest major axis"
+    m = w.get("mirror")
+    if m and m["location"] != w["location"]:
+        s += f" (and, its mirror image, {m['location']} at {m['tooth_angle_deg']:+.3f} deg)"
+    if w["section_z_mm"] is not None:
+        s += f", section z = {w['section_z_mm']:g} mm"
+    return s + f"; e.g. tooth {w['tooth']} at generator angle {w['generator_angle_deg']:.3f} deg"
+
+
+def audit_summary(name: str, res: dict) -> str:
+    """The printed summary of an audit's JSON document (:func:`audit_json`)."""
+    w = res["worst"]
+    st = res["settings"]
+    lines = [f"{name}: clearance audit ({st['engine']} engine)"]
+    lines.append(f"  minimum clearance: {res['min_clearance_um']:.3f} um, {_spot(w)}")
+    if res["interference"]:
+        lines.append(f"  INTERFERENCE: penetration {-res['min_clearance_um']:.3f} um deeper than the tolerance "
+                     f"{res['interference_tol_um']:g} um (overlap area {w['overlap_area_um2']:.1f} um^2)")
+    elif res["min_clearance_um"] < res["interference_tol_um"]:
+        lines.append(f"  contact within the tolerance ({res['interference_tol_um']:g} um): no interference")
+    else:
+        lines.append("  no interference")
+    e = res["entry"]
+    if res["entry_gap_um"] is not None:
+        sec = "" if e["section_z_mm"] is None else f", section z = {e['section_z_mm']:g} mm"
+        lines.append(f"  entry gap: {res['entry_gap_um']:.3f} um at tooth angle {e['tooth_angle_deg']:+.3f} deg{sec} "
+                     "(flexspline tip crossing the rigid tip circle)")
+        if e["pinch_um"] is None:
+            lines.append("  entry pinch: none (from the crossing to the major axis the clearance never rises again from a minimum)")
+        else:
+            psec = "" if e["pinch_section_z_mm"] is None else f", section z = {e['pinch_section_z_mm']:g} mm"
+            lines.append(f"  entry pinch: {e['pinch_um']:.3f} um at tooth angle {e['pinch_tooth_angle_deg']:+.3f} deg{psec}, {e['pinch_location']}"
+                         + ("  TIP-TO-TIP RISK" if e["tip_to_tip_risk"] else ""))
+    else:
+        lines.append("  entry gap: none (the tips never cross the rigid tip circle)")
+    b = res["backlash_at"]
+    if res["backlash_arcmin"] is None:
+        if res["interference"]:
+            lines.append(f"  backlash: none, teeth interfere at generator angle {b['generator_angle_deg']:g} deg")
+        else:
+            lines.append(f"  backlash: none (the teeth touch at generator angle {b['generator_angle_deg']:g} deg)")
+    else:
+        lines.append(f"  backlash: {res['backlash_arcmin']:.4f} arcmin = {res['backlash_um_at_pitch']:.2f} um at the rigid pitch circle "
+                     f"(generator angle {b['generator_angle_deg']:g} deg)")
+    if st.get("refined"):
+        lines.append(f"  figures refined on the exact tooth curves (to {st['refine_tol_um']:g} um either side; "
+                     f"outlines at {st['chord_tol_um']:g} um chords find where)")
+    else:
+        lines.append(f"  polygon figures: within 2 x {st['chord_tol_um']:g} um of the exact curves' (either side)")
+    if st.get("face_ends_checked") is False:
+        lines.append(f"  WARNING: coned flexspline, sections {st['sections_z_mm']} mm: the face ends were not checked")
+    c = res["counts"]
+    lines.append(f"  computed {c['evaluated']} of {c['samples']} tooth samples on polygons, {c.get('refined', 0)} on the exact curves "
+                 f"({c['unique_tooth_angles']} distinct tooth angles, {c['culled']} culled by radius) in {res['elapsed_s']:.3f} s")
+    return "\n".join(lines)
