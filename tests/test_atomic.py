@@ -159,16 +159,35 @@ def test_commit_all_missing_temp_removes_the_others(tmp_path):
     assert listing(tmp_path) == []
 
 
-def test_commit_all_rename_failure_reports_progress_and_cleans_up(tmp_path):
-    # the second target is a non-empty folder: os.replace onto it fails
-    (tmp_path / "b.dxf").mkdir()
-    (tmp_path / "b.dxf" / "keep").write_text("")
+def test_commit_all_rename_failure_reports_progress_and_cleans_up(tmp_path, monkeypatch):
+    # a file-system fault on the second rename (the targets themselves are fine)
     temps = []
     for name in ("a", "b", "c"):
         t = tmp_path / f".{name}.tmp"
         t.write_text(name)
         temps.append(t)
     finals = [tmp_path / n for n in ("a.dxf", "b.dxf", "c.dxf")]
+    real_replace, calls = os.replace, []
+
+    def flaky_replace(src, dst):
+        calls.append(dst)
+        if len(calls) == 2:
+            raise OSError(5, "Input/output error")
+        return real_replace(src, dst)
+
+    monkeypatch.setattr(os, "replace", flaky_replace)
     with pytest.raises(OutputError, match="1 of 3 files were already written"):
         commit_all(zip(finals, temps))
-    assert listing(tmp_path) == ["a.dxf", "b.dxf"]
+    assert listing(tmp_path) == ["a.dxf"]
+
+
+def test_commit_all_refuses_a_folder_as_target_before_renaming_anything(tmp_path):
+    (tmp_path / "b.dxf").mkdir()
+    temps = []
+    for name in ("a", "b"):
+        t = tmp_path / f".{name}.tmp"
+        t.write_text(name)
+        temps.append(t)
+    with pytest.raises(OutputError, match="b.dxf: is a folder"):
+        commit_all(zip([tmp_path / "a.dxf", tmp_path / "b.dxf"], temps))
+    assert listing(tmp_path) == ["b.dxf"]
