@@ -95,7 +95,7 @@ class Progress:
         if math.isfinite(f):
             f = min(1.0, max(0.0, f))
             if f > self.fraction and self._ref is None:
-                self._ref = (self.clock(), self.fraction)
+                self._ref = (self.clock(), f)
             self.fraction = max(self.fraction, f)
         if stage is not None:
             self.stage = str(stage)
