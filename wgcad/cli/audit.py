@@ -84,7 +84,7 @@ def cmd_audit(args) -> int:
     from .common import Progress, want_progress
     from .outputs import STDOUT, write_stdout
 
-    bar = Progress(want_progress(args.progress))
+    bar = Progress(want_progress(args.progress) and (args.progress or not args.quiet))
     bar.start("loading modules")
     _check_outputs(args)
     from ..audit import RunSettings, run_audit
@@ -235,13 +235,14 @@ def _audit_pngs(drive, result):
 def register(sub) -> None:
     """Add the subcommand to the ``wgcad`` parser's subparsers."""
     import argparse
+    import textwrap
 
     a = sub.add_parser(
         "audit", help="clearance and interference over the generator cycle; exit 1 on interference or baseline drift",
-        description="Signed clearance of every flexspline tooth against its rigid neighbours over a full generator "
+        description=textwrap.fill("Signed clearance of every flexspline tooth against its rigid neighbours over a full generator "
                     "revolution (and several sections when coned): the worst spot, entry gap and pinch, backlash. "
                     "Prints a summary; --json - puts the JSON on standard output and the summary on standard error "
-                    "(--quiet drops it), so the audit can be piped.",
+                    "(--quiet drops it), so the audit can be piped.", width=79),
         epilog=EPILOG, formatter_class=argparse.RawDescriptionHelpFormatter)
     a.add_argument("design", help="design file (TOML), e.g. templates/d1_involute.toml")
     grp = a.add_mutually_exclusive_group()
@@ -265,6 +266,7 @@ def register(sub) -> None:
     a.add_argument("--no-mirror", action="store_true", help="do not use the mirror symmetry c(-phi) = c(phi) with the flanks swapped")
     a.add_argument("--no-culling", action="store_true", help="also evaluate teeth radially clear of all rigid material, and the third-nearest rigid tooth everywhere")
     a.add_argument("--no-bound", action="store_true", help="evaluate every sample (no branch and bound on the Lipschitz lower bound)")
-    a.add_argument("--progress", action="store_true", help="progress bar on stderr even when it is not a terminal")
+    a.add_argument("--progress", action="store_true", help="progress bar (fraction, ETA) on stderr even when it is not a terminal or with --quiet; "
+                   "by default it is drawn only on a terminal")
     a.add_argument("--quiet", action="store_true", help="print no summary")
     a.set_defaults(func=cmd_audit)

@@ -30,6 +30,7 @@ EPILOG = f"""exit codes:
   2    bad input: design file, flag, or output path (one-line message, nothing written)
   3    internal error: a bug in wgcad (one-line message; --traceback or {TRACEBACK_ENV}=1 shows the traceback)
   130  interrupted (Ctrl-C); 143 SIGTERM; 129 SIGHUP: temporary files removed, nothing half-written
+  141  standard output closed by its reader (e.g. | head)
 """
 
 

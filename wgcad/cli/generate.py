@@ -97,7 +97,7 @@ def cmd_generate(args) -> int:
     from .outputs import Manifest, check_output_dir, manifest_name, write_stdout
 
     t0 = time.perf_counter()
-    bar = Progress(want_progress(args.progress))
+    bar = Progress(want_progress(args.progress) and (args.progress or not args.quiet))
     angles = list(args.generator_angle or [])
     total = (_COST["design"] + _COST["dxf"] + (0 if args.no_stl else 2 * _COST["stl"])
              + len(angles) * (_COST["angle_dxf"] + _COST["angle_png"]) + _COST["report"])
@@ -225,14 +225,16 @@ def cmd_generate(args) -> int:
 def register(sub) -> None:
     """Add the subcommand to the ``wgcad`` parser's subparsers."""
     import argparse
+    import textwrap
 
     g = sub.add_parser(
         "generate", help="write DXF, STL, <design>.report.json (and deformed-state DXF/PNG) for a design",
-        description="Write the manufacturing files of a design into one folder: <design>.dxf, "
+        description=textwrap.fill("Write the manufacturing files of a design into one folder: <design>.dxf, "
                     "<design>_flexspline.stl, <design>_rigid.stl, <design>.report.json and, per --generator-angle, "
                     "<design>_phi<angle>.dxf/.png. Several designs can share a folder (each file starts with the design "
                     "file's name). A re-run replaces this design's files and removes those of its previous run that it "
-                    "does not write again (listed in the hidden .<design>.wgcad-files.json), nothing else.",
+                    "does not write again (listed in the hidden .<design>.wgcad-files.json), nothing else, "
+                    "and the temporary files a killed run left (.<file>.<pid>-<hex>.tmp).", width=79),
         epilog=EPILOG, formatter_class=argparse.RawDescriptionHelpFormatter)
     g.add_argument("design", help="design file (TOML), e.g. templates/d1_involute.toml")
     g.add_argument("--out", metavar="DIR", help="output folder (default: output/<design name>); created when the files are written")
@@ -244,6 +246,7 @@ def register(sub) -> None:
     g.add_argument("--force", action="store_true",
                    help="replace the files that a different design file of the same name wrote in --out")
     g.add_argument("--json", action="store_true", help="print the report (as in <design>.report.json) to stdout instead of the summary")
-    g.add_argument("--progress", action="store_true", help="progress bar on stderr even when it is not a terminal")
+    g.add_argument("--progress", action="store_true", help="progress bar (fraction, ETA) on stderr even when it is not a terminal or with --quiet; "
+                   "by default it is drawn only on a terminal")
     g.add_argument("--quiet", action="store_true", help="print nothing on success")
     g.set_defaults(func=cmd_generate)
