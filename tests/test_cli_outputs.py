@@ -134,6 +134,15 @@ def test_full_stdout_is_a_one_line_error():
     one_line_error(r.returncode, r.stderr, "standard output", "No space left on device")
 
 
+def test_reader_closing_the_pipe_is_a_quiet_exit():
+    # `wgcad audit ... --json - | head -c 0`: the reader is gone before wgcad writes
+    p = subprocess.Popen([sys.executable, "-m", "wgcad", "audit", str(D4), "--json", "-", "--quiet"],
+                         env={**os.environ, "PYTHONPATH": str(ROOT)}, stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+    p.stdout.close()
+    err = p.stderr.read().decode()
+    assert p.wait(timeout=120) == 141 and err == ""
+
+
 def test_both_to_stdout_is_refused(capsys):
     code, out, err = run(["audit", D4, "--json", "-", "--write-baseline", "-"], capsys)
     one_line_error(code, err, "only one of them")

@@ -103,10 +103,11 @@ def cmd_generate(args) -> int:
              + len(angles) * (_COST["angle_dxf"] + _COST["angle_png"]) + _COST["report"])
     done = 0.0
 
-    def step(cost, stage):
+    def step(cost, next_stage):
+        """A step of relative cost ``cost`` is finished; ``next_stage`` starts."""
         nonlocal done
-        bar.set(done / total, stage)
         done += cost
+        bar.set(done / total, next_stage)
 
     bar.start("loading modules")
     from ..design import load_design
