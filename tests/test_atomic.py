@@ -159,16 +159,212 @@ def test_commit_all_missing_temp_removes_the_others(tmp_path):
     assert listing(tmp_path) == []
 
 
-def test_commit_all_rename_failure_reports_progress_and_cleans_up(tmp_path):
-    # the second target is a non-empty folder: os.replace onto it fails
-    (tmp_path / "b.dxf").mkdir()
-    (tmp_path / "b.dxf" / "keep").write_text("")
+def test_commit_all_rename_failure_reports_progress_and_cleans_up(tmp_path, monkeypatch):
+    # a file-system fault on the second rename (the targets themselves are fine)
     temps = []
     for name in ("a", "b", "c"):
         t = tmp_path / f".{name}.tmp"
         t.write_text(name)
         temps.append(t)
     finals = [tmp_path / n for n in ("a.dxf", "b.dxf", "c.dxf")]
+    real_replace, calls = os.replace, []
+
+    def flaky_replace(src, dst):
+        calls.append(dst)
+        if len(calls) == 2:
+            raise OSError(5, "Input/output error")
+        return real_replace(src, dst)
+
+    monkeypatch.setattr(os, "replace", flaky_replace)
     with pytest.raises(OutputError, match="1 of 3 files were already written"):
         commit_all(zip(finals, temps))
-    assert listing(tmp_path) == ["a.dxf", "b.dxf"]
+    assert listing(tmp_path) == ["a.dxf"]
+
+
+def test_commit_all_refuses_a_folder_as_target_before_renaming_anything(tmp_path):
+    (tmp_path / "b.dxf").mkdir()
+    temps = []
+    for name in ("a", "b"):
+        t = tmp_path / f".{name}.tmp"
+        t.write_text(name)
+        temps.append(t)
+    with pytest.raises(OutputError, match="b.dxf: is a folder"):
+        commit_all(zip([tmp_path / "a.dxf", tmp_path / "b.dxf"], temps))
+    assert listing(tmp_path) == ["b.dxf"]
+
+
+# -- targets that are not regular files (issue 13: a rename onto /dev/null replaced the device) --
+
+def _special_targets(tmp_path):
+    fifo = tmp_path / "fifo"
+    os.mkfifo(fifo)
+    (tmp_path / "real.json").write_text("keep")
+    link = tmp_path / "link.json"
+    link.symlink_to(tmp_path / "real.json")
+    dangling = tmp_path / "dangling.json"
+    dangling.symlink_to(tmp_path / "nowhere.json")
+    folder = tmp_path / "folder.json"
+    folder.mkdir()
+    return {"fifo": fifo, "link": link, "dangling": dangling, "folder": folder}
+
+
+@pytest.mark.parametrize("kind", ["fifo", "link", "dangling", "folder"])
+def test_special_targets_are_refused_and_left_alone(tmp_path, kind):
+    from wgcad.export.atomic import check_target
+
+    target = _special_targets(tmp_path)[kind]
+    before = os.lstat(target)
+    with pytest.raises(OutputError, match="wgcad writes only new or regular files"):
+        check_target(target)
+    with pytest.raises(OutputError, match="only new or regular"):
+        atomic_write(target, b"x")
+    with pytest.raises(OutputError, match="only new or regular"):
+        with atomic_batch() as batch:
+            batch.temp_path(target)
+    after = os.lstat(target)
+    assert (after.st_mode, after.st_ino) == (before.st_mode, before.st_ino)
+    assert (tmp_path / "real.json").read_text() == "keep"
+    assert not [p for p in os.listdir(tmp_path) if p.endswith(".tmp")]
+
+
+@pytest.mark.parametrize("device", ["/dev/null", "/dev/full", "/dev/stdout"])
+def test_devices_are_refused_even_as_root(device):
+    from wgcad.export.atomic import check_target
+
+    if not os.path.lexists(device):
+        pytest.skip(f"{device} missing here")
+    before = os.lstat(device)
+    with pytest.raises(OutputError, match="only new or regular files"):
+        check_target(device)
+    with pytest.raises(OutputError):
+        atomic_write(device, b"x")
+    after = os.lstat(device)
+    assert (after.st_mode, after.st_ino, after.st_rdev) == (before.st_mode, before.st_ino, before.st_rdev)
+
+
+def test_target_that_turns_into_a_fifo_before_the_commit_is_refused(tmp_path):
+    # checked again just before the rename, not only when the temporary file is made
+    target = tmp_path / "out.json"
+    with pytest.raises(OutputError, match="named pipe"):
+        with atomic_batch() as batch:
+            with open(batch.temp_path(target), "w") as fp:
+                fp.write("new")
+            os.mkfifo(target)
+    assert stat.S_ISFIFO(os.lstat(target).st_mode)
+    assert listing(tmp_path) == ["out.json"]
+
+
+# -- folders: created only when files are written, removed again when the write fails --
+
+def test_check_writable_dir_creates_nothing(tmp_path):
+    from wgcad.export.atomic import check_writable_dir
+
+    check_writable_dir(tmp_path / "a" / "b" / "c")
+    assert listing(tmp_path) == []
+
+
+def test_failed_batch_removes_the_folders_it_created(tmp_path):
+    with pytest.raises(Boom):
+        with atomic_batch() as batch:
+            with open(batch.temp_path(tmp_path / "new" / "sub" / "a.dxf"), "w") as fp:
+                fp.write("x")
+            raise Boom()
+    assert listing(tmp_path) == []
+
+
+def test_failed_batch_keeps_folders_that_hold_other_files(tmp_path):
+    (tmp_path / "old").mkdir()
+    with pytest.raises(Boom):
+        with atomic_batch() as batch:
+            batch.temp_path(tmp_path / "old" / "new" / "a.dxf")
+            (tmp_path / "old" / "new" / "user.txt").write_text("someone else's")
+            raise Boom()
+    assert listing(tmp_path / "old" / "new") == ["user.txt"]
+
+
+@pytest.mark.skipif(not os.path.isdir("/proc/self"), reason="needs a proc file system")
+@pytest.mark.parametrize("folder", ["/proc", "/proc/wgcad-test/out"])
+def test_proc_is_named_as_such_not_no_such_file(folder):
+    from wgcad.export.atomic import check_writable_dir
+
+    with pytest.raises(OutputError) as info:
+        check_writable_dir(folder)
+    msg = str(info.value)
+    assert "proc file system" in msg and "No such file" not in msg
+
+
+def test_a_device_in_the_path_is_named(tmp_path):
+    from wgcad.export.atomic import check_writable_dir
+
+    os.mkfifo(tmp_path / "pipe")
+    with pytest.raises(OutputError, match=r"pipe is a named pipe \(FIFO\), not a folder"):
+        check_writable_dir(tmp_path / "pipe" / "out")
+
+
+# -- leftovers of killed runs --
+
+def _dead_pid():
+    import subprocess
+    import sys
+
+    p = subprocess.Popen([sys.executable, "-c", "pass"])
+    p.wait()
+    return p.pid
+
+
+def test_stale_temps_of_dead_writers_are_removed_and_nothing_else(tmp_path):
+    from wgcad.export.atomic import remove_stale_temps
+
+    dead, alive = _dead_pid(), os.getpid()
+    names = {
+        f".a.dxf.{dead}-0123456789ab.tmp": True,  # writer gone
+        f".b.stl.{alive}-0123456789ab.tmp": False,  # writer alive (a concurrent run)
+        ".c.png.0123456789ab.tmp": True,  # wgcad 0.1.0 name, untouched for two hours
+        ".d.png.0123456789ac.tmp": False,  # wgcad 0.1.0 name, recent
+        f".e.dxf.{dead}-0123456789.tmp": False,  # not wgcad's pattern (10 hex digits)
+        f"f.dxf.{dead}-0123456789ab.tmp": False,  # not hidden
+        "notes.tmp": False,
+        "a.dxf": False,
+    }
+    for name in names:
+        (tmp_path / name).write_text("x")
+    old = os.stat(tmp_path / ".c.png.0123456789ab.tmp").st_mtime - 7200
+    os.utime(tmp_path / ".c.png.0123456789ab.tmp", (old, old))
+    (tmp_path / f".g.dxf.{dead}-0123456789ab.tmp").symlink_to(tmp_path / "a.dxf")  # a link: not ours
+    removed = remove_stale_temps(tmp_path)
+    assert sorted(removed) == sorted(n for n, stale in names.items() if stale)
+    left = set(listing(tmp_path))
+    assert left == {n for n, stale in names.items() if not stale} | {f".g.dxf.{dead}-0123456789ab.tmp"}
+
+
+def test_a_batch_sweeps_its_folder_first(tmp_path):
+    dead = _dead_pid()
+    (tmp_path / f".a.dxf.{dead}-0123456789ab.tmp").write_bytes(b"x" * 1000)
+    with atomic_batch() as batch:
+        with open(batch.temp_path(tmp_path / "a.dxf"), "w") as fp:
+            fp.write("new")
+    assert listing(tmp_path) == ["a.dxf"]
+
+
+def test_temp_names_carry_the_pid(tmp_path):
+    with atomic_writer(tmp_path / "x.dxf") as temp:
+        assert f".x.dxf.{os.getpid()}-" in os.path.basename(temp)
+
+
+def test_commit_removes_listed_files_with_the_renames(tmp_path):
+    (tmp_path / "old.stl").write_text("previous run")
+    with atomic_batch() as batch:
+        with open(batch.temp_path(tmp_path / "new.stl"), "w") as fp:
+            fp.write("this run")
+        batch.remove_on_commit(tmp_path / "old.stl")
+        assert (tmp_path / "old.stl").exists()  # not before the commit
+    assert listing(tmp_path) == ["new.stl"]
+
+
+def test_failed_batch_removes_nothing_listed(tmp_path):
+    (tmp_path / "old.stl").write_text("previous run")
+    with pytest.raises(Boom):
+        with atomic_batch() as batch:
+            batch.remove_on_commit(tmp_path / "old.stl")
+            raise Boom()
+    assert listing(tmp_path) == ["old.stl"]

@@ -127,10 +127,11 @@ def test_generate_writes_everything(d4_run):
             "d4_discrete_phip000_000.png",
             "d4_discrete_phip030_000.dxf",
             "d4_discrete_phip030_000.png",
-            "report.json",
+            "d4_discrete.report.json",
+            ".d4_discrete.wgcad-files.json",
         ]
     )
-    rep = json.loads((d4_run / "report.json").read_text())
+    rep = json.loads((d4_run / "d4_discrete.report.json").read_text())
     for key in ("pitch_radius_mm", "tip_radius_mm", "root_radius_mm", "base_radius_mm", "tooth_thickness_pitch_mm", "space_width_pitch_mm"):
         assert key in rep["flexspline"] and key in rep["rigid"]
     assert rep["drive"]["ratio_rigid_fixed"] == -43 and rep["drive"]["ratio_flexspline_fixed"] == 44

@@ -3,38 +3,87 @@
 from __future__ import annotations
 
 import argparse
+import os
 import sys
 
 from .. import __version__
 from ..errors import WgcadError
 from . import audit, generate, ke, kinematics, sector
-from .common import EPILOG, EXIT_INPUT, EXIT_INTERFERENCE, EXIT_OK, Parser, circle as _circle  # noqa: F401
+from .common import (  # noqa: F401
+    EPILOG,
+    EXIT_INPUT,
+    EXIT_INTERFERENCE,
+    EXIT_INTERNAL,
+    EXIT_OK,
+    TRACEBACK_ENV,
+    Parser,
+    Terminated,
+    circle as _circle,
+    internal_error_line,
+    signals_raise,
+)
 
-__all__ = ["main", "build_parser", "EXIT_OK", "EXIT_INTERFERENCE", "EXIT_INPUT"]
+__all__ = ["main", "build_parser", "EXIT_OK", "EXIT_INTERFERENCE", "EXIT_INPUT", "EXIT_INTERNAL"]
 
 
 def build_parser() -> argparse.ArgumentParser:
     p = Parser(prog="wgcad", description="Geometry, deformation and clearance of harmonic (strain-wave) drives.",
                epilog=EPILOG, formatter_class=argparse.RawDescriptionHelpFormatter)
-    p.add_argument("--version", action="version", version=f"wgcad {__version__}")
-    sub = p.add_subparsers(dest="command", required=True, parser_class=Parser)
+    p.add_argument("--version", action="version", version=f"wgcad {__version__}", help="print the version and exit")
+    p.add_argument("--traceback", action="store_true",
+                   help=f"on an internal error (exit 3) also print the Python traceback (same as {TRACEBACK_ENV}=1)")
+    sub = p.add_subparsers(dest="command", required=True, parser_class=Parser, metavar="COMMAND",
+                           help="generate, audit, kinematics, ke or sector; wgcad COMMAND --help for its flags")
     for mod in (generate, audit, kinematics, ke, sector):
         mod.register(sub)
     return p
 
 
+def _quiet_stdout() -> None:
+    """After a broken pipe, point stdout at /dev/null so the interpreter's final flush stays silent."""
+    try:
+        fd = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(fd, sys.stdout.fileno())
+        os.close(fd)
+    except (OSError, ValueError, AttributeError):
+        pass
+
+
 def main(argv=None) -> int:
-    """Entry point of the ``wgcad`` command; returns the exit code."""
+    """Entry point of the ``wgcad`` command; returns the exit code.
+
+    Exit codes: 0 success, 1 interference or baseline drift (audit), 2 bad
+    input (one line on stderr, nothing written), 3 internal error (one line
+    asking for a report; the traceback with ``--traceback`` or
+    ``WGCAD_TRACEBACK=1``), 128 + signal number when interrupted (SIGINT,
+    SIGTERM, SIGHUP: temporary files are removed first).
+    """
     parser = build_parser()
     args = parser.parse_args(argv)
+    show_tb = args.traceback or os.environ.get(TRACEBACK_ENV, "") not in ("", "0")
     try:
-        return args.func(args)
+        with signals_raise():
+            return args.func(args)
     except WgcadError as e:
-        print(f"wgcad: error: {e}", file=sys.stderr)
+        print(f"wgcad: error: {' '.join(str(e).split())}", file=sys.stderr)
         return e.exit_code
+    except Terminated as e:
+        print(f"wgcad: stopped by {e.name}; temporary files removed, no file half-written", file=sys.stderr)
+        return 128 + e.signum
     except KeyboardInterrupt:
-        print("wgcad: interrupted; nothing was written", file=sys.stderr)
+        print("wgcad: interrupted; temporary files removed, no file half-written", file=sys.stderr)
         return 130
+    except BrokenPipeError:
+        # the reader of our stdout went away (`wgcad audit --json - | head`): nothing more to say
+        _quiet_stdout()
+        return 141  # 128 + SIGPIPE, what a shell reports for a process killed by it
+    except Exception as e:  # noqa: BLE001 (the one place that turns bugs into a clear exit)
+        if show_tb:
+            import traceback
+
+            traceback.print_exc()
+        print(internal_error_line(e), file=sys.stderr)
+        return EXIT_INTERNAL
 
 
 if __name__ == "__main__":  # pragma: no cover

@@ -3,22 +3,34 @@
 from __future__ import annotations
 
 import argparse
+import contextlib
+import os
+import signal
 import sys
 from pathlib import Path
 
 from ..errors import WgcadError
+from .progress import Progress
 
-__all__ = ["EXIT_OK", "EXIT_INTERFERENCE", "EXIT_INPUT", "EPILOG", "Parser", "angles_deg", "positive_float",
-           "angle_count", "add_memory_flag", "out_dir", "angle_tag", "circle", "Progress"]
+__all__ = ["EXIT_OK", "EXIT_INTERFERENCE", "EXIT_INPUT", "EXIT_INTERNAL", "EPILOG", "TRACEBACK_ENV", "Parser",
+           "angles_deg", "positive_float", "angle_count", "out_dir", "angle_tag", "circle", "Progress",
+           "Terminated", "signals_raise", "internal_error_line", "want_progress", "add_memory_flag"]
 
 EXIT_OK = 0
-EXIT_INTERFERENCE = 1  # reserved for `wgcad audit`: interference found
-EXIT_INPUT = 2  # bad design file, flag or output folder; nothing written
+EXIT_INTERFERENCE = 1  # reserved for `wgcad audit`: interference found or baseline drift
+EXIT_INPUT = 2  # bad design file, flag or output path; nothing written
+EXIT_INTERNAL = 3  # an unexpected error inside wgcad (a bug): one line, a request for a report
 
-EPILOG = """exit codes:
-  0  success
-  1  interference found (audit)
-  2  bad input: design file, flag, or output folder (one-line message, nothing written)
+#: set to 1 to get the Python traceback of an internal error (same as --traceback)
+TRACEBACK_ENV = "WGCAD_TRACEBACK"
+
+EPILOG = f"""exit codes:
+  0    success
+  1    interference found, or drift from --baseline (audit)
+  2    bad input: design file, flag, or output path (one-line message, nothing written)
+  3    internal error: a bug in wgcad (one-line message; --traceback or {TRACEBACK_ENV}=1 shows the traceback)
+  130  interrupted (Ctrl-C); 143 SIGTERM; 129 SIGHUP: temporary files removed, nothing half-written
+  141  standard output closed by its reader (e.g. | head)
 """
 
 
@@ -31,6 +43,67 @@ class Parser(argparse.ArgumentParser):
 
 class _UsageError(WgcadError, ValueError):
     pass
+
+
+class Terminated(KeyboardInterrupt):
+    """SIGTERM or SIGHUP turned into an exception, so the same clean-up as Ctrl-C runs (temporary files removed)."""
+
+    def __init__(self, signum: int):
+        super().__init__(signum)
+        self.signum = signum
+        self.name = signal.Signals(signum).name
+
+
+@contextlib.contextmanager
+def signals_raise():
+    """While active, SIGTERM and SIGHUP raise :class:`Terminated` in the main thread (SIGINT already raises)."""
+    def handler(signum, frame):
+        raise Terminated(signum)
+
+    saved = {}
+    for name in ("SIGTERM", "SIGHUP"):
+        sig = getattr(signal, name, None)
+        if sig is None:  # pragma: no cover (Windows has no SIGHUP)
+            continue
+        try:
+            saved[sig] = signal.signal(sig, handler)
+        except ValueError:  # not the main thread: leave the handlers alone
+            break
+    try:
+        yield
+    finally:
+        for sig, old in saved.items():
+            signal.signal(sig, old)
+
+
+def internal_error_line(exc: BaseException) -> str:
+    """One line for an unexpected exception: what, where in wgcad, and what to do."""
+    import traceback
+
+    what = " ".join(str(exc).split()) or "(no message)"
+    if len(what) > 200:
+        what = what[:197] + "..."
+    where = ""
+    frames = [f for f in traceback.extract_tb(exc.__traceback__) if f"{os.sep}wgcad{os.sep}" in f.filename]
+    if frames:
+        f = frames[-1]
+        rel = f.filename[f.filename.rfind(f"{os.sep}wgcad{os.sep}") + 1:]
+        where = f" at {rel}:{f.lineno}"
+    kind = type(exc).__name__
+    if isinstance(exc, MemoryError):
+        what = "out of memory" + ("" if what == "(no message)" else f" ({what})")
+    return (f"wgcad: internal error: {kind}: {what}{where}; this is a bug in wgcad, please report it with the design "
+            f"file and the command (run with --traceback or {TRACEBACK_ENV}=1 for the traceback)")
+
+
+def want_progress(flag: bool) -> bool:
+    """The bar is drawn when asked for, or when stderr is a terminal."""
+    if flag:
+        return True
+    try:
+        return sys.stderr.isatty()
+    except (AttributeError, ValueError):
+        return False
 
 
 def angles_deg(text: str) -> list[float]:
@@ -100,19 +173,3 @@ def circle(radius: float, tol: float):
     n = max(64, int(np.ceil(2 * np.pi / step)))
     t = np.linspace(0.0, 2 * np.pi, n, endpoint=False)
     return np.stack([radius * np.cos(t), radius * np.sin(t)], axis=1)
-
-
-class Progress:
-    """A one-line progress bar on stderr, only when stderr is a terminal (or forced)."""
-
-    def __init__(self, enabled: bool):
-        self.enabled = enabled
-
-    def __call__(self, done, total, stage):
-        if self.enabled:
-            n = int(30 * done / total)
-            sys.stderr.write(f"\r[{'#' * n}{'.' * (30 - n)}] {stage:<12s}")
-            sys.stderr.flush()
-            if done == total:
-                sys.stderr.write("\n")
-

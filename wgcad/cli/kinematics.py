@@ -18,6 +18,10 @@ def cmd_kinematics(args) -> int:
 
     design = load_design(args.design)
     drive = build_drive(design)
+    if design.external:  # judge the output folder before printing anything
+        from .outputs import check_output_dir
+
+        check_output_dir(out_dir(args, args.design))
     d = design.drive
     r = gear_ratios(d.z_flex, d.z_rigid)
 
@@ -32,11 +36,10 @@ def cmd_kinematics(args) -> int:
           f"(the {'rigid' if d.fixed == 'rigid' else 'flexspline'} teeth pass one pitch)")
     if not design.external:
         return EXIT_OK
-    from ..export.atomic import atomic_batch, ensure_writable_dir
+    from ..export.atomic import atomic_batch
     from ..kinematics import ring_generator_velocities
 
-    out = out_dir(args, args.design)
-    ensure_writable_dir(out)
+    out = out_dir(args, args.design)  # checked above; created with the files
     a_w = design.w0 if args.eccentricity is None else args.eccentricity
     phi = np.linspace(0.0, np.pi, 721)
     vel = ring_generator_velocities(drive.law, phi, args.omega_h, design.flexspline.rim_thickness, a_w)
@@ -69,8 +72,8 @@ def register(sub) -> None:
 
     k = sub.add_parser("kinematics", help="gear ratios; velocities of the external ring generator (CSV + PNG)",
                        epilog=EPILOG, formatter_class=argparse.RawDescriptionHelpFormatter)
-    k.add_argument("design")
-    k.add_argument("--out", help="output folder (default: output/<design name>)")
+    k.add_argument("design", help="design file (TOML), e.g. templates/d3_external.toml")
+    k.add_argument("--out", metavar="DIR", help="output folder of the velocity CSV and PNG (external deformation only; default: output/<design name>)")
     k.add_argument("--omega-h", type=positive_float(0.0, 1e6, "rad/s"), default=1.0,
                    help="generator speed, rad/s (default 1: velocities per rad/s; [S3] uses 210)")
     k.add_argument("--eccentricity", type=positive_float(0.0, 100.0, "mm"), default=None,

@@ -9,7 +9,6 @@ from dataclasses import dataclass, field, replace
 from typing import ClassVar
 
 import numpy as np
-from scipy.special import ellipe, ellipeinc
 
 from wgcad.constants import NEWTON_TOL
 from wgcad.errors import DesignError, GeometryError
@@ -531,6 +530,20 @@ class FourForce(_SectionedLaw):
 
 # --------------------------------------------------------------------------
 # exact elliptical cam
+
+
+def ellipe(m):
+    """Complete elliptic integral of the second kind (scipy.special, imported on first use: ~0.35 s)."""
+    from scipy.special import ellipe as _e
+
+    return _e(m)
+
+
+def ellipeinc(phi, m):
+    """Incomplete elliptic integral of the second kind (scipy.special, imported on first use)."""
+    from scipy.special import ellipeinc as _e
+
+    return _e(phi, m)
 
 
 def _solve_ellipe(target: float) -> float:

@@ -49,7 +49,6 @@ from __future__ import annotations
 from math import pi
 
 import numpy as np
-from scipy.optimize import brentq
 
 from . import cycloid as cy
 from . import involute as iv
@@ -262,7 +261,7 @@ def pins_numerical(gear: Gear, d_pin: float) -> dict:
     if idx.size == 0:
         raise ArithmeticError("the pin does not touch both flanks")
     i = idx[0] if sp.internal else idx[-1]
-    R_m = brentq(f, grid[i], grid[i + 1], xtol=1e-13)
+    R_m = _brentq(f, grid[i], grid[i + 1], xtol=1e-13)
     span = 2 * R_m * (1.0 if sp.z % 2 == 0 else np.cos(pi / (2 * sp.z)))
     return {"centre_radius_mm": float(R_m), "dimension_mm": float(span - d_pin if sp.internal else span + d_pin)}
 
@@ -364,3 +363,10 @@ def workshop_figures(gear: Gear, measure_diameter: float | None = None, pin_diam
 def fine_copy(gear: Gear, tol: float) -> Gear:
     """The same gear sampled at another chord tolerance (for numerical checks)."""
     return make_gear(gear.spec, tol)
+
+
+def _brentq(*args, **kwargs):
+    # scipy.optimize costs 0.3-0.8 s to import: only on first use
+    from scipy.optimize import brentq
+
+    return brentq(*args, **kwargs)

@@ -1,0 +1,143 @@
+"""Start-up benchmark: whole-process wall time of ``wgcad audit`` against the in-process audit, and where the rest goes.
+
+Run from the repository root (not part of the test run):
+
+    .venv/bin/python benchmarks/startup.py          # best of 7
+    .venv/bin/python benchmarks/startup.py -n 15    # steadier on a busy machine
+
+For each bundled template it measures
+
+* the whole process, ``python -m wgcad audit TEMPLATE --quiet`` (no plots),
+  spawn to exit, as a user waits for it;
+* the same command in-process (``wgcad.cli.main``, modules already imported):
+  the work itself;
+
+and their ratio. Then the import chain of ``audit`` as whole-process times
+of ``python -c "import a, b, ..."`` with one more module each row, so the
+difference between rows is what that module adds (cold, in the order audit
+imports them). Times are best-of-N wall clock; the machine's load average is
+printed with them because other jobs on a 2-core machine change them.
+Writes output/bench/startup.md and startup.csv.
+"""
+
+from __future__ import annotations
+
+import argparse
+import csv
+import os
+import platform
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parent.parent
+sys.path.insert(0, str(ROOT))
+OUT = ROOT / "output" / "bench"
+TEMPLATES = sorted((ROOT / "templates").glob("*.toml"))
+
+# What `wgcad audit` imports, heaviest dependencies first in the order the code reaches them
+# (wgcad.audit -> clearance.engine -> scipy.optimize.brentq; placement -> deformation.laws ->
+# scipy.special; clearance.distance -> shapely). Each row adds one.
+CHAIN = [
+    ("python itself", []),
+    ("+ wgcad.cli (argument parsing)", ["wgcad.cli"]),
+    ("+ numpy", ["numpy"]),
+    ("+ shapely", ["shapely"]),
+    ("+ scipy.special (deformation/laws.py: ellipe, ellipeinc)", ["scipy.special"]),
+    ("+ scipy.optimize (clearance/engine.py: brentq)", ["scipy.optimize"]),
+    ("+ the rest of wgcad.audit", ["wgcad.audit"]),
+]
+
+
+def env() -> dict:
+    return {**os.environ, "PYTHONPATH": str(ROOT)}
+
+
+def wall(cmd: list[str], n: int) -> tuple[float, float]:
+    """Best-of-n wall time of a whole process, spawn to exit, and its CPU time (user + system) in that run.
+
+    The CPU time is the steadier figure when other jobs share the machine:
+    waiting for a core does not count in it.
+    """
+    best, cpu = float("inf"), float("nan")
+    for _ in range(n):
+        t = time.perf_counter()
+        p = subprocess.Popen(cmd, env=env(), stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+        _, status, usage = os.wait4(p.pid, 0)
+        dt = time.perf_counter() - t
+        p.returncode = os.waitstatus_to_exitcode(status)
+        if p.returncode not in (0, 1):
+            raise SystemExit(f"{' '.join(cmd)} failed ({p.returncode})")
+        if dt < best:
+            best, cpu = dt, usage.ru_utime + usage.ru_stime
+    return best, cpu
+
+
+def in_process(template: Path, n: int) -> float:
+    """Best-of-n time of the same command inside this process, modules already imported."""
+    from wgcad.cli import main
+
+    main(["audit", str(template), "--quiet"])  # warm: imports, caches
+    best = float("inf")
+    for _ in range(n):
+        t = time.perf_counter()
+        main(["audit", str(template), "--quiet"])
+        best = min(best, time.perf_counter() - t)
+    return best
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("-n", type=int, default=7, help="repetitions; the best is kept (default 7)")
+    args = ap.parse_args(argv)
+    n = args.n
+    py = sys.executable
+    load0 = os.getloadavg()
+    rows = []
+    for t in TEMPLATES:
+        whole, cpu = wall([py, "-m", "wgcad", "audit", str(t), "--quiet"], n)
+        inside = in_process(t, n)
+        rows.append({"template": t.stem, "whole_process_s": whole, "whole_process_cpu_s": cpu, "in_process_s": inside,
+                     "ratio": whole / inside, "start_up_s": whole - inside})
+        print(f"{t.stem:14s} whole {whole:6.3f} s (cpu {cpu:6.3f} s)  in-process {inside:6.3f} s  ratio {whole / inside:5.2f}",
+              flush=True)
+    chain, mods = [], []
+    for label, add in CHAIN:
+        mods = mods + add
+        code = "import " + ", ".join(mods) if mods else "pass"
+        w, c = wall([py, "-c", code], n)
+        chain.append({"step": label, "whole_process_s": w, "whole_process_cpu_s": c})
+    prev = None
+    for row in chain:
+        row["adds_s"] = None if prev is None else row["whole_process_s"] - prev
+        prev = row["whole_process_s"]
+        adds = "" if row["adds_s"] is None else f"  adds {row['adds_s']:6.3f} s"
+        print(f"{row['step']:60s} {row['whole_process_s']:6.3f} s (cpu {row['whole_process_cpu_s']:6.3f} s){adds}", flush=True)
+    load1 = os.getloadavg()
+
+    OUT.mkdir(parents=True, exist_ok=True)
+    with open(OUT / "startup.csv", "w", newline="") as fp:
+        w = csv.DictWriter(fp, fieldnames=list(rows[0]))
+        w.writeheader()
+        w.writerows(rows)
+    md = [f"# wgcad audit start-up (best of {n})", "",
+          f"{platform.processor() or platform.machine()}, {os.cpu_count()} cores, Python {platform.python_version()}; "
+          f"load average {load0[0]:.2f} before, {load1[0]:.2f} after", "",
+          "`python -m wgcad audit TEMPLATE --quiet` (no plots): whole process against the same command in-process", "",
+          "| template | whole process, s | its CPU time, s | in-process, s | ratio | start-up (difference), s |",
+          "|---|---|---|---|---|---|"]
+    md += [f"| {r['template']} | {r['whole_process_s']:.3f} | {r['whole_process_cpu_s']:.3f} | {r['in_process_s']:.3f} "
+           f"| {r['ratio']:.2f} | {r['start_up_s']:.3f} |" for r in rows]
+    md += ["", "Import chain of `audit`: whole-process time of `python -c \"import ...\"`, one module more per row", "",
+           "| step | whole process, s | its CPU time, s | adds (wall), s |", "|---|---|---|---|"]
+    for r in chain:
+        adds = "" if r["adds_s"] is None else f"{r['adds_s']:.3f}"
+        md.append(f"| {r['step']} | {r['whole_process_s']:.3f} | {r['whole_process_cpu_s']:.3f} | {adds} |")
+    (OUT / "startup.md").write_text("\n".join(md) + "\n")
+    print(f"wrote {OUT / 'startup.md'} and startup.csv")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
