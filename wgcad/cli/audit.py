@@ -88,6 +88,9 @@ def cmd_audit(args) -> int:
     res = result.to_json()
     res["design"] = drive.design.drive.name
     res["source"] = drive.design.source
+    from .common import not_modelled
+
+    res["not_checked"] = not_modelled(drive.design, "this audit")
     if args.engine in ("fcl", "both"):
         bar.set(work_end, "3D check (fcl)")
         from ..clearance.fcl3d import verify_worst
@@ -134,6 +137,7 @@ def cmd_audit(args) -> int:
         # with a JSON document on stdout, the summary for people goes to stderr
         stream = sys.stderr if STDOUT in (args.json, args.write_baseline) else sys.stdout
         lines = [_audit_summary(res["design"], res)]
+        lines += [f"  NOT CHECKED: {n}" for n in res["not_checked"]]
         if "fcl" in res:
             lines.append(f"  FCL 3D check of the pairs the 2D engine singled out: {res['fcl']['summary']}")
         if drifts is not None:

@@ -14,7 +14,7 @@ from .progress import Progress
 
 __all__ = ["EXIT_OK", "EXIT_INTERFERENCE", "EXIT_INPUT", "EXIT_INTERNAL", "EPILOG", "TRACEBACK_ENV", "Parser",
            "angles_deg", "positive_float", "angle_count", "out_dir", "angle_tag", "circle", "Progress",
-           "Terminated", "signals_raise", "internal_error_line", "want_progress", "add_memory_flag"]
+           "Terminated", "signals_raise", "internal_error_line", "want_progress", "add_memory_flag", "not_modelled"]
 
 EXIT_OK = 0
 EXIT_INTERFERENCE = 1  # reserved for `wgcad audit`: interference found or baseline drift
@@ -173,3 +173,14 @@ def circle(radius: float, tol: float):
     n = max(64, int(np.ceil(2 * np.pi / step)))
     t = np.linspace(0.0, 2 * np.pi, n, endpoint=False)
     return np.stack([radius * np.cos(t), radius * np.sin(t)], axis=1)
+
+
+def not_modelled(design, command: str) -> list[str]:
+    """What a design's optional tables ask for that ``command`` does not model: said in every summary, never silent."""
+    notes = []
+    if design.sectors.active:
+        notes.append(f"[sectors]: {command} uses the plain rigid gear of drive.z_rigid = {design.drive.z_rigid} teeth; "
+                     "`wgcad sector` builds and audits the sectored gear")
+    if design.imperfections.any:
+        notes.append(f"[imperfections]: {command} uses perfect parts; `wgcad ke` computes the imperfect drive's kinematic error")
+    return notes

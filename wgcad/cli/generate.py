@@ -149,6 +149,9 @@ def cmd_generate(args) -> int:
         DxfLayer("RIGID_RIM", circles=((0.0, 0.0, drive.rigid_rim_radius),), color=1),
     ]
     rep = drive_report(drive)
+    from .common import not_modelled
+
+    rep["not_modelled"] = not_modelled(design, "generate")
     files = []
     with atomic_batch() as batch:
         path = out / f"{stem}.dxf"
@@ -218,7 +221,7 @@ def cmd_generate(args) -> int:
         write_stdout(json.dumps(rep, indent=2) + "\n")
     elif not args.quiet:
         removed = f", removed {len(stale)} of the previous run's files" if stale else ""
-        write_stdout(format_summary(rep) + "\n"
+        write_stdout(format_summary(rep) + "\n" + "".join(f"  NOT MODELLED: {n}\n" for n in rep["not_modelled"])
                      + f"\n  wrote {len(files)} files to {out}/ ({report_path.name}){removed} in {time.perf_counter() - t0:.2f} s\n")
     return EXIT_OK
 
