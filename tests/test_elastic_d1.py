@@ -11,7 +11,7 @@ from wgcad.deformation import Law
 from wgcad.deformation.elastic import LoadedLaw, build_model, solve_load
 from wgcad.deformation.elastic.state import POSITION_TOL
 from wgcad.deformation.elastic.sweep import torque_sweep
-from wgcad.design.schema import load_design, with_changes
+from wgcad.design import load_design, with_changes
 from wgcad.drive import build_drive
 
 ROOT = Path(__file__).resolve().parents[1]

@@ -74,7 +74,7 @@ def _summary(name: str, res: dict) -> str:
 def _sweep(path, torques, e_um, e_deg, sections, progress):
     from ..deformation.elastic.model import build_model
     from ..deformation.elastic.sweep import torque_sweep
-    from ..design.schema import load_design
+    from ..design import load_design
     from ..drive import build_drive
 
     drive = build_drive(load_design(path))
