@@ -176,8 +176,33 @@ def write_dxf(path: str | os.PathLike, layers) -> None:
         # time and random GUIDs into the header; fixed metadata makes the
         # same design give byte-identical files (reproducible output).
         with _fixed_metadata():
+            _canonical_classes(doc)
             with open(temp, "wt", encoding=doc.output_encoding, errors="dxfreplace") as fp:
                 doc.write(fp)
+
+
+def _canonical_classes(doc) -> None:
+    """Put the CLASSES section in an order that does not depend on the hash seed.
+
+    ezdxf adds the version's required classes in a fixed order, then one
+    class per entity type in use, iterating a *set* of type names: the order
+    of e.g. ``LAYOUT`` and ``ACDBPLACEHOLDER`` followed ``PYTHONHASHSEED``, so
+    the same design gave different bytes in different processes. Adding the
+    classes now and sorting the set-derived ones by name makes the later
+    ``add_required_classes`` inside ``doc.write`` a no-op (it only adds
+    missing keys) and the file byte-reproducible.
+    """
+    from collections import OrderedDict
+
+    from ezdxf.sections.classes import REQ_R2004, REQUIRED_CLASSES
+
+    section = doc.classes
+    section.add_required_classes(doc.dxfversion)
+    fixed = REQUIRED_CLASSES.get(doc.dxfversion, REQ_R2004)
+    items = list(section.classes.items())
+    head = [kv for name in fixed for kv in items if kv[1].dxf.name == name]
+    rest = sorted((kv for kv in items if kv not in head), key=lambda kv: kv[0])
+    section.classes = OrderedDict(head + rest)
 
 
 def _readfile(path) -> "ezdxf.document.Drawing":
