@@ -7,6 +7,8 @@ __all__ = [
     "NEWTON_TOL",
     "INTERFERENCE_TOL",
     "DUPLICATE_TOL",
+    "MIN_VERTEX_SPACING",
+    "REFINE_TOL",
 ]
 
 #: Largest distance (mm) between a discretised outline and the exact curve.
@@ -38,3 +40,19 @@ INTERFERENCE_TOL = 1e-3
 #: ~1e-14 mm rounding noise of float64 coordinates near 100 mm, so it removes
 #: exact and round-off duplicates and nothing else.
 DUPLICATE_TOL = 1e-9
+
+#: Smallest distance (mm) between neighbouring vertices of any outline wgcad
+#: builds (rigid, deformed, exported). 0.1 um: more than ten times the float32
+#: resolution of an STL coordinate up to ~800 mm from the axis (2^-24 * 800 mm
+#: = 0.05 um), so no two vertices of an outline merge in a float32 file, and
+#: well below the spacing of chords at any sensible chord tolerance
+#: (``sqrt(8 R tol)`` is 7 um for a 0.2 mm fillet at 0.03 um); dropping a
+#: vertex closer than this to its neighbour moves the polygon by far less than
+#: the chord tolerance (the two chords it joins are nearly collinear).
+MIN_VERTEX_SPACING = 1e-4
+
+#: Tolerance (mm) to which the clearance engine's figures (minimum clearance,
+#: penetration depth, entry gap, pinch) are refined on the exact tooth curves,
+#: whatever the chord tolerance: 1 nm, a thousandth of the default 1 um chords
+#: and ten times below the 0.01 um accuracy the audit promises.
+REFINE_TOL = 1e-6

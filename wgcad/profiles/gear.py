@@ -11,6 +11,7 @@ from .. import constants
 from ..errors import DesignError
 from . import cycloid as cy
 from . import involute as iv
+from . import pieces as pc
 from .sampling import arc_points, polar, sample_curve
 
 __all__ = ["ToothSpec", "Gear", "make_gear", "rotate", "largest_fillet_coef"]
@@ -70,6 +71,10 @@ class Gear:
     outline : (N, 2) float
         The whole toothed boundary, counter-clockwise, closed implicitly,
         turned by ``spec.phase``.
+    pieces : tuple of :class:`~wgcad.profiles.pieces.Piece`
+        The exact curves of one pitch, -pi/z .. pi/z in the tooth frame, in
+        the order and direction of :attr:`period`; each piece ends where the
+        next begins, and every vertex of :attr:`period` lies on one of them.
     """
 
     spec: ToothSpec
@@ -82,6 +87,11 @@ class Gear:
     period: np.ndarray = field(repr=False)
     outline: np.ndarray = field(repr=False)
     tol: float = constants.CHORD_TOL
+    pieces: tuple = field(default=(), repr=False)
+
+    def outline_pieces(self) -> list:
+        """The exact pieces of the whole :attr:`outline` (``z`` pitches turned by ``k 2 pi/z + phase``), in its order."""
+        return [p.rotated(k * self.pitch_angle + self.spec.phase) for k in range(self.spec.z) for p in self.pieces]
 
     @property
     def pitch_angle(self) -> float:
@@ -200,9 +210,9 @@ def make_gear(sp: ToothSpec, tol: float = constants.CHORD_TOL) -> Gear:
     else:
         tip_field, fix = "tooth.clearance_coef", "truncate the tip: larger tooth.clearance_coef (or a tip_radius)"
     if sp.form == "involute":
-        half, tip_thk, r_base = _involute_half_period(sp, r, r_a, r_f, tol, tip_field)
+        half, tip_thk, r_base, hp = _involute_half_period(sp, r, r_a, r_f, tol, tip_field)
     else:
-        half, tip_thk, r_base = _cycloid_half_period(sp, r, r_a, r_f, tol, tip_field, fix)
+        half, tip_thk, r_base, hp = _cycloid_half_period(sp, r, r_a, r_f, tol, tip_field, fix)
     s_min = constants.MIN_TIP_THICKNESS_COEF * sp.module
     if tip_thk < s_min:
         raise DesignError(
@@ -210,7 +220,9 @@ def make_gear(sp: ToothSpec, tol: float = constants.CHORD_TOL) -> Gear:
             f"pointed teeth: tip thickness {tip_thk:.4f} mm is below the minimum {s_min:.4f} mm "
             f"({constants.MIN_TIP_THICKNESS_COEF} m); {fix}",
         )
-    half = _dedupe(half)
+    half = _thin(half, constants.MIN_VERTEX_SPACING)
+    hp = [p for p in hp if p.length() > constants.DUPLICATE_TOL]
+    pieces = tuple(pc.merge_arcs(pc.mirror_path(hp) + hp))
     mirror = half[::-1] * np.array([1.0, -1.0])
     period = np.concatenate([mirror, half[1:]])
     gamma = 2.0 * pi / sp.z
@@ -220,7 +232,7 @@ def make_gear(sp: ToothSpec, tol: float = constants.CHORD_TOL) -> Gear:
     outline = polar(np.broadcast_to(rad, ang.shape), ang).reshape(-1, 2)
     for arr in (half, period, outline):
         arr.setflags(write=False)
-    return Gear(sp, r, r_a, r_f, r_base, float(tip_thk), half, period, outline, tol)
+    return Gear(sp, r, r_a, r_f, r_base, float(tip_thk), half, period, outline, tol, pieces)
 
 
 def _fillet_fits(sp: ToothSpec, rho: float) -> bool:
@@ -261,14 +273,35 @@ def _no_fit(sp: ToothSpec, rho: float, why: str) -> DesignError:
     )
 
 
-def _dedupe(pts: np.ndarray, eps: float = 1e-9) -> np.ndarray:
-    keep = np.ones(len(pts), dtype=bool)
-    keep[1:] = np.hypot(*(np.diff(pts, axis=0).T)) > eps
+def _thin(pts: np.ndarray, spacing: float) -> np.ndarray:
+    """Drop vertices closer than ``spacing`` to the last kept one; both end points are kept.
+
+    Every kept vertex is an original one (it stays on the exact curve); the
+    chord that replaces a dropped vertex is shorter than ``spacing`` plus the
+    neighbouring chord, so its deviation from the curve stays far below the
+    chord tolerance (constants.MIN_VERTEX_SPACING).
+    """
+    keep = [0]
+    for i in range(1, len(pts) - 1):
+        if np.hypot(*(pts[i] - pts[keep[-1]])) >= spacing:
+            keep.append(i)
+    last = len(pts) - 1
+    while len(keep) > 1 and np.hypot(*(pts[last] - pts[keep[-1]])) < spacing:
+        keep.pop()
+    if last > 0:
+        keep.append(last)
     return np.ascontiguousarray(pts[keep])
 
 
 def _join(*pieces: np.ndarray) -> np.ndarray:
     return np.concatenate([np.atleast_2d(p) for p in pieces if len(p)])
+
+
+def _arc_piece(center, radius, p0, p1) -> pc.Piece:
+    """The short arc of ``radius`` about ``center`` from ``p0`` to ``p1`` (as :func:`_short_arc`)."""
+    a0 = np.arctan2(p0[1] - center[1], p0[0] - center[0])
+    a1 = np.arctan2(p1[1] - center[1], p1[0] - center[0])
+    return pc.arc(center, radius, a0, a0 + (a1 - a0 + pi) % (2 * pi) - pi)
 
 
 def _short_arc(center, p0, p1, tol) -> np.ndarray:
@@ -300,6 +333,7 @@ def _involute_half_period(sp: ToothSpec, r, r_a, r_f, tol, tip_field):
         t_a = np.sqrt((r_a / r_b) ** 2 - 1.0)
         flank = lambda t: iv.involute_flank(base, r_b, t)  # noqa: E731
         tip = arc_points((0.0, 0.0), r_a, 0.0, psi_a, tol)
+        hp = [pc.arc((0.0, 0.0), r_a, 0.0, psi_a)]
         if rho > 0:
             center, ang_c, fp, t_f = iv.fillet_external(base, r_b, r_f, rho)
             fp_r = float(np.hypot(*fp))
@@ -309,22 +343,29 @@ def _involute_half_period(sp: ToothSpec, r, r_a, r_f, tol, tip_field):
                 raise _no_fit(sp, rho, f"does not fit the space at the root circle ({r_f:.4f} mm)")
             if t_f is not None:
                 fl = sample_curve(flank, t_a, t_f, tol)
+                hp.append(pc.involute(base, r_b, t_a, t_f))
             else:
                 fl = _join(sample_curve(flank, t_a, 0.0, tol), fp[None, :])
+                hp += [pc.involute(base, r_b, t_a, 0.0), pc.line(fl[-2], fp)]
             root0 = ang_c
             fil = _short_arc(center, fl[-1], polar(r_f, ang_c), tol)
+            hp.append(_arc_piece(center, rho, fl[-1], fil[-1]))
             pieces = [tip, fl[1:], fil[1:]]
         else:
             if r_f >= r_b:
-                fl = sample_curve(flank, t_a, np.sqrt((r_f / r_b) ** 2 - 1.0), tol)
+                t_r = np.sqrt((r_f / r_b) ** 2 - 1.0)
+                fl = sample_curve(flank, t_a, t_r, tol)
+                hp.append(pc.involute(base, r_b, t_a, t_r))
             else:
                 fl = _join(sample_curve(flank, t_a, 0.0, tol), polar(r_f, base)[None, :])
+                hp += [pc.involute(base, r_b, t_a, 0.0), pc.line(fl[-2], fl[-1])]
             root0 = float(np.arctan2(fl[-1, 1], fl[-1, 0]))
             if root0 >= gamma2:
                 raise DesignError(f"{f}.root_radius", "teeth overlap at the root circle: the space closes before the root")
             pieces = [tip, fl[1:]]
         root = arc_points((0.0, 0.0), r_f, root0, gamma2, tol)
-        return _join(*pieces, root[1:]), tip_thk, float(r_b)
+        hp.append(pc.arc((0.0, 0.0), r_f, root0, gamma2))
+        return _join(*pieces, root[1:]), tip_thk, float(r_b), hp
     # internal gear: work on the space (centred on angle 0 in its own frame),
     # then map to the tooth frame by a -> gamma/2 - a
     if r_a <= r_b:
@@ -344,17 +385,22 @@ def _involute_half_period(sp: ToothSpec, r, r_a, r_f, tol, tip_field):
         fl = sample_curve(flank, t_a, t_f, tol)
         fil = _short_arc(center, fl[-1], polar(r_f, ang_c), tol)
         space_side = _join(fl, fil[1:])
+        sp_pieces = [pc.involute(base, r_b, t_a, t_f), _arc_piece(center, rho, fl[-1], fil[-1])]
         root0 = ang_c
     else:
-        space_side = sample_curve(flank, t_a, np.sqrt((r_f / r_b) ** 2 - 1.0), tol)
+        t_r = np.sqrt((r_f / r_b) ** 2 - 1.0)
+        space_side = sample_curve(flank, t_a, t_r, tol)
+        sp_pieces = [pc.involute(base, r_b, t_a, t_r)]
         root0 = float(np.arctan2(space_side[-1, 1], space_side[-1, 0]))
         if root0 <= 0:
             raise DesignError(f"{f}.root_radius", "the space closes before the root circle")
     root = arc_points((0.0, 0.0), r_f, root0, 0.0, tol)
     space_side = _join(space_side, root[1:])  # space frame: from tip to space centre
+    sp_pieces.append(pc.arc((0.0, 0.0), r_f, root0, 0.0))
     tooth_frame = rotate(space_side * np.array([1.0, -1.0]), gamma2)
     tip = arc_points((0.0, 0.0), r_a, 0.0, gamma2 - sig_a, tol)
-    return _join(tip, tooth_frame[1:]), tip_thk, float(r_b)
+    hp = [pc.arc((0.0, 0.0), r_a, 0.0, gamma2 - sig_a)] + [p.mirrored().rotated(gamma2) for p in sp_pieces]
+    return _join(tip, tooth_frame[1:]), tip_thk, float(r_b), hp
 
 
 def _cycloid_half_period(sp: ToothSpec, r, r_a, r_f, tol, tip_field, fix):
@@ -393,4 +439,8 @@ def _cycloid_half_period(sp: ToothSpec, r, r_a, r_f, tol, tip_field, fix):
     if root0 > gamma2 * (1 + 1e-9):
         raise DesignError(f"{f}.thinning", "negative thinning closes the space at the root")
     root = arc_points((0.0, 0.0), r_f, root0, gamma2, tol)
-    return _join(tip, a_pts[1:], d_pts[1:], root[1:]), tip_thk, None
+    hp = [pc.arc((0.0, 0.0), r_a, 0.0, psi_a),
+          pc.cycloid("epicycloid" if add_epi else "hypocycloid", r, rho, phi_a, 0.0, rot=q, flip=-1.0),
+          pc.cycloid("hypocycloid" if add_epi else "epicycloid", r, rho, 0.0, phi_f, rot=q),
+          pc.arc((0.0, 0.0), r_f, root0, gamma2)]
+    return _join(tip, a_pts[1:], d_pts[1:], root[1:]), tip_thk, None, hp

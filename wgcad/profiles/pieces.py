@@ -1,0 +1,252 @@
+"""Exact curve pieces of a tooth outline: involutes, arcs, lines, epi/hypocycloids with their derivatives (docs/models.md 2.1, 2.2).
+
+A :class:`Piece` is one analytic curve over a parameter range ``t0 -> t1``
+(either order: the piece runs from ``point(t0)`` to ``point(t1)``). The
+sampled polygons of :mod:`wgcad.profiles.gear` are vertices of these pieces;
+the pieces are what exports can write as arcs and what the clearance engine
+refines on.
+
+Kinds and parameters (``params``)
+---------------------------------
+``"arc"``          ``(cx, cy, radius)``: ``C + R (cos t, sin t)``, ``t`` the
+                   polar angle about the centre (world frame, no ``rot``/``flip``).
+``"line"``         ``(x0, y0, dx, dy)``: ``P0 + t D``, ``t`` in ``[0, 1]``.
+``"involute"``     ``(psi_base, r_base)``: ``r_b sqrt(1+t^2) (cos a, sin a)``,
+                   ``a = psi_base - (t - atan t)``, ``t`` the roll parameter.
+``"epicycloid"``   ``(r, rho)``: :func:`wgcad.profiles.cycloid.epicycloid` of roll angle ``t``.
+``"hypocycloid"``  ``(r, rho)``: :func:`wgcad.profiles.cycloid.hypocycloid` of roll angle ``t``.
+
+Non-arc, non-line kinds are then mirrored (``flip = -1``: ``y -> -y``) and
+turned by ``rot`` about the origin: ``point = R(rot) diag(1, flip) base(t)``.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+__all__ = ["Piece", "arc", "line", "involute", "cycloid", "mirror_path", "merge_arcs", "path_points"]
+
+
+def _rot(v: np.ndarray, a: float) -> np.ndarray:
+    c, s = np.cos(a), np.sin(a)
+    return np.stack([c * v[..., 0] - s * v[..., 1], s * v[..., 0] + c * v[..., 1]], axis=-1)
+
+
+@dataclass(frozen=True)
+class Piece:
+    """One analytic piece of an outline (module docstring). Lengths mm, angles rad.
+
+    Attributes
+    ----------
+    kind : str
+        ``"arc"``, ``"line"``, ``"involute"``, ``"epicycloid"`` or ``"hypocycloid"``.
+    t0, t1 : float
+        Parameter at the start and at the end of the piece (``t1 < t0`` allowed).
+    params : tuple of float
+        Kind-specific parameters (module docstring).
+    rot : float
+        Turn applied after the canonical curve (not used by arcs and lines).
+    flip : float
+        ``+1`` or ``-1`` (mirror ``y -> -y`` before ``rot``; not used by arcs and lines).
+    """
+
+    kind: str
+    t0: float
+    t1: float
+    params: tuple
+    rot: float = 0.0
+    flip: float = 1.0
+
+    # -- geometry -----------------------------------------------------------------
+    @property
+    def center(self) -> np.ndarray:
+        """Centre ``(2,)`` of an arc, mm."""
+        if self.kind != "arc":
+            raise AttributeError(f"a {self.kind} piece has no centre")
+        return np.array(self.params[:2], dtype=float)
+
+    @property
+    def radius(self) -> float:
+        """Radius of an arc, mm."""
+        if self.kind != "arc":
+            raise AttributeError(f"a {self.kind} piece has no radius")
+        return float(self.params[2])
+
+    @property
+    def start(self) -> np.ndarray:
+        """First point ``(2,)``."""
+        return self.point(np.array([self.t0]))[0]
+
+    @property
+    def end(self) -> np.ndarray:
+        """Last point ``(2,)``."""
+        return self.point(np.array([self.t1]))[0]
+
+    def point(self, t) -> np.ndarray:
+        """Points ``(n, 2)`` at parameters ``t (n,)``."""
+        return self._eval(np.atleast_1d(np.asarray(t, dtype=float)), 0)
+
+    def deriv(self, t) -> np.ndarray:
+        """First derivatives ``dP/dt``, ``(n, 2)``."""
+        return self._eval(np.atleast_1d(np.asarray(t, dtype=float)), 1)
+
+    def deriv2(self, t) -> np.ndarray:
+        """Second derivatives ``d2P/dt2``, ``(n, 2)``."""
+        return self._eval(np.atleast_1d(np.asarray(t, dtype=float)), 2)
+
+    def length(self, n: int = 64) -> float:
+        """Arc length (Gauss-Legendre on ``n`` nodes; exact for arcs and lines), mm."""
+        if self.kind == "arc":
+            return abs(self.t1 - self.t0) * self.radius
+        if self.kind == "line":
+            return abs(self.t1 - self.t0) * float(np.hypot(self.params[2], self.params[3]))
+        x, w = np.polynomial.legendre.leggauss(n)
+        h = 0.5 * (self.t1 - self.t0)
+        d = self.deriv(self.t0 + h * (x + 1.0))
+        return float(abs(h) * np.dot(w, np.hypot(d[:, 0], d[:, 1])))
+
+    # -- transforms ----------------------------------------------------------------
+    def reversed(self) -> "Piece":
+        """The same curve run the other way."""
+        return Piece(self.kind, self.t1, self.t0, self.params, self.rot, self.flip)
+
+    def mirrored(self) -> "Piece":
+        """Mirror image about the x axis (``y -> -y``), same direction of travel along the image."""
+        if self.kind == "arc":
+            cx, cy, R = self.params
+            return Piece("arc", -self.t0, -self.t1, (cx, -cy, R))
+        if self.kind == "line":
+            x0, y0, dx, dy = self.params
+            return Piece("line", self.t0, self.t1, (x0, -y0, dx, -dy))
+        # diag(1,-1) R(a) = R(-a) diag(1,-1)
+        return Piece(self.kind, self.t0, self.t1, self.params, -self.rot, -self.flip)
+
+    def rotated(self, angle: float) -> "Piece":
+        """Turned by ``angle`` (rad, counter-clockwise) about the origin."""
+        if self.kind == "arc":
+            cx, cy, R = self.params
+            c = _rot(np.array([cx, cy]), angle)
+            return Piece("arc", self.t0 + angle, self.t1 + angle, (float(c[0]), float(c[1]), R))
+        if self.kind == "line":
+            x0, y0, dx, dy = self.params
+            p, d = _rot(np.array([x0, y0]), angle), _rot(np.array([dx, dy]), angle)
+            return Piece("line", self.t0, self.t1, (float(p[0]), float(p[1]), float(d[0]), float(d[1])))
+        return Piece(self.kind, self.t0, self.t1, self.params, self.rot + angle, self.flip)
+
+    # -- evaluation ---------------------------------------------------------------
+    def _eval(self, t: np.ndarray, order: int) -> np.ndarray:
+        k = self.kind
+        if k == "arc":
+            cx, cy, R = self.params
+            c, s = np.cos(t), np.sin(t)
+            if order == 0:
+                return np.stack([cx + R * c, cy + R * s], axis=-1)
+            if order == 1:
+                return np.stack([-R * s, R * c], axis=-1)
+            return np.stack([-R * c, -R * s], axis=-1)
+        if k == "line":
+            x0, y0, dx, dy = self.params
+            if order == 0:
+                return np.stack([x0 + t * dx, y0 + t * dy], axis=-1)
+            d = np.array([dx, dy]) if order == 1 else np.zeros(2)
+            return np.broadcast_to(d, (len(t), 2)).copy()
+        if k == "involute":
+            out = _involute(self.params, t, order)
+        elif k == "epicycloid":
+            out = _cycloid(self.params, t, order, +1.0)
+        elif k == "hypocycloid":
+            out = _cycloid(self.params, t, order, -1.0)
+        else:  # pragma: no cover - constructors only make the kinds above
+            raise ValueError(f"unknown piece kind {k!r}")
+        if self.flip < 0:
+            out = out * np.array([1.0, -1.0])
+        return _rot(out, self.rot) if self.rot else out
+
+
+def _involute(params, t, order):
+    """Polar form ``rad(t) (cos a(t), sin a(t))`` and its derivatives (docs/models.md 2.1)."""
+    psi, rb = params
+    s2 = 1.0 + t * t
+    s = np.sqrt(s2)
+    a = psi - (t - np.arctan(t))
+    u = np.stack([np.cos(a), np.sin(a)], axis=-1)
+    n = np.stack([-np.sin(a), np.cos(a)], axis=-1)
+    rad = rb * s
+    if order == 0:
+        return rad[:, None] * u
+    rad1 = rb * t / s
+    a1 = -t * t / s2
+    if order == 1:
+        return rad1[:, None] * u + (rad * a1)[:, None] * n
+    rad2 = rb / (s2 * s)
+    a2 = -2.0 * t / (s2 * s2)
+    return (rad2 - rad * a1 * a1)[:, None] * u + (2.0 * rad1 * a1 + rad * a2)[:, None] * n
+
+
+def _cycloid(params, phi, order, sgn):
+    """Epicycloid (``sgn = +1``) or hypocycloid (``-1``) of roll angle ``phi`` and its derivatives (docs/models.md 2.2).
+
+    ``P = (r + s rho) e(th) - s rho e(th + s phi)``, ``th = rho phi / r``.
+    """
+    r, rho = params
+    k = rho / r
+    A = r + sgn * rho
+    B = -sgn * rho
+    w1, w2 = k, k + sgn  # angular rates of the two terms
+    a1, a2 = w1 * phi, w2 * phi
+    if order == 0:
+        return np.stack([A * np.cos(a1) + B * np.cos(a2), A * np.sin(a1) + B * np.sin(a2)], axis=-1)
+    if order == 1:
+        return np.stack([-A * w1 * np.sin(a1) - B * w2 * np.sin(a2), A * w1 * np.cos(a1) + B * w2 * np.cos(a2)], axis=-1)
+    return np.stack([-A * w1 * w1 * np.cos(a1) - B * w2 * w2 * np.cos(a2),
+                     -A * w1 * w1 * np.sin(a1) - B * w2 * w2 * np.sin(a2)], axis=-1)
+
+
+# -- constructors ------------------------------------------------------------------
+def arc(center, radius: float, a0: float, a1: float) -> Piece:
+    """Arc of ``radius`` about ``center`` from polar angle ``a0`` to ``a1`` (about the centre)."""
+    return Piece("arc", float(a0), float(a1), (float(center[0]), float(center[1]), float(radius)))
+
+
+def line(p0, p1) -> Piece:
+    """Segment from ``p0`` to ``p1``."""
+    p0, p1 = np.asarray(p0, dtype=float), np.asarray(p1, dtype=float)
+    d = p1 - p0
+    return Piece("line", 0.0, 1.0, (float(p0[0]), float(p0[1]), float(d[0]), float(d[1])))
+
+
+def involute(psi_base: float, r_base: float, t0: float, t1: float) -> Piece:
+    """The involute of :func:`wgcad.profiles.involute.involute_flank` from roll parameter ``t0`` to ``t1``."""
+    return Piece("involute", float(t0), float(t1), (float(psi_base), float(r_base)))
+
+
+def cycloid(kind: str, r: float, rho: float, phi0: float, phi1: float, rot: float = 0.0, flip: float = 1.0) -> Piece:
+    """Epi/hypocycloid (``kind``) on pitch radius ``r``, rolling radius ``rho``, roll angle ``phi0 -> phi1``."""
+    return Piece(kind, float(phi0), float(phi1), (float(r), float(rho)), float(rot), float(flip))
+
+
+# -- paths -------------------------------------------------------------------------
+def mirror_path(pieces) -> list[Piece]:
+    """The mirror image (``y -> -y``) of a path of pieces, run backwards: the path that leads into it."""
+    return [p.mirrored().reversed() for p in reversed(list(pieces))]
+
+
+def merge_arcs(pieces, tol: float = 1e-12) -> list[Piece]:
+    """Join consecutive arcs of one circle that continue each other into one arc."""
+    out: list[Piece] = []
+    for p in pieces:
+        if out and p.kind == "arc" and out[-1].kind == "arc":
+            q = out[-1]
+            same = all(abs(a - b) <= tol * max(1.0, abs(b)) for a, b in zip(p.params, q.params))
+            if same and abs(p.t0 - q.t1) <= tol and (p.t1 - p.t0) * (q.t1 - q.t0) >= 0:
+                out[-1] = Piece("arc", q.t0, p.t1, q.params)
+                continue
+        out.append(p)
+    return out
+
+
+def path_points(pieces, n: int = 16) -> np.ndarray:
+    """``n`` evenly spaced parameter points per piece, concatenated ``(len(pieces) * n, 2)`` (for plots and tests)."""
+    return np.concatenate([p.point(np.linspace(p.t0, p.t1, n)) for p in pieces])
