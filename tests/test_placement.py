@@ -138,3 +138,25 @@ def test_deformed_outline_is_simple(form):
         outline = join_teeth(place_flex_teeth(d3, phi_h, local=d3.flex.period))
         assert shapely.LinearRing(outline).is_simple
         assert abs(shapely.Polygon(outline).area) > 0
+
+
+@pytest.mark.parametrize("name", sorted(p.stem for p in TEMPLATES.glob("*.toml")) + ["d3_external-cycloidal"])
+def test_deformed_outline_has_no_back_steps_or_near_duplicates(name):
+    # issue 13: where neighbouring root lands join, the outline stepped back 0.06-1 um;
+    # an outline must have no two neighbouring vertices closer than MIN_VERTEX_SPACING
+    from wgcad import constants
+    from wgcad.design import with_changes
+    from wgcad.placement import join_teeth
+
+    des = load_design(TEMPLATES / f"{name.split('-')[0]}.toml")
+    if name.endswith("cycloidal"):
+        des = with_changes(des, tooth={"form": "cycloidal", "clearance_coef": 0.1})
+    drive = build_drive(des)
+    for phi_h in (0.0, 0.26, 1.0):
+        o = join_teeth(place_flex_teeth(drive, phi_h, local=drive.flex.period))
+        seg = np.diff(np.vstack([o, o[:1]]), axis=0)
+        L = np.hypot(*seg.T)
+        assert L.min() >= constants.MIN_VERTEX_SPACING
+        # a back-step turns the outline by ~180 deg; real corners (tips, fillets) turn by < 70 deg
+        cos_turn = (seg * np.roll(seg, -1, axis=0)).sum(axis=1) / (L * np.roll(L, -1))
+        assert cos_turn.min() > 0.0, f"{name} at {phi_h}: the outline turns back on itself"

@@ -6,6 +6,7 @@ from math import pi
 
 import numpy as np
 
+from . import constants
 from .deformation import Law
 from .kinematics import flex_rotation
 
@@ -235,10 +236,40 @@ def join_teeth(teeth: np.ndarray, m: int = 6) -> np.ndarray:
         if trail[k] is not None:
             part = np.vstack([part, trail[k]])
         out.append(part)
-    pts = np.vstack(out)
-    keep = np.ones(len(pts), dtype=bool)
-    keep[1:] = np.hypot(*np.diff(pts, axis=0).T) > 1e-9
-    pts = pts[keep]
-    if np.hypot(*(pts[-1] - pts[0])) <= 1e-9:
-        pts = pts[:-1]
+    for k in range(K):
+        if trail[k] is None:
+            out[k] = _trim_back_step(out[k], out[(k + 1) % K][0])
+    return _space(np.vstack(out), constants.MIN_VERTEX_SPACING)
+
+
+def _trim_back_step(part: np.ndarray, nxt: np.ndarray) -> np.ndarray:
+    """Drop end vertices of ``part`` that the next tooth's first vertex ``nxt`` lies behind (or within the minimum spacing of).
+
+    Where neighbouring root lands overlap without crossing (they run
+    sub-micrometre apart), joining them straight stepped back along the
+    root by 0.06-1 um (issue 13): the outline now leaves ``part`` at its
+    last vertex that ``nxt`` lies ahead of.
+    """
+    while len(part) > 2:
+        d_in = part[-1] - part[-2]
+        step = nxt - part[-1]
+        if float(np.dot(step, d_in)) > 0.0 and np.hypot(*step) >= constants.MIN_VERTEX_SPACING:
+            break
+        part = part[:-1]
+    return part
+
+
+def _space(pts: np.ndarray, spacing: float) -> np.ndarray:
+    """Drop vertices closer than ``spacing`` to the last kept one (closed outline: the last is also checked against the first)."""
+    pts = np.ascontiguousarray(pts)
+    while len(pts) > 3:
+        step = np.hypot(*(np.roll(pts, -1, axis=0) - pts).T)  # step i: vertex i -> i + 1 (cyclic)
+        bad = np.nonzero(step < spacing)[0]
+        if bad.size == 0:
+            break
+        # drop the later vertex of each short step; of a run of short steps only every other one per pass
+        bad = bad[np.concatenate([[True], np.diff(bad) > 1])]
+        drop = (bad + 1) % len(pts)
+        drop = drop[drop != 0] if len(drop) > 1 else drop
+        pts = np.delete(pts, drop, axis=0)
     return pts
