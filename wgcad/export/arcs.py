@@ -18,7 +18,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-__all__ = ["ArcPath", "fit_pieces", "arc_points", "arc_deviation", "bulge_centres"]
+__all__ = ["ArcPath", "fit_pieces", "fit_gear", "arc_points", "arc_deviation", "bulge_centres", "segment_tangents"]
 
 #: Curve points checked per biarc while fitting (the curve->arc distance).
 #: The independent check, :func:`arc_deviation`, samples the arcs instead.
@@ -41,9 +41,10 @@ class ArcPath:
     bulges : (n,) float
         ``tan(theta / 4)`` of each segment, ``theta`` its signed included
         angle (positive counter-clockwise); 0 for a straight segment.
-    source : (n, 3) float
-        ``(piece index, t_start, t_end)``: the exact curve each segment
-        replaces (for the deviation check).
+    source : (n, 4) float
+        ``(piece index, t_start, t_end, turn)``: the exact curve each
+        segment replaces is piece ``index`` between those parameters, turned
+        by ``turn`` (rad) about the origin (for the deviation check).
     end : (2,) float or None
         ``None`` for a closed path; else the end point of the last segment.
     """
@@ -66,7 +67,9 @@ class ArcPath:
         c, s = np.cos(angle), np.sin(angle)
         v = self.vertices
         rot = lambda p: np.stack([c * p[..., 0] - s * p[..., 1], s * p[..., 0] + c * p[..., 1]], axis=-1)  # noqa: E731
-        return ArcPath(rot(v), self.bulges, self.source, None if self.end is None else rot(self.end))
+        src = self.source.copy()
+        src[:, 3] += angle
+        return ArcPath(rot(v), self.bulges, src, None if self.end is None else rot(self.end))
 
     @property
     def n_arcs(self) -> int:
@@ -85,8 +88,8 @@ def _tangent(piece, t: float, forward: float) -> np.ndarray:
     if np.hypot(*d) <= 1e-9 * scale / max(abs(piece.t1 - piece.t0), 1e-300):
         # cusp (e.g. a cycloid's start on the pitch circle): P ~ P0 + P'' dt^2 / 2 leaves along +P'' either way
         d2 = piece.deriv2(np.array([t]))[0]
-        at_start = forward * (t - piece.t0) * np.sign(piece.t1 - piece.t0) <= 0 if piece.t1 != piece.t0 else True
-        d = d2 if at_start else -d2
+        # leaving the cusp (start of the piece) the path runs along +P''; arriving at it, along -P''
+        d = d2 if abs(t - piece.t0) <= abs(t - piece.t1) else -d2
     return _unit(d)
 
 
@@ -178,7 +181,7 @@ def _fit_piece(piece, index: int, tol: float, out_v, out_b, out_s):
     if piece.kind == "line":
         out_v.append(piece.point(np.array([t_a]))[0])
         out_b.append(0.0)
-        out_s.append((index, t_a, t_b))
+        out_s.append((index, t_a, t_b, 0.0))
         return
     if piece.kind == "arc":  # exact: one bulge segment (split in two above a half turn)
         theta = t_b - t_a
@@ -188,7 +191,7 @@ def _fit_piece(piece, index: int, tol: float, out_v, out_b, out_s):
         for k in range(n):
             out_v.append(pts[k])
             out_b.append(float(np.tan((ts[k + 1] - ts[k]) / 4.0)))
-            out_s.append((index, ts[k], ts[k + 1]))
+            out_s.append((index, ts[k], ts[k + 1], 0.0))
         return
     stack = [(t_a, t_b, 0)]
     while stack:
@@ -202,7 +205,7 @@ def _fit_piece(piece, index: int, tol: float, out_v, out_b, out_s):
             # the joint's parameter is not known exactly; the two halves share [a, b] as their source
             out_v.extend([pa, joint])
             out_b.extend([b0, b1])
-            out_s.extend([(index, a, b), (index, a, b)])
+            out_s.extend([(index, a, b, 0.0), (index, a, b, 0.0)])
             continue
         if depth >= MAX_DEPTH:
             raise ValueError(f"piece {index} ({piece.kind}) cannot be fitted by arcs within {tol:g} mm")
@@ -237,7 +240,7 @@ def fit_pieces(pieces, tol: float, closed: bool = True) -> ArcPath:
     for i, p in enumerate(pieces):
         _fit_piece(p, i, tol, out_v, out_b, out_s)
     end = None if closed else pieces[-1].point(np.array([pieces[-1].t1]))[0]
-    return ArcPath(np.asarray(out_v, dtype=float), np.asarray(out_b, dtype=float), np.asarray(out_s, dtype=float), end)
+    return ArcPath(np.asarray(out_v, dtype=float), np.asarray(out_b, dtype=float), np.asarray(out_s, dtype=float).reshape(-1, 4), end)
 
 
 def arc_deviation(path: ArcPath, pieces, n_per_arc: int = 64, newton_steps: int = 8) -> np.ndarray:
@@ -253,6 +256,9 @@ def arc_deviation(path: ArcPath, pieces, n_per_arc: int = 64, newton_steps: int 
     v = path.vertices
     ends = path.ends
     q = arc_points(v, ends, path.bulges, n_per_arc)  # (n, k, 2)
+    # into the frame of the source piece
+    c, sn = np.cos(-path.source[:, 3])[:, None], np.sin(-path.source[:, 3])[:, None]
+    q = np.stack([c * q[..., 0] - sn * q[..., 1], sn * q[..., 0] + c * q[..., 1]], axis=-1)
     dev = np.zeros(len(v))
     s = np.linspace(0.0, 1.0, n_per_arc)
     idx = path.source[:, 0].astype(int)
@@ -270,8 +276,8 @@ def arc_deviation(path: ArcPath, pieces, n_per_arc: int = 64, newton_steps: int 
         tt = t.ravel()
         qq = pts.reshape(-1, 2)
         lo, hi = np.broadcast_to(lo, t.shape).ravel(), np.broadcast_to(hi, t.shape).ravel()
-        # coarse start: nearest of 33 curve samples of the segment's window
-        grid = lo[:, None] + (hi - lo)[:, None] * np.linspace(0.0, 1.0, 33)[None, :]
+        # coarse start: nearest of 13 curve samples of the segment's window
+        grid = lo[:, None] + (hi - lo)[:, None] * np.linspace(0.0, 1.0, 13)[None, :]
         g = pc.point(grid.ravel()).reshape(grid.shape + (2,))
         k = np.argmin(np.hypot(*(g - qq[:, None, :]).transpose(2, 0, 1)), axis=1)
         tt = grid[np.arange(len(tt)), k]
@@ -286,3 +292,30 @@ def arc_deviation(path: ArcPath, pieces, n_per_arc: int = 64, newton_steps: int 
         d = np.hypot(*(pc.point(tt) - qq).T).reshape(t.shape)
         dev[sel] = d.max(axis=1)
     return dev
+
+
+def fit_gear(gear, tol: float) -> ArcPath:
+    """The whole toothed boundary of a gear as one closed arc path, in the order of ``gear.outline``.
+
+    One pitch (``gear.pieces``) is fitted once and turned ``z`` times by
+    ``k 2 pi / z + phase`` (bulges do not change under rotation); the
+    segment sources index ``gear.pieces`` with the turn of their tooth.
+    """
+    pieces = list(gear.pieces)
+    one = fit_pieces(pieces, tol, closed=False)
+    turned = [one.rotated(k * gear.pitch_angle + gear.spec.phase) for k in range(gear.spec.z)]
+    return ArcPath(np.concatenate([t.vertices for t in turned]), np.tile(one.bulges, gear.spec.z),
+                   np.concatenate([t.source for t in turned]))
+
+
+def segment_tangents(path: ArcPath) -> tuple[np.ndarray, np.ndarray]:
+    """Unit tangents at the start and at the end of every segment, in the direction of travel ``(n, 2)`` each."""
+    v, e = path.vertices, path.ends
+    chord = _unit(e - v)
+    half = 2.0 * np.arctan(path.bulges)  # theta / 2
+
+    def turn(u, a):
+        c, s = np.cos(a), np.sin(a)
+        return np.stack([c * u[:, 0] - s * u[:, 1], s * u[:, 0] + c * u[:, 1]], axis=-1)
+
+    return turn(chord, -half), turn(chord, half)
