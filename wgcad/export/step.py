@@ -10,7 +10,7 @@ import numpy as np
 from wgcad.errors import GeometryError
 from wgcad.export.atomic import atomic_write
 
-__all__ = ["wire_from_path", "wire_from_polygon", "circle_wire", "prism", "revolve_profile", "fuse", "cut", "drill",
+__all__ = ["wire_from_path", "wire_from_polygon", "bspline_wire", "circle_wire", "prism", "revolve_profile", "fuse", "cut", "drill",
            "write_step", "read_step", "solid_props", "step_text"]
 
 #: Fixed FILE_NAME time stamp, so the same design gives byte-identical STEP files.
@@ -75,6 +75,30 @@ def wire_from_polygon(points):
     return wire_from_path(pts, np.zeros(len(pts)))
 
 
+def bspline_wire(points):
+    """A closed wire of one smooth periodic B-spline interpolating ``points (n, 2)`` (closing point implicit)."""
+    from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeEdge
+    from OCP.BRep import BRep_Builder
+    from OCP.GeomAPI import GeomAPI_Interpolate
+    from OCP.collections import HArray1_gp_Pnt as TColgp_HArray1OfPnt
+    from OCP.TopoDS import TopoDS_Wire
+
+    pts = np.asarray(points, dtype=float)
+    arr = TColgp_HArray1OfPnt(1, len(pts))
+    for i, p in enumerate(pts):
+        arr.SetValue(i + 1, _pnt(*p))
+    interp = GeomAPI_Interpolate(arr, True, 1e-9)
+    interp.Perform()
+    if not interp.IsDone():
+        raise GeometryError("B-spline interpolation of a closed outline failed")
+    wire = TopoDS_Wire()
+    bld = BRep_Builder()
+    bld.MakeWire(wire)
+    bld.Add(wire, BRepBuilderAPI_MakeEdge(interp.Curve()).Edge())
+    wire.Closed(True)
+    return wire
+
+
 def circle_wire(radius: float, cx: float = 0.0, cy: float = 0.0):
     """A closed circular wire (one exact circle edge)."""
     from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeEdge, BRepBuilderAPI_MakeWire
@@ -132,28 +156,35 @@ def fuse(a, b):
     """Boolean union of two shapes."""
     from OCP.BRepAlgoAPI import BRepAlgoAPI_Fuse
 
-    op = BRepAlgoAPI_Fuse(a, b)
+    op = BRepAlgoAPI_Fuse()
+    _run(op, a, b)
     if not op.IsDone():
         raise GeometryError("solid union failed")
-    return _unify(op.Shape())
+    return op.Shape()
 
 
 def cut(a, b):
     """Boolean difference ``a - b``."""
     from OCP.BRepAlgoAPI import BRepAlgoAPI_Cut
 
-    op = BRepAlgoAPI_Cut(a, b)
+    op = BRepAlgoAPI_Cut()
+    _run(op, a, b)
     if not op.IsDone():
         raise GeometryError("solid difference failed")
-    return _unify(op.Shape())
+    return op.Shape()
 
 
-def _unify(shape):
-    from OCP.ShapeUpgrade import ShapeUpgrade_UnifySameDomain
+def _run(op, a, b) -> None:
+    """Run a boolean on both cores (OCCT's parallel mode)."""
+    from OCP.collections import List_TopoDS_Shape as TopTools_ListOfShape
 
-    u = ShapeUpgrade_UnifySameDomain(shape, True, True, False)
-    u.Build()
-    return u.Shape()
+    args, tools = TopTools_ListOfShape(), TopTools_ListOfShape()
+    args.Append(a)
+    tools.Append(b)
+    op.SetArguments(args)
+    op.SetTools(tools)
+    op.SetRunParallel(True)
+    op.Build()
 
 
 def drill(solid, holes, z0: float, z1: float):
@@ -182,6 +213,7 @@ def step_text(shapes: dict, name: str = "wgcad") -> str:
     from OCP.Interface import Interface_Static
     from OCP.STEPControl import STEPControl_AsIs, STEPControl_Writer
 
+    _quiet()
     Interface_Static.SetCVal_s("write.step.unit", "MM")
     Interface_Static.SetCVal_s("write.step.schema", "AP214IS")
     Interface_Static.SetCVal_s("write.step.product.name", name)
@@ -198,6 +230,14 @@ def step_text(shapes: dict, name: str = "wgcad") -> str:
             text = f.read()
     # the header's FILE_NAME carries the wall-clock time: fix it (reproducible output)
     return re.sub(r"(FILE_NAME\('[^']*',)'[^']*'", rf"\1'{FIXED_STAMP}'", text, count=1)
+
+
+def _quiet() -> None:
+    """Stop OpenCASCADE printing transfer statistics on stdout (the CLI's stdout is for its own output)."""
+    from OCP.Message import Message, Message_Gravity
+
+    for printer in Message.DefaultMessenger_s().Printers():
+        printer.SetTraceLevel(Message_Gravity.Message_Fail)
 
 
 def write_step(path: str | os.PathLike, shapes: dict) -> None:
@@ -220,6 +260,7 @@ def read_step(path: str | os.PathLike) -> list:
     from OCP.TopExp import TopExp_Explorer
     from OCP.TopoDS import TopoDS
 
+    _quiet()
     r = STEPControl_Reader()
     if r.ReadFile(str(path)) != IFSelect_RetDone:
         raise GeometryError(f"{path}: not a readable STEP file")
