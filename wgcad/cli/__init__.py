@@ -7,7 +7,7 @@ import sys
 
 from .. import __version__
 from ..errors import WgcadError
-from . import audit, generate, kinematics
+from . import audit, generate, kinematics, parts
 from .common import EPILOG, EXIT_INPUT, EXIT_INTERFERENCE, EXIT_OK, Parser, circle as _circle  # noqa: F401
 
 __all__ = ["main", "build_parser", "EXIT_OK", "EXIT_INTERFERENCE", "EXIT_INPUT"]
@@ -18,7 +18,7 @@ def build_parser() -> argparse.ArgumentParser:
                epilog=EPILOG, formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("--version", action="version", version=f"wgcad {__version__}")
     sub = p.add_subparsers(dest="command", required=True, parser_class=Parser)
-    for mod in (generate, audit, kinematics):
+    for mod in (generate, audit, kinematics, parts):
         mod.register(sub)
     return p
 

@@ -84,7 +84,7 @@ def load_parts(path) -> PartsSpec:
 
 def _r(x: float, step: float = 0.1) -> float:
     """Round a derived size to a workshop step (0.1 mm)."""
-    return max(step, round(x / step) * step)
+    return max(step, round(round(x / step) * step, 6))
 
 
 def part_sizes(spec: PartsSpec, drive) -> PartSizes:

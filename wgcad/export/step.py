@@ -229,7 +229,9 @@ def step_text(shapes: dict, name: str = "wgcad") -> str:
         with open(path, encoding="latin-1") as f:
             text = f.read()
     # the header's FILE_NAME carries the wall-clock time: fix it (reproducible output)
-    return re.sub(r"(FILE_NAME\('[^']*',)'[^']*'", rf"\1'{FIXED_STAMP}'", text, count=1)
+    text = re.sub(r"(FILE_NAME\('[^']*',)'[^']*'", rf"\1'{FIXED_STAMP}'", text, count=1)
+    # OCCT numbers products by how many were written in this process ('rigid 3'): drop the counter
+    return re.sub(r"PRODUCT\('([^']*?) \d+','\1 \d+'", r"PRODUCT('\1','\1'", text)
 
 
 def _quiet() -> None:
