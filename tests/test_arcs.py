@@ -1,6 +1,9 @@
 """Tests of wgcad.export.arcs: biarcs within the chord tolerance of the exact tooth curves (sampled along the arcs), tangent where the curve is smooth, closed and simple, and their DXF round trip."""
 
 import glob
+import os
+import shutil
+import subprocess
 import math
 from pathlib import Path
 
@@ -140,3 +143,23 @@ def test_exact_arcs_and_lines_are_copied():
     square = [pc.line((0, 0), (1, 0)), pc.line((1, 0), (1, 1)), pc.line((1, 1), (0, 1)), pc.line((0, 1), (0, 0))]
     sq = fit_pieces(square, 1e-3)
     assert np.all(sq.bulges == 0) and path_area(sq) == 1.0
+
+
+@pytest.mark.skipif(shutil.which("librecad") is None, reason="LibreCAD not installed")
+def test_librecad_reads_the_arc_dxf(tmp_path):
+    """A real CAD program opens an arc-path gear DXF with its gear-data text and draws it (optional)."""
+    drive = build_drive(load_design(Path(__file__).parent.parent / "templates" / "d4_discrete.toml"), tol=TOL)
+    path = tmp_path / "rigid.dxf"
+    write_dxf(path, [DxfLayer("RIGID", paths=(fit_gear(drive.rigid, TOL),), circles=((0, 0, drive.rigid_rim_radius),)),
+                     DxfLayer("GEAR_DATA", texts=((25.0, 20.0, 0.8, "RIGID GEAR DATA"),))])
+    env = dict(os.environ, QT_QPA_PLATFORM="offscreen")
+    subprocess.run(["librecad", "dxf2pdf", "-a", "-m", str(path)], cwd=tmp_path, env=env, check=True,
+                   capture_output=True, timeout=120)
+    pdf = tmp_path / "rigid.pdf"
+    assert pdf.exists() and pdf.stat().st_size > 10_000  # 88 teeth of arcs drawn, not an empty page
+    if shutil.which("pdftoppm"):  # LibreCAD draws text as strokes: look at the pixels instead
+        subprocess.run(["pdftoppm", "-gray", "-r", "40", str(pdf), str(tmp_path / "page")], check=True, timeout=60)
+        import matplotlib.image as mpimg
+
+        img = mpimg.imread(next(tmp_path.glob("page*.pgm")) if list(tmp_path.glob("page*.pgm")) else next(tmp_path.glob("page*")))
+        assert np.mean(np.asarray(img) < 0.5 * np.max(img)) > 0.005  # lines drawn on the page
