@@ -3,7 +3,8 @@
 Run from the repository root (not part of the test run):
 
     .venv/bin/python benchmarks/export.py                 # D1 involute and D1 cycloidal
-    .venv/bin/python benchmarks/export.py --no-step       # skip the (slow) STEP solids
+    .venv/bin/python benchmarks/export.py --no-step       # skip STEP
+    .venv/bin/python benchmarks/export.py --step-parts    # also STEP of the whole part set (slow: OCCT booleans)
 
 Prints a Markdown table and writes it with the raw figures to
 output/bench/export.{md,json}. Times are wall-clock best-of-N (N = 3, STEP
@@ -42,7 +43,7 @@ def best_of(fn, n=3):
     return min(ts), val
 
 
-def bench(design_path: Path, step: bool, tmp: Path) -> list[dict]:
+def bench(design_path: Path, step: bool, tmp: Path, parts_step: bool = False) -> list[dict]:
     from wgcad.cli.common import circle
     from wgcad.export.arcs import arc_deviation, fit_gear, fit_pieces
     from wgcad.export.dxf import DxfLayer, write_dxf
@@ -98,6 +99,30 @@ def bench(design_path: Path, step: bool, tmp: Path) -> list[dict]:
     t, _ = best_of(lambda: write_3mf(p, {q.name: q.mesh() for q in parts}))
     row("3mf", "3 parts", t, p)
     if step:
+        from wgcad.export import step as S
+        from wgcad.export.step import read_step, solid_props, write_step
+
+        # the two toothed rings as B-rep prisms of their arc outlines (the gears alone, no booleans)
+        for which, gear, rim in (("flexspline", drive.flex, drive.flex_rim_radius), ("rigid", drive.rigid, drive.rigid_rim_radius)):
+            path = fit_gear(gear, 1e-3)
+
+            def ring():
+                teeth = S.wire_from_path(path.vertices, path.bulges)
+                if rim < min(gear.r_a, gear.r_f):
+                    return S.prism(teeth, [S.circle_wire(rim)], bw)
+                return S.prism(S.circle_wire(rim), [teeth], bw)
+
+            t_sol, solid = best_of(ring, n=1)
+            p = tmp / f"{stem}_{which}_ring.step"
+            t_w, _ = best_of(lambda: write_step(p, {which: solid}), n=1)
+            t_r, back = best_of(lambda: read_step(p), n=1)
+            t_c, props = best_of(lambda: solid_props(back[0]), n=1)
+            from wgcad.export.arcs import path_area
+
+            vol = abs(path_area(path) - np.pi * rim * rim) * bw
+            row("step", which + " ring", t_sol + t_w, p, read_seconds=t_r, check_seconds=t_c, valid=props["valid"],
+                volume_rel_err=props["volume"] / vol - 1.0, faces=sum(props["faces"].values()))
+    if step and parts_step:
         from wgcad.export.step import read_step, solid_props, write_step
 
         for prt in parts:
@@ -114,12 +139,13 @@ def bench(design_path: Path, step: bool, tmp: Path) -> list[dict]:
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--no-step", action="store_true", help="skip STEP")
+    ap.add_argument("--step-parts", action="store_true", help="also STEP of the whole part set (cup, plug, flanged rigid gear): slow")
     ap.add_argument("--designs", default="d1_involute,d1_cycloidal")
     args = ap.parse_args()
     rows = []
     with tempfile.TemporaryDirectory() as d:
         for name in args.designs.split(","):
-            rows += bench(ROOT / "templates" / f"{name}.toml", not args.no_step, Path(d))
+            rows += bench(ROOT / "templates" / f"{name}.toml", not args.no_step, Path(d), args.step_parts)
     OUT.mkdir(parents=True, exist_ok=True)
     head = "| design | format | part | time s | size kB | vertices | arcs | max dev um | notes |\n|---|---|---|---|---|---|---|---|---|"
     lines = [head]

@@ -60,7 +60,10 @@ def test_default_sizes_are_derived_and_reported():
     drive = build_drive(load_design(TEMPLATES / "d1_involute.toml"), tol=TOL)
     sizes = part_sizes(PartsSpec(), drive)
     assert sizes.cup_length == 160.0  # generator.cone_length of the template
-    assert "cup_length" in sizes.derived and "plug_bore_diameter" not in sizes.values or sizes.plug_bore_diameter is None
+    assert "cup_length" in sizes.derived
+    assert sizes.plug_bore_diameter is None  # derived later, from the plug's own outline
+    # 0.7 h1 = 0.98 mm rounded to the 0.05 mm step; diaphragm 1.5 x shell
+    assert sizes.shell_thickness == pytest.approx(1.0) and sizes.diaphragm_thickness == pytest.approx(1.5)
     given = part_sizes(PartsSpec(cup_length=150.0, cup_bolt_count=6), drive)
     assert given.cup_length == 150.0 and "cup_length" not in given.derived
     assert given.cup_bolt_count == 6
