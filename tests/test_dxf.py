@@ -138,7 +138,8 @@ def test_layer_validation():
 def test_empty_layer_round_trips(tmp_path):
     write_dxf(tmp_path / "e.dxf", [DxfLayer("empty"), DxfLayer("0", circles=((0, 0, 1),))])
     back = read_dxf(tmp_path / "e.dxf")
-    assert back == {"empty": {"outlines": [], "circles": []}, "0": {"outlines": [], "circles": [(0.0, 0.0, 1.0)]}}
+    empty = {"outlines": [], "circles": [], "paths": [], "texts": []}
+    assert back == {"empty": empty, "0": {**empty, "circles": [(0.0, 0.0, 1.0)]}}
 
 
 def test_read_rejects_what_the_writer_never_writes(tmp_path):

@@ -203,6 +203,8 @@ _TABLES: dict[str, type] = {
     "imperfections": ImperfectionsSpec,
 }
 _OPTIONAL_TABLES = ("tooth", "sectors", "material", "bearing", "load", "imperfections")
+#: tables validated by other modules (``[parts]``: wgcad.design.parts), passed over here
+_OTHER_TABLES = ("parts",)
 
 
 def _base_type(tp) -> tuple[type, bool]:
@@ -350,7 +352,7 @@ def parse_design(data: dict, source: str = "<memory>") -> Design:
     if not isinstance(data, dict):
         raise DesignError("<file>", "must be a TOML document with tables")
     for key in data:
-        if key not in _TABLES:
+        if key not in _TABLES and key not in _OTHER_TABLES:
             near = difflib.get_close_matches(key, _TABLES, n=1)
             hint = f"; did you mean [{near[0]}]?" if near else f"; valid tables: {', '.join(_TABLES)}"
             raise DesignError(key, f"unknown table{hint}")

@@ -1,4 +1,4 @@
-"""DXF export and read-back of 2D outlines: one closed LWPOLYLINE per outline, circles as CIRCLE, in mm."""
+"""DXF export and read-back of 2D outlines: one closed LWPOLYLINE per outline (straight or with arc bulges), circles as CIRCLE, text lines as TEXT, in mm."""
 
 from __future__ import annotations
 
@@ -13,10 +13,11 @@ from ezdxf.lldxf.validator import is_valid_layer_name
 
 from wgcad.errors import InputFileError
 from wgcad.constants import DUPLICATE_TOL  # noqa: F401  (re-exported for callers)
+from wgcad.export.arcs import arc_points
 from wgcad.export.atomic import atomic_writer
-from wgcad.export.rings import clean_outline
+from wgcad.export.rings import clean_outline, min_spacing
 
-__all__ = ["DxfLayer", "build_dxf", "write_dxf", "read_dxf", "audit_dxf", "clean_outline"]
+__all__ = ["DxfLayer", "build_dxf", "write_dxf", "read_dxf", "audit_dxf", "clean_outline", "clean_path"]
 
 #: DXF version written: R2010 (AC1024), read by every current CAD program.
 DXF_VERSION = "R2010"
@@ -49,12 +50,20 @@ class DxfLayer:
         Circle centres and radii, ``r > 0``.
     color : int
         AutoCAD Color Index of the layer, 1..255 (7 = white/black).
+    paths : tuple of ((N, 2) float, (N,) float) pairs
+        Closed paths of arcs: vertices and the bulge ``tan(theta/4)`` of the
+        segment starting at each vertex (an :class:`~wgcad.export.arcs.ArcPath`
+        also works). Written as LWPOLYLINE with bulges.
+    texts : tuple of (x, y, height, str)
+        Single-line texts (lower-left corner, character height, mm).
     """
 
     name: str
     outlines: tuple = field(default=())
     circles: tuple = field(default=())
     color: int = 7
+    paths: tuple = field(default=())
+    texts: tuple = field(default=())
 
     def __post_init__(self):
         if not isinstance(self.name, str) or not is_valid_layer_name(self.name):
@@ -73,6 +82,23 @@ class DxfLayer:
             if not (math.isfinite(cx) and math.isfinite(cy) and math.isfinite(r) and r > 0):
                 raise ValueError(f"layer {self.name}: circle {k} must have finite centre and r > 0, got {c!r}")
             circles.append((cx, cy, r))
+        paths = []
+        for k, p in enumerate(self.paths):
+            v, b = (p.vertices, p.bulges) if hasattr(p, "bulges") else p
+            v, b = np.asarray(v, dtype=np.float64), np.asarray(b, dtype=np.float64)
+            if v.ndim != 2 or v.shape[1] != 2 or b.shape != (len(v),):
+                raise ValueError(f"layer {self.name}: path {k} must be (N, 2) vertices and (N,) bulges")
+            if not (np.all(np.isfinite(v)) and np.all(np.abs(b) <= 1.0)):
+                raise ValueError(f"layer {self.name}: path {k} needs finite vertices and |bulge| <= 1 (at most half circles)")
+            paths.append((_readonly(v), _readonly(b)))
+        texts = []
+        for k, t in enumerate(self.texts):
+            x, y, h, text = t
+            if not (math.isfinite(x) and math.isfinite(y) and h > 0 and isinstance(text, str) and "\n" not in text):
+                raise ValueError(f"layer {self.name}: text {k} must be (x, y, height > 0, one line)")
+            texts.append((float(x), float(y), float(h), text))
+        object.__setattr__(self, "paths", tuple(paths))
+        object.__setattr__(self, "texts", tuple(texts))
         object.__setattr__(self, "outlines", tuple(outlines))
         object.__setattr__(self, "circles", tuple(circles))
         object.__setattr__(self, "color", int(self.color))
@@ -131,15 +157,64 @@ def build_dxf(layers) -> "ezdxf.document.Drawing":
             e.lwpoints.set(np.column_stack([pts, np.zeros((len(pts), 3))]))
             lo = np.minimum(lo, pts.min(axis=0))
             hi = np.maximum(hi, pts.max(axis=0))
+        for k, (v, b) in enumerate(layer.paths):
+            try:
+                v, b = clean_path(v, b)
+            except ValueError as exc:
+                raise ValueError(f"layer {layer.name}: path {k}: {exc}") from None
+            e = msp.add_lwpolyline([], close=True, dxfattribs=attribs)
+            e.lwpoints.set(np.column_stack([v, np.zeros((len(v), 2)), b]))
+            # bounding box of the arcs, not only of their vertices
+            pts = arc_points(v, np.roll(v, -1, axis=0), b, 9).reshape(-1, 2)
+            lo = np.minimum(lo, pts.min(axis=0))
+            hi = np.maximum(hi, pts.max(axis=0))
         for cx, cy, r in layer.circles:
             msp.add_circle((cx, cy), r, dxfattribs=attribs)
             lo = np.minimum(lo, (cx - r, cy - r))
             hi = np.maximum(hi, (cx + r, cy + r))
+        for x, y, h, text in layer.texts:
+            msp.add_text(text, height=h, dxfattribs={**attribs, "insert": (x, y)})
     if np.all(lo <= hi):
         # Document.update_extents copies these into $EXTMIN/$EXTMAX on write.
         msp.dxf.extmin = (lo[0], lo[1], 0.0)
         msp.dxf.extmax = (hi[0], hi[1], 0.0)
     return doc
+
+
+def clean_path(vertices, bulges, tol: float | None = None):
+    """Drop segments of a closed bulge path that are no longer than ``tol`` (default :func:`min_spacing`).
+
+    A short segment's start vertex is removed, so the previous segment ends
+    where the short one ended: the path moves by at most ``tol``.
+
+    Returns
+    -------
+    (M, 2) vertices, (M,) bulges
+
+    Raises
+    ------
+    ValueError
+        If fewer than 2 segments remain, or coordinates are not finite.
+    """
+    v = np.asarray(vertices, dtype=np.float64)
+    b = np.asarray(bulges, dtype=np.float64)
+    if not np.all(np.isfinite(v)):
+        raise ValueError("path has non-finite coordinates")
+    tol = min_spacing(v) if tol is None else tol
+    while len(v) >= 2:
+        step = np.hypot(*(np.roll(v, -1, axis=0) - v).T)
+        short = step <= tol
+        if not short.any():
+            break
+        # drop every other short one so neighbours of the removed vertex are re-measured
+        k = np.nonzero(short)[0]
+        k = k[np.concatenate(([True], np.diff(k) > 1))]
+        keep = np.ones(len(v), dtype=bool)
+        keep[k] = False
+        v, b = v[keep], b[keep]
+    if len(v) < 2:
+        raise ValueError(f"path has {len(v)} distinct vertices, needs at least 2")
+    return v, b
 
 
 @contextlib.contextmanager
@@ -176,8 +251,33 @@ def write_dxf(path: str | os.PathLike, layers) -> None:
         # time and random GUIDs into the header; fixed metadata makes the
         # same design give byte-identical files (reproducible output).
         with _fixed_metadata():
+            _canonical_classes(doc)
             with open(temp, "wt", encoding=doc.output_encoding, errors="dxfreplace") as fp:
                 doc.write(fp)
+
+
+def _canonical_classes(doc) -> None:
+    """Put the CLASSES section in an order that does not depend on the hash seed.
+
+    ezdxf adds the version's required classes in a fixed order, then one
+    class per entity type in use, iterating a *set* of type names: the order
+    of e.g. ``LAYOUT`` and ``ACDBPLACEHOLDER`` followed ``PYTHONHASHSEED``, so
+    the same design gave different bytes in different processes. Adding the
+    classes now and sorting the set-derived ones by name makes the later
+    ``add_required_classes`` inside ``doc.write`` a no-op (it only adds
+    missing keys) and the file byte-reproducible.
+    """
+    from collections import OrderedDict
+
+    from ezdxf.sections.classes import REQ_R2004, REQUIRED_CLASSES
+
+    section = doc.classes
+    section.add_required_classes(doc.dxfversion)
+    fixed = REQUIRED_CLASSES.get(doc.dxfversion, REQ_R2004)
+    items = list(section.classes.items())
+    head = [kv for name in fixed for kv in items if kv[1].dxf.name == name]
+    rest = sorted((kv for kv in items if kv not in head), key=lambda kv: kv[0])
+    section.classes = OrderedDict(head + rest)
 
 
 def _readfile(path) -> "ezdxf.document.Drawing":
@@ -201,7 +301,9 @@ def read_dxf(path: str | os.PathLike) -> dict:
     -------
     dict
         ``{layer_name: {"outlines": [(N, 2) float64 arrays], "circles":
-        [(cx, cy, r)]}}`` in file order, for every layer that holds an entity
+        [(cx, cy, r)], "paths": [((N, 2) vertices, (N,) bulges)], "texts":
+        [(x, y, height, str)]}}`` in file order (polylines with any non-zero
+        bulge are paths, the others outlines), for every layer that holds an entity
         and every layer of the layer table other than ``0`` and
         ``Defpoints`` (so empty layers round-trip too).
 
@@ -209,32 +311,42 @@ def read_dxf(path: str | os.PathLike) -> dict:
     ------
     InputFileError
         When the file cannot be read or holds something the writer never
-        writes (open polylines, bulges or widths, other entity types):
+        writes (open polylines, widths, other entity types):
         silently dropping such entities would hide a broken export.
     """
     doc = _readfile(path)
     out: dict = {}
     for layer in doc.layers:
         if layer.dxf.name.lower() not in ("0", "defpoints"):
-            out[layer.dxf.name] = {"outlines": [], "circles": []}
+            out[layer.dxf.name] = _empty()
     for e in doc.modelspace():
         kind = e.dxftype()
         name = e.dxf.layer
         where = f"{path}: {kind} #{e.dxf.handle} on layer {name}"
-        entry = out.setdefault(name, {"outlines": [], "circles": []})
+        entry = out.setdefault(name, _empty())
         if kind == "LWPOLYLINE":
             values = e.lwpoints.values
             if not e.closed:
                 raise InputFileError(f"{where} is not closed (outlines must be closed)")
-            if np.any(values[:, 2:] != 0):
-                raise InputFileError(f"{where} has widths or bulges (outlines must be straight segments)")
-            entry["outlines"].append(np.array(values[:, :2], dtype=np.float64))
+            if np.any(values[:, 2:4] != 0):
+                raise InputFileError(f"{where} has widths (outlines must be plain lines and arcs)")
+            if np.any(values[:, 4] != 0):
+                entry["paths"].append((np.array(values[:, :2], dtype=np.float64), np.array(values[:, 4], dtype=np.float64)))
+            else:
+                entry["outlines"].append(np.array(values[:, :2], dtype=np.float64))
         elif kind == "CIRCLE":
             c = e.dxf.center
             entry["circles"].append((float(c.x), float(c.y), float(e.dxf.radius)))
+        elif kind == "TEXT":
+            p = e.dxf.insert
+            entry["texts"].append((float(p.x), float(p.y), float(e.dxf.height), e.dxf.text))
         else:
-            raise InputFileError(f"{where} is not supported (only closed LWPOLYLINE and CIRCLE)")
+            raise InputFileError(f"{where} is not supported (only closed LWPOLYLINE, CIRCLE and TEXT)")
     return out
+
+
+def _empty() -> dict:
+    return {"outlines": [], "circles": [], "paths": [], "texts": []}
 
 
 def audit_dxf(path: str | os.PathLike) -> int:

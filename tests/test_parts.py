@@ -1,0 +1,209 @@
+"""Tests of the part set (wgcad parts): every export read back and checked against the 2D areas, the plug against the law's neutral line, bad sizes refused with nothing written."""
+
+import re
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+import shapely
+import trimesh
+
+from conftest import TEMPLATES, edit_toml
+from wgcad.cli import main
+from wgcad.design import load_design
+from wgcad.design.parts import PartsSpec, load_parts, part_sizes
+from wgcad.drive import build_drive
+from wgcad.errors import DesignError
+from wgcad.export.dxf import audit_dxf, read_dxf
+from wgcad.export.parts import build_parts
+from wgcad.export.parts.bodies import plug_outline
+from wgcad.export.threemf import read_3mf
+
+ALL = sorted(p.stem for p in TEMPLATES.glob("*.toml"))
+TOL = 1e-3  # mm, chord tolerance of the runs
+
+# Plug: the plug outline offset outward by the bearing and half the rim
+# (shapely's buffer, a second construction) must lie on the law's neutral
+# line. Both polylines are within the chord tolerance of their curves, the
+# buffer's round joins (64 segments per quarter) add < 0.2 um at 10 mm:
+# measured 0.02-0.13 um on the templates; 2 x chord tolerance is the bound.
+PLUG_TOL = 2 * TOL
+
+
+def small_design(tmp_path, parts_lines=""):
+    """D4 with 40/42 teeth: the whole part set in STEP takes seconds."""
+    text = (TEMPLATES / "d4_discrete.toml").read_text()
+    text = edit_toml(text, "drive", "z_flex", "40")
+    text = edit_toml(text, "drive", "z_rigid", "42")
+    path = tmp_path / "small.toml"
+    path.write_text(text + ("\n[parts]\n" + parts_lines + "\n" if parts_lines else ""))
+    return path
+
+
+@pytest.mark.parametrize("name", ALL)
+def test_plug_offset_by_the_bearing_reproduces_the_neutral_line(name):
+    design = TEMPLATES / f"{name}.toml"
+    drive = build_drive(load_design(design), tol=TOL)
+    sizes = part_sizes(load_parts(design), drive)
+    po = plug_outline(drive, sizes)
+    off = po["offset_mm"]
+    # internal deformation: plug inside (offset < 0); external: generator ring's bore outside (offset > 0)
+    assert (off > 0) == drive.external
+    assert abs(off) == pytest.approx(0.5 * drive.design.flexspline.rim_thickness + sizes.bearing_thickness, rel=1e-12)
+    back = shapely.Polygon(po["outline"]).buffer(-off, quad_segs=64).exterior
+    hd = shapely.hausdorff_distance(back, shapely.LinearRing(po["neutral"]), densify=0.05)
+    assert hd <= PLUG_TOL
+
+
+def test_default_sizes_are_derived_and_reported():
+    drive = build_drive(load_design(TEMPLATES / "d1_involute.toml"), tol=TOL)
+    sizes = part_sizes(PartsSpec(), drive)
+    assert sizes.cup_length == 160.0  # generator.cone_length of the template
+    assert "cup_length" in sizes.derived
+    assert sizes.plug_bore_diameter is None  # derived later, from the plug's own outline
+    # 0.7 h1 = 0.98 mm rounded to the 0.05 mm step; diaphragm 1.5 x shell
+    assert sizes.shell_thickness == pytest.approx(1.0) and sizes.diaphragm_thickness == pytest.approx(1.5)
+    given = part_sizes(PartsSpec(cup_length=150.0, cup_bolt_count=6), drive)
+    assert given.cup_length == 150.0 and "cup_length" not in given.derived
+    assert given.cup_bolt_count == 6
+
+
+@pytest.mark.parametrize("line, field", [
+    ("cup_bolt_circle_diameter = 200.0", "parts.cup_bolt_circle_diameter"),  # outside the cup bore
+    ("cup_bolt_circle_diameter = 4.5", "parts.cup_bolt_circle_diameter"),  # cuts into the hub bore
+    ("cup_bolt_count = 60\ncup_bolt_hole_diameter = 1.0", "parts.cup_bolt_count"),  # holes overlap
+    ("diaphragm_thickness = 40.0", "parts.diaphragm_thickness"),  # thicker than the cup behind the rim
+    ("bearing_thickness = 7.5", "parts.bearing_thickness"),  # no plug left inside the bearing
+    ("plug_bore_diameter = 20.0", "parts.plug_bore_diameter"),  # bore larger than the plug
+    ("flange_bolt_circle_diameter = 300.0", "parts.flange_bolt_circle_diameter"),
+    ("shell_thickness = 5.0", "parts.shell_thickness"),
+    ("cup_lenght = 5.0", "parts.cup_lenght"),
+    ("cup_length = -5.0", "parts.cup_length"),
+])
+def test_bad_sizes_one_line_error_exit_2_nothing_written(tmp_path, capsys, line, field):
+    design = small_design(tmp_path, line)
+    out = tmp_path / "out"
+    code = main(["parts", str(design), "--out", str(out), "--format", "dxf,stl"])
+    err = capsys.readouterr().err
+    assert code == 2
+    assert err.count("\n") == 1 and err.startswith(f"wgcad: error: {field}:"), err
+    assert not out.exists()
+
+
+@pytest.fixture(scope="module")
+def small_run(tmp_path_factory):
+    """Every format of the small design's part set, plus the assembly at 30 deg, through the CLI."""
+    tmp = tmp_path_factory.mktemp("parts")
+    design = small_design(tmp)
+    out = tmp / "out"
+    assert main(["parts", str(design), "--out", str(out), "--generator-angle", "30", "--quiet"]) == 0
+    drive = build_drive(load_design(design), tol=TOL)
+    parts = {p.name: p for p in build_parts(drive, part_sizes(load_parts(design), drive), generator_angles_deg=[30.0])}
+    return out, parts, drive
+
+
+def test_step_solids_valid_with_2d_volumes_and_bounds(small_run):
+    from wgcad.export.step import read_step, solid_props
+
+    out, parts, drive = small_run
+    for name in ("flexspline", "plug", "rigid"):
+        solids = read_step(out / f"small_{name}.step")
+        assert len(solids) == 1
+        pr = solid_props(solids[0])
+        assert pr["valid"], name
+        p = parts[name]
+        if name == "plug":
+            # a periodic B-spline through the outline's points: within the chord tolerance along its length
+            assert abs(pr["volume"] - p.volume_mm3) <= p.info["volume_tol_mm3"]
+            assert pr["faces"].get("GeomAbs_Plane", 0) == 2  # the two ends; the seat is one smooth face
+        else:
+            # exact arcs and circles: the solid's volume is the 2D area x width to rounding
+            assert pr["volume"] == pytest.approx(p.volume_mm3, rel=1e-9), name
+            # smooth tooth faces: one cylinder per written arc, not facets
+            assert pr["faces"].get("GeomAbs_Plane", 0) <= 6
+            assert pr["faces"]["GeomAbs_Cylinder"] >= 5 * drive.flex.spec.z
+        lo, hi = np.array(pr["bounds"])
+        elo, ehi = np.array(p.bounds)
+        assert np.allclose(lo[2], elo[2], atol=1e-6) and np.allclose(hi[2], ehi[2], atol=1e-6)
+        assert np.all(np.abs(hi[:2]) <= np.abs(ehi[:2]) + 1e-6)
+
+
+def test_step_is_byte_reproducible(small_run, tmp_path):
+    out, parts, drive = small_run
+    from wgcad.export.step import write_step
+
+    write_step(tmp_path / "again.step", {"rigid": parts["rigid"].solid()})
+    a = (out / "small_rigid.step").read_bytes()
+    assert re.search(rb"FILE_NAME\('[^']*','2000-01-01T00:00:00'", a)
+    assert a == (tmp_path / "again.step").read_bytes()
+
+
+def _check_mesh(mesh, part, what):
+    assert mesh.is_watertight, what
+    assert mesh.is_volume, what
+    # inscribed polygons: every surface within the chord tolerance of the exact one
+    assert abs(mesh.volume - part.volume_mm3) <= TOL * mesh.area + part.info.get("volume_tol_mm3", 0.0), what
+
+
+def test_stl_and_3mf_watertight_after_read_back(small_run):
+    out, parts, drive = small_run
+    for name, p in parts.items():
+        back = trimesh.load(out / f"small_{name}.stl", force="mesh")  # float32, vertices merged by the reader
+        if name.startswith("assembly"):
+            for body in back.split(only_watertight=False):
+                assert body.is_watertight
+            assert back.volume == pytest.approx(p.volume_mm3, rel=1e-3)
+        else:
+            _check_mesh(back, p, f"{name}.stl")
+    pkg = read_3mf(out / "small_parts.3mf")
+    assert pkg["unit"] == "millimeter"
+    assert list(pkg["objects"]) == ["flexspline", "plug", "rigid"]  # one object per part
+    for name, (v, f) in pkg["objects"].items():
+        _check_mesh(trimesh.Trimesh(v, f, process=True), parts[name], f"{name} in 3MF")
+    asm = read_3mf(out / "small_assembly_phip030_000.3mf")
+    assert sorted(asm["objects"]) == ["assembly_phip030_000_" + k for k in ("flexspline", "plug", "rigid")]
+    for v, f in asm["objects"].values():
+        assert trimesh.Trimesh(v, f, process=True).is_watertight
+
+
+def test_dxf_and_svg_of_the_parts(small_run):
+    out, parts, drive = small_run
+    for name in ("flexspline", "plug", "rigid"):
+        path = out / f"small_{name}.dxf"
+        assert audit_dxf(path) == 0
+        back = read_dxf(path)
+        for layer in back.values():
+            for o in layer["outlines"]:
+                assert shapely.LinearRing(o).is_simple
+                assert np.hypot(*(np.roll(o, -1, axis=0) - o).T).min() > 1e-6
+            for v, b in layer["paths"]:
+                assert np.hypot(*(np.roll(v, -1, axis=0) - v).T).min() > 1e-6
+        svg = (out / f"small_{name}.svg").read_text()
+        assert svg.startswith("<svg") and svg.rstrip().endswith("</svg>")
+    data = [t[3] for t in read_dxf(out / "small_flexspline.dxf")["GEAR_DATA"]["texts"]]
+    assert data[0] == "FLEXSPLINE GEAR DATA"
+    assert any(t.startswith("span W") for t in data) and any("pins" in t for t in data)
+    assert any(t.startswith("module m = 0.4 mm") for t in data)
+    rigid = [t[3] for t in read_dxf(out / "small_rigid.dxf")["GEAR_DATA"]["texts"]]
+    assert any(t.startswith("dimension between pins") for t in rigid)
+
+
+def test_polyline_style_and_format_choice(tmp_path):
+    design = small_design(tmp_path)
+    assert main(["parts", str(design), "--out", str(tmp_path / "o"), "--format", "dxf", "--dxf-style", "polyline", "--quiet"]) == 0
+    names = sorted(p.name for p in (tmp_path / "o").iterdir())
+    assert names == ["parts.json", "small_flexspline.dxf", "small_plug.dxf", "small_rigid.dxf"]
+    back = read_dxf(tmp_path / "o" / "small_flexspline.dxf")
+    assert back["FLEXSPLINE"]["outlines"] and not back["FLEXSPLINE"]["paths"]
+
+
+def test_parts_json_reports_sizes_and_defaults(tmp_path, capsys):
+    import json
+
+    design = small_design(tmp_path, "cup_bolt_count = 6")
+    assert main(["parts", str(design), "--out", str(tmp_path / "o"), "--format", "dxf", "--json"]) == 0
+    rep = json.loads(capsys.readouterr().out)
+    assert rep["sizes_mm"]["cup_bolt_count"] == 6 and "cup_bolt_count" not in rep["derived_from_gear_size"]
+    assert "cup_length" in rep["derived_from_gear_size"]
+    assert rep["parts"]["flexspline"]["gear_data"]["teeth"] == 40

@@ -1,0 +1,132 @@
+"""``wgcad parts``: the parts a shop makes (cup flexspline, generator plug, rigid gear, deformed assembly) as DXF, SVG, STL, 3MF and STEP."""
+
+from __future__ import annotations
+
+import argparse
+import json
+import time
+from pathlib import Path
+
+from .common import EPILOG, EXIT_OK, angles_deg, out_dir, positive_float
+
+__all__ = ["register", "cmd_parts", "FORMATS"]
+
+FORMATS = ("dxf", "svg", "stl", "3mf", "step")
+
+
+def formats(text: str) -> list[str]:
+    out = []
+    for part in text.split(","):
+        part = part.strip().lower()
+        if part not in FORMATS:
+            raise argparse.ArgumentTypeError(f"'{part}' is not a format (choose from {', '.join(FORMATS)})")
+        if part not in out:
+            out.append(part)
+    return out
+
+
+def _jsonable(v):
+    if isinstance(v, dict):
+        return {k: _jsonable(x) for k, x in v.items() if k not in ("plug_outline", "neutral_line", "meshes", "build_meshes")}
+    if isinstance(v, float):
+        return round(v, 6)
+    return v
+
+
+def cmd_parts(args) -> int:
+    t0 = time.perf_counter()
+    from ..design import load_design
+    from ..design.parts import load_parts, part_sizes
+    from ..drive import build_drive
+    from ..errors import GeometryError
+    from ..export.atomic import atomic_batch, ensure_writable_dir
+    from ..export.parts import build_parts
+
+    design = load_design(args.design)
+    spec = load_parts(args.design)
+    tol = args.chord_tol_um * 1e-3
+    drive = build_drive(design, tol=tol)
+    sizes = part_sizes(spec, drive)  # every fit rule is checked here or while building: before anything is written
+    parts = build_parts(drive, sizes, style=args.dxf_style, tol=tol, generator_angles_deg=args.generator_angle or [])
+    fmts = args.format
+    out = out_dir(args, args.design)
+    stem = Path(args.design).stem
+    # build everything before the output folder is touched
+    meshes = {}
+    if {"stl", "3mf"} & set(fmts):
+        for p in parts:
+            m = p.mesh()
+            if not m.is_watertight:
+                raise GeometryError(f"{p.name}: mesh is not watertight")
+            meshes[p.name] = m
+    solids = {}
+    if "step" in fmts:
+        for p in parts:
+            if not p.name.startswith("assembly"):
+                solids[p.name] = p.solid()
+    ensure_writable_dir(out)
+    files = []
+    report = {"design": str(args.design), "chord_tol_mm": tol, "dxf_style": args.dxf_style, "formats": fmts,
+              "sizes_mm": _jsonable(sizes.values), "derived_from_gear_size": list(sizes.derived), "parts": {}}
+    with atomic_batch() as batch:
+        def target(name):
+            path = out / name
+            files.append(path)
+            return batch.temp_path(path)
+
+        for p in parts:
+            entry = {"volume_mm3": round(p.volume_mm3, 4), **_jsonable(p.info)}
+            report["parts"][p.name] = entry
+            if p.layers and "dxf" in fmts:
+                from ..export.dxf import write_dxf
+
+                write_dxf(target(f"{stem}_{p.name}.dxf"), p.layers)
+            if p.layers and "svg" in fmts:
+                from ..export.svg import write_svg
+
+                write_svg(target(f"{stem}_{p.name}.svg"), p.layers, f"{design.drive.name}: {p.name}")
+            if "stl" in fmts:
+                from ..export.stl import write_stl
+
+                write_stl(target(f"{stem}_{p.name}.stl"), meshes[p.name])
+            if "step" in fmts and p.name in solids:
+                from ..export.step import write_step
+
+                write_step(target(f"{stem}_{p.name}.step"), {p.name: solids[p.name]})
+        if "3mf" in fmts:
+            from ..export.threemf import write_3mf
+
+            write_3mf(target(f"{stem}_parts.3mf"), {p.name: meshes[p.name] for p in parts if not p.name.startswith("assembly")})
+            for p in parts:
+                if p.name.startswith("assembly"):
+                    write_3mf(target(f"{stem}_{p.name}.3mf"), {f"{p.name}_{k}": m for k, m in p.info["meshes"].items()})
+        report["files"] = [f.name for f in files] + ["parts.json"]
+        Path(target("parts.json")).write_text(json.dumps(report, indent=2) + "\n")
+        files.pop()
+    if args.json:
+        print(json.dumps(report, indent=2))
+    elif not args.quiet:
+        print(f"{design.drive.name}: {len(parts)} parts ({', '.join(p.name for p in parts)})")
+        for k in sizes.derived:
+            print(f"  {k} = {sizes.values[k]:g} (derived from the gear size; set [parts].{k} to change)")
+        print(f"\n  wrote {len(files) + 1} files to {out}/ in {time.perf_counter() - t0:.2f} s")
+    return EXIT_OK
+
+
+def register(sub) -> None:
+    """Add the subcommand to the ``wgcad`` parser's subparsers."""
+    g = sub.add_parser("parts", help="write the parts a shop makes: cup flexspline, generator plug, rigid gear (DXF, SVG, STL, 3MF, STEP)",
+                       epilog=EPILOG, formatter_class=argparse.RawDescriptionHelpFormatter)
+    g.add_argument("design", help="design file (TOML); sizes of the parts from its optional [parts] table")
+    g.add_argument("--out", help="output folder (default: output/<design name>)")
+    g.add_argument("--format", type=formats, default=list(FORMATS), metavar="FMT[,FMT...]",
+                   help=f"file formats to write (default all: {','.join(FORMATS)})")
+    g.add_argument("--dxf-style", choices=("arcs", "polyline"), default="arcs",
+                   help="tooth outlines in DXF/SVG as tangent arcs (default) or straight segments")
+    g.add_argument("--chord-tol-um", type=positive_float(0.0, 100.0, "um"), default=1.0,
+                   help="largest distance between written geometry and exact curve, um (default 1)")
+    g.add_argument("--generator-angle", type=angles_deg, metavar="DEG[,DEG...]",
+                   help="also write the deformed assembly (STL/3MF meshes) at these generator angles, degrees")
+    g.add_argument("--json", action="store_true", help="print parts.json to stdout instead of the summary")
+    g.add_argument("--quiet", action="store_true", help="print nothing on success")
+    g.set_defaults(func=cmd_parts)

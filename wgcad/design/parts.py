@@ -1,0 +1,184 @@
+"""The optional ``[parts]`` table: sizes of the cup, wave-generator plug and rigid-gear body, with defaults derived from the gear size."""
+
+from __future__ import annotations
+
+import difflib
+import math
+import tomllib
+from dataclasses import dataclass, fields
+from pathlib import Path
+
+from ..errors import DesignError, InputFileError
+
+__all__ = ["PartsSpec", "PartSizes", "parse_parts", "load_parts", "part_sizes"]
+
+
+@dataclass(frozen=True)
+class PartsSpec:
+    """``[parts]``: every key optional (mm, counts); ``None`` means "derive from the gear size" (:func:`part_sizes`)."""
+
+    cup_length: float | None = None  # open end to the diaphragm's outer face
+    shell_thickness: float | None = None  # cup wall between the toothed rim and the diaphragm
+    diaphragm_thickness: float | None = None
+    hub_bore_diameter: float | None = None  # bore of the diaphragm
+    cup_bolt_circle_diameter: float | None = None
+    cup_bolt_count: int | None = None
+    cup_bolt_hole_diameter: float | None = None
+    bearing_thickness: float | None = None  # radial section of the flexible bearing (races + balls)
+    bearing_width: float | None = None  # axial
+    plug_bore_diameter: float | None = None
+    flange_outer_diameter: float | None = None  # rigid gear's mounting flange
+    flange_thickness: float | None = None
+    flange_bolt_circle_diameter: float | None = None
+    flange_bolt_count: int | None = None
+    flange_bolt_hole_diameter: float | None = None
+
+
+@dataclass(frozen=True)
+class PartSizes:
+    """The resolved sizes (mm): every field of :class:`PartsSpec` with a value, and which were derived."""
+
+    values: dict
+    derived: tuple
+
+    def __getattr__(self, name):
+        try:
+            return self.__dict__["values"][name]
+        except KeyError:
+            raise AttributeError(name) from None
+
+
+def parse_parts(data) -> PartsSpec:
+    """Build a :class:`PartsSpec` from the ``[parts]`` table (a dict, or None when absent)."""
+    if data is None:
+        return PartsSpec()
+    if not isinstance(data, dict):
+        raise DesignError("parts", f"must be a table [parts], got {type(data).__name__}")
+    known = {f.name: f for f in fields(PartsSpec)}
+    kw = {}
+    for key, value in data.items():
+        if key not in known:
+            near = difflib.get_close_matches(key, known, n=1)
+            hint = f"; did you mean '{near[0]}'?" if near else ""
+            raise DesignError(f"parts.{key}", f"unknown key{hint}")
+        where = f"parts.{key}"
+        if key.endswith("_count"):
+            if isinstance(value, bool) or not isinstance(value, int) or not 1 <= value <= 360:
+                raise DesignError(where, f"must be a whole number 1..360, got {value!r}")
+        else:
+            if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value) or not value > 0:
+                raise DesignError(where, f"must be a positive number of mm, got {value!r}")
+            value = float(value)
+        kw[key] = value
+    return PartsSpec(**kw)
+
+
+def load_parts(path) -> PartsSpec:
+    """The ``[parts]`` table of a design file (defaults when it has none)."""
+    try:
+        data = tomllib.loads(Path(path).read_bytes().decode("utf-8"))
+    except (OSError, UnicodeDecodeError, tomllib.TOMLDecodeError) as e:
+        raise InputFileError(f"{path}: cannot read the [parts] table ({e})") from None
+    return parse_parts(data.get("parts"))
+
+
+def _r(x: float, step: float = 0.1) -> float:
+    """Round a derived size to a workshop step (0.1 mm)."""
+    return max(step, round(round(x / step) * step, 6))
+
+
+def part_sizes(spec: PartsSpec, drive) -> PartSizes:
+    """Every part size, from the ``[parts]`` table or derived from the gear size, checked.
+
+    Defaults (``d`` the flexspline pitch diameter, ``r_in`` its bore radius,
+    ``h1`` the rim under its teeth, ``R_rim`` the rigid gear's outer radius):
+    cup length = ``generator.cone_length`` or ``0.8 d``; shell = ``0.7 h1``;
+    diaphragm = ``1.5 x`` shell; hub bore = ``0.5 r_in``; cup bolt circle in
+    the middle of the diaphragm's annulus, 8 holes of a third of its width;
+    bearing radial thickness ``0.06 x 2 r_in``, width ``0.8 x`` face width;
+    plug bore ``0.4 x`` the plug's smallest diameter; flange holes
+    ``max(2, 0.025 x 2 R_rim)``, flange ``R_rim + 3`` holes, bolt circle at
+    ``R_rim + 1.5`` holes, 12 holes, flange thickness ``0.3 x`` face width.
+
+    Raises
+    ------
+    DesignError
+        A bolt circle that does not fit its annulus (or whose holes overlap),
+        a diaphragm thicker than the cup beyond the toothed rim, a shell
+        thicker than the rim, a bearing that does not fit the plug (or a
+        plug bore larger than the plug).
+    """
+    d = drive.design
+    bw = d.drive.face_width
+    h1 = d.flexspline.rim_thickness
+    ext = drive.external
+    given = {f.name: getattr(spec, f.name) for f in fields(PartsSpec)}
+    v = dict(given)
+    derived = []
+
+    def default(key, value):
+        if v[key] is None:
+            v[key] = value
+            derived.append(key)
+
+    d_pitch = 2.0 * drive.flex.r
+    r_in = drive.flex_rim_radius  # flexspline bore (internal deformation) / outer surface (external)
+    default("cup_length", d.generator.cone_length if d.generator.cone_length is not None else _r(0.8 * d_pitch))
+    default("shell_thickness", _r(0.7 * h1, 0.05))
+    default("diaphragm_thickness", _r(1.5 * v["shell_thickness"], 0.05))
+    default("hub_bore_diameter", _r(0.5 * r_in))
+    default("cup_bolt_circle_diameter", _r(0.5 * v["hub_bore_diameter"] + r_in))
+    default("cup_bolt_count", 8)
+    annulus = r_in - 0.5 * v["hub_bore_diameter"]
+    default("cup_bolt_hole_diameter", _r(min(annulus / 3.0, 0.5 * math.pi * v["cup_bolt_circle_diameter"] / v["cup_bolt_count"])))
+    default("bearing_thickness", _r(0.06 * 2.0 * (r_in if not ext else drive.r_m)))
+    default("bearing_width", _r(0.8 * bw))
+    R_rim = drive.rigid_rim_radius
+    default("flange_bolt_hole_diameter", _r(max(2.0, 0.025 * 2.0 * R_rim)))
+    dh = v["flange_bolt_hole_diameter"]
+    if not ext:
+        default("flange_outer_diameter", _r(2.0 * (R_rim + 3.0 * dh)))
+        default("flange_bolt_circle_diameter", _r(2.0 * (R_rim + 1.5 * dh)))
+    else:  # external deformation: the rigid gear has external teeth; holes in its body between bore and root
+        default("flange_outer_diameter", _r(2.0 * min(drive.rigid.r_f, drive.rigid.r_a)))
+        default("flange_bolt_circle_diameter", _r(R_rim + min(drive.rigid.r_f, drive.rigid.r_a)))
+    default("flange_bolt_count", 12)
+    default("flange_thickness", _r(min(bw, max(0.3 * bw, 1.5 * dh))))
+
+    # --- rules (each names the key the user sets) ---
+    if v["shell_thickness"] > h1:
+        raise DesignError("parts.shell_thickness", f"{v['shell_thickness']:g} mm is thicker than the rim under the teeth (flexspline.rim_thickness {h1:g} mm)")
+    if not ext:
+        room = v["cup_length"] - bw
+        if v["cup_length"] <= bw:
+            raise DesignError("parts.cup_length", f"{v['cup_length']:g} mm leaves no shell behind the {bw:g} mm toothed rim")
+        if v["diaphragm_thickness"] >= room:
+            raise DesignError("parts.diaphragm_thickness", f"{v['diaphragm_thickness']:g} mm is thicker than the cup behind the toothed rim ({room:g} mm = cup_length - face_width)")
+        if v["hub_bore_diameter"] >= 2.0 * r_in:
+            raise DesignError("parts.hub_bore_diameter", f"{v['hub_bore_diameter']:g} mm leaves no diaphragm inside the cup bore {2 * r_in:.3f} mm")
+        _bolts("cup", v["cup_bolt_circle_diameter"], v["cup_bolt_hole_diameter"], v["cup_bolt_count"],
+               0.5 * v["hub_bore_diameter"], r_in, "the hub bore", "the cup wall")
+    if ext:
+        _bolts("flange", v["flange_bolt_circle_diameter"], dh, v["flange_bolt_count"], R_rim,
+               min(drive.rigid.r_f, drive.rigid.r_a), "the bore", "the root circle")
+    else:
+        if v["flange_outer_diameter"] <= 2.0 * R_rim:
+            raise DesignError("parts.flange_outer_diameter", f"{v['flange_outer_diameter']:g} mm must exceed the rigid gear's outer diameter {2 * R_rim:.3f} mm")
+        _bolts("flange", v["flange_bolt_circle_diameter"], dh, v["flange_bolt_count"], R_rim,
+               0.5 * v["flange_outer_diameter"], "the gear body", "the flange rim")
+    if v["flange_thickness"] > bw:
+        raise DesignError("parts.flange_thickness", f"{v['flange_thickness']:g} mm is thicker than the gear (face_width {bw:g} mm)")
+    if v["bearing_width"] > (v["cup_length"] if not ext else bw):
+        raise DesignError("parts.bearing_width", f"{v['bearing_width']:g} mm is longer than the cup")
+    return PartSizes(v, tuple(derived))
+
+
+def _bolts(prefix, bc_d, hole_d, count, r_lo, r_hi, inner, outer):
+    key = f"parts.{prefix}_bolt_circle_diameter"
+    r = 0.5 * bc_d
+    if r - 0.5 * hole_d <= r_lo:
+        raise DesignError(key, f"{bc_d:g} mm with {hole_d:g} mm holes cuts into {inner} (radius {r_lo:.3f} mm)")
+    if r + 0.5 * hole_d >= r_hi:
+        raise DesignError(key, f"{bc_d:g} mm with {hole_d:g} mm holes cuts through {outer} (radius {r_hi:.3f} mm)")
+    if count > 1 and bc_d * math.sin(math.pi / count) <= hole_d:
+        raise DesignError(f"parts.{prefix}_bolt_count", f"{count} holes of {hole_d:g} mm overlap on a {bc_d:g} mm bolt circle")

@@ -1,0 +1,112 @@
+"""The deformed assembly at one generator angle as meshes for visual checks: rigid gear, flexspline in axial slices (coning included), plug."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from wgcad.errors import GeometryError
+
+from . import Part
+from .solids import circle_points, prism_m, to_trimesh
+
+__all__ = ["deformed_assembly", "N_SLICES_CONED"]
+
+#: Axial slices of a coned flexspline's toothed rim: each slice is the
+#: deformed section at its middle (coning changes W0 linearly along the
+#: axis, docs/models.md 3.1); 6 slices make the taper visible.
+N_SLICES_CONED = 6
+
+
+def _rot(p, a):
+    c, s = np.cos(a), np.sin(a)
+    return np.stack([c * p[..., 0] - s * p[..., 1], s * p[..., 0] + c * p[..., 1]], axis=-1)
+
+
+def _area(p) -> float:
+    x, y = p[:, 0], p[:, 1]
+    return abs(0.5 * float(np.dot(x, np.roll(y, -1)) - np.dot(np.roll(x, -1), y)))
+
+
+def deformed_assembly(drive, sizes, generator_angle_deg: float, tol: float) -> Part:
+    """Meshes of the drive at generator angle ``generator_angle_deg`` (counter-clockwise from +x, relative to the fixed member).
+
+    Returns
+    -------
+    Part
+        ``mesh()`` is all bodies in one mesh; ``info["meshes"]`` has one
+        mesh per body (``rigid``, ``flexspline``, ``plug``) for 3MF; there is
+        no STEP solid (``make_solid`` raises).
+    """
+    import shapely
+    import trimesh
+
+    from wgcad.kinematics import gear_ratios
+    from wgcad.placement import deformed_curve, join_teeth, place_flex_teeth
+
+    from .bodies import plug_outline
+
+    d = drive.design.drive
+    bw = d.face_width
+    phi_abs = float(np.deg2rad(generator_angle_deg))
+    if d.fixed == "rigid":
+        phi_h, frame = phi_abs, 0.0
+    else:  # flexspline fixed: draw in its frame (as `wgcad generate` does)
+        phi_b = phi_abs / gear_ratios(d.z_flex, d.z_rigid)["u_hb"]
+        phi_h, frame = phi_abs - phi_b, phi_b
+    n_rim = max(720, int(np.ceil(2 * np.pi / np.sqrt(8 * tol / drive.r_m))))
+    ph = np.linspace(0.0, 2 * np.pi, n_rim, endpoint=False)
+    k = N_SLICES_CONED if drive.coned else 1
+    edges = np.linspace(0.0, bw, k + 1)
+    slices = []
+    vol = 0.0
+    for z0, z1 in zip(edges[:-1], edges[1:]):
+        zc = 0.5 * (z0 + z1)
+        teeth = _rot(place_flex_teeth(drive, phi_h, local=drive.flex.period, z=zc if drive.coned else None), frame)
+        outline = join_teeth(teeth)
+        law = drive.law_at(zc) if drive.coned else drive.law
+        rim = _rot(_rot(deformed_curve(law, drive.r_m, drive.flex_rim_radius - drive.r_m, ph), phi_h), frame)
+        if not shapely.LinearRing(outline).is_simple:
+            raise GeometryError(f"deformed flexspline outline at {generator_angle_deg:g} deg, z = {zc:.3f} mm is not simple")
+        outer, hole = (rim, outline) if drive.external else (outline, rim)
+        slices.append((outer, hole, z0, z1))
+        vol += (_area(outer) - _area(hole)) * (z1 - z0)
+    rigid_outline = _rot(drive.rigid.outline, frame)
+    R = drive.rigid_rim_radius
+    rim_c = circle_points(R, tol)
+    if drive.external:
+        vol += (_area(rigid_outline) - _area(rim_c)) * bw
+    else:
+        vol += (_area(rim_c) - _area(rigid_outline)) * bw
+    po = plug_outline(drive, sizes, n_rim)
+    plug = _rot(_rot(po["outline"], phi_h), frame)
+    pz0, pz1 = po["z_mm"] - 0.5 * sizes.bearing_width, po["z_mm"] + 0.5 * sizes.bearing_width
+    if drive.external:
+        R_out = float(np.hypot(*po["outline"].T).max()) + max(2.0, sizes.bearing_thickness)
+        ring = circle_points(R_out, tol)
+        vol += (_area(ring) - _area(plug)) * (pz1 - pz0)
+    else:
+        vol += _area(plug) * (pz1 - pz0)
+    meshes = {}
+
+    def mesh():
+        if not meshes:
+            if drive.external:
+                meshes["rigid"] = to_trimesh(prism_m(rigid_outline, [rim_c], 0.0, bw))
+                meshes["plug"] = to_trimesh(prism_m(ring, [plug], pz0, pz1))
+            else:
+                meshes["rigid"] = to_trimesh(prism_m(rim_c, [rigid_outline], 0.0, bw))
+                meshes["plug"] = to_trimesh(prism_m(plug, [], pz0, pz1))
+            flex = None
+            for outer, hole, z0, z1 in slices:
+                s = prism_m(outer, [hole], z0, z1)
+                flex = s if flex is None else flex + s
+            meshes["flexspline"] = to_trimesh(flex)
+        return trimesh.util.concatenate([meshes[n] for n in ("rigid", "flexspline", "plug")])
+
+    def solid():
+        raise GeometryError("the deformed assembly is exported as a mesh only")
+
+    tag = f"{generator_angle_deg:+08.3f}".replace("+", "p").replace("-", "m").replace(".", "_")
+    info = {"generator_angle_deg": generator_angle_deg, "slices": k, "meshes": meshes, "build_meshes": mesh}
+    lo = -max(R, float(np.hypot(*rigid_outline.T).max()))
+    return Part(f"assembly_phi{tag}", [], solid, mesh, vol, ((lo, lo, min(0.0, pz0)), (-lo, -lo, max(bw, pz1))), info)

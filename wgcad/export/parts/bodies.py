@@ -1,0 +1,264 @@
+"""The three bodies of a drive: cup flexspline (or toothed ring), wave-generator plug (or generator ring), rigid gear with flange and bolt holes."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from wgcad.errors import DesignError
+from wgcad.export.arcs import fit_gear, path_area
+from wgcad.export.dxf import DxfLayer
+from wgcad.export.gear_data import data_lines, gear_data
+
+from . import Part
+from .solids import bolt_circle, circle_points, holes_m, n_segments, prism_m, revolve_m, to_trimesh
+
+__all__ = ["flexspline", "plug", "rigid", "plug_outline", "data_layer"]
+
+PI = math.pi
+
+
+def data_layer(name: str, gear, tol: float, x: float, y: float, height: float) -> tuple:
+    """The GEAR_DATA text layer (one TEXT per line, top line at ``y``) and the data dict."""
+    data = gear_data(gear, tol)
+    lines = data_lines(name, data)
+    texts = tuple((x, y - 1.6 * height * k, height, line) for k, line in enumerate(lines))
+    return DxfLayer("GEAR_DATA", texts=texts, color=7), data, lines
+
+
+def _teeth_layer(name, gear, path, style, color):
+    if style == "arcs":
+        return DxfLayer(name, paths=(path,), color=color)
+    return DxfLayer(name, outlines=(gear.outline,), color=color)
+
+
+def _pappus(rz) -> float:
+    """Volume of the solid of revolution of a closed (r, z) polygon about z: 2 pi * integral of r dA (Green)."""
+    r, z = np.asarray(rz, dtype=float).T
+    r2, z2 = np.roll(r, -1), np.roll(z, -1)
+    # integral of r dr dz over the polygon = -(1/2) closed integral of r^2 dz ... use exact per-edge form
+    val = np.sum((z2 - z) * (r * r + r * r2 + r2 * r2)) / 6.0
+    return 2.0 * PI * abs(float(val))
+
+
+def _surface_bound(perimeters_mm, height_mm) -> float:
+    return float(np.sum(perimeters_mm)) * height_mm
+
+
+def flexspline(drive, sizes, style: str, tol: float) -> Part:
+    """The cup flexspline (internal deformation) or the internally toothed flexible ring (external)."""
+    from wgcad.export import step as S
+
+    g = drive.flex
+    d = drive.design
+    bw = d.drive.face_width
+    path = fit_gear(g, tol)
+    area = abs(path_area(path))
+    r_rim = drive.flex_rim_radius
+    tip_r = float(np.hypot(*g.outline.T).max())
+    text_h = max(0.5, round(0.02 * 2 * tip_r, 1))
+    gl, data, lines = data_layer("flexspline", g, tol, 1.15 * tip_r, tip_r, text_h)
+    layers = [_teeth_layer("FLEXSPLINE", g, path, style, 5)]
+    info = {"gear_data": data}
+    if drive.external:
+        R = r_rim
+        layers.append(DxfLayer("FLEXSPLINE_OUTER", circles=((0.0, 0.0, R),), color=5))
+        layers.append(gl)
+        vol = (PI * R * R - area) * bw
+
+        def solid():
+            return S.prism(S.circle_wire(R), [S.wire_from_path(path.vertices, path.bulges)], bw)
+
+        def mesh():
+            return to_trimesh(prism_m(circle_points(R, tol), [g.outline], 0.0, bw))
+
+        info["kind"] = "toothed flexible ring (external deformation: no cup)"
+        return Part("flexspline", layers, solid, mesh, vol, ((-R, -R, 0.0), (R, R, bw)), info)
+    L, ts, td = sizes.cup_length, sizes.shell_thickness, sizes.diaphragm_thickness
+    r_bore = 0.5 * sizes.hub_bore_diameter
+    holes = bolt_circle(sizes.cup_bolt_circle_diameter, sizes.cup_bolt_count, sizes.cup_bolt_hole_diameter)
+    rz = np.array([[r_rim, bw], [r_rim + ts, bw], [r_rim + ts, L], [r_bore, L], [r_bore, L - td], [r_rim, L - td]])
+    vol = (area - PI * r_rim**2) * bw + _pappus(rz) - len(holes) * PI * (0.5 * sizes.cup_bolt_hole_diameter) ** 2 * td
+    layers += [
+        DxfLayer("FLEXSPLINE_BORE", circles=((0.0, 0.0, r_rim),), color=5),
+        DxfLayer("CUP_SHELL", circles=((0.0, 0.0, r_rim + ts),), color=8),
+        DxfLayer("HUB_BORE", circles=((0.0, 0.0, r_bore),), color=3),
+        DxfLayer("CUP_BOLT_HOLES", circles=tuple((x, y, 0.5 * h) for x, y, h in holes), color=3),
+        gl,
+    ]
+
+    def solid():
+        # holes first, in the small shell: booleans cost grows with the faces involved
+        ring = S.prism(S.wire_from_path(path.vertices, path.bulges), [S.circle_wire(r_rim)], bw)
+        return S.fuse(ring, S.drill(S.revolve_profile(rz), holes, L - td, L))
+
+    def mesh():
+        ring = prism_m(g.outline, [circle_points(r_rim, tol)], 0.0, bw)
+        n = n_segments(r_rim + ts, tol)
+        return to_trimesh(ring + (revolve_m(rz, n) - holes_m(holes, L - td, L, tol)))
+
+    info.update({"kind": "cup flexspline", "cup_length_mm": L, "shell_thickness_mm": ts, "diaphragm_thickness_mm": td,
+                 "hub_bore_diameter_mm": 2 * r_bore, "bolt_circle_diameter_mm": sizes.cup_bolt_circle_diameter,
+                 "bolt_count": sizes.cup_bolt_count, "bolt_hole_diameter_mm": sizes.cup_bolt_hole_diameter})
+    return Part("flexspline", layers, solid, mesh, vol, ((-tip_r, -tip_r, 0.0), (tip_r, tip_r, L)), info)
+
+
+def plug_outline(drive, sizes, n: int | None = None) -> dict:
+    """Outline of the wave-generator plug (internal deformation) or the generator ring's bore (external).
+
+    The flexible bearing's races bend with the flexspline and keep their
+    radial section ``t_b``: the plug surface is the flexspline's deformed
+    inner surface offset inward by ``t_b`` along its normal, i.e. the
+    neutral line offset by ``-(h1/2 + t_b)`` (external deformation: outward
+    by ``h1/2 + t_b``), docs/models.md 3. The law is the one at the
+    generator's centre section (coned drives: ``drive.law_at(generator_z)``).
+
+    Returns
+    -------
+    dict
+        ``outline (n, 2)``, ``neutral (n, 2)``, ``offset_mm`` (signed, from
+        the neutral line), ``z_mm`` (generator section), ``phi (n,)``.
+    """
+    from wgcad.placement import deformed_curve
+
+    d = drive.design
+    bw = d.drive.face_width
+    z_g = d.generator.generator_z if d.generator.generator_z is not None else 0.5 * bw
+    law = drive.law_at(z_g) if drive.coned else drive.law
+    if n is None:
+        n = max(720, int(np.ceil(2 * np.pi / np.sqrt(8 * drive.tol / drive.r_m))))
+    ph = np.linspace(0.0, 2 * np.pi, n, endpoint=False)
+    half = drive.flex_rim_radius - drive.r_m  # -h1/2 (internal), +h1/2 (external)
+    off = half + (1.0 if drive.external else -1.0) * sizes.bearing_thickness
+    neutral = deformed_curve(law, drive.r_m, 0.0, ph)
+    outline = deformed_curve(law, drive.r_m, off, ph)
+    return {"outline": outline, "neutral": neutral, "offset_mm": off, "z_mm": z_g, "phi": ph}
+
+
+def _min_curvature_radius(pts: np.ndarray) -> float:
+    """Smallest radius of the circle through three consecutive vertices of a closed polygon, mm."""
+    a, b, c = np.roll(pts, 1, axis=0), pts, np.roll(pts, -1, axis=0)
+    ab, bc, ca = np.hypot(*(b - a).T), np.hypot(*(c - b).T), np.hypot(*(a - c).T)
+    cross = np.abs((b - a)[:, 0] * (c - a)[:, 1] - (b - a)[:, 1] * (c - a)[:, 0])
+    with np.errstate(divide="ignore"):
+        R = ab * bc * ca / (2.0 * cross)
+    return float(R.min())
+
+
+def plug(drive, sizes, tol: float) -> Part:
+    """The wave-generator plug (internal deformation) or generator ring (external), with its bearing seat outline."""
+    import shapely
+
+    from wgcad.export import step as S
+
+    po = plug_outline(drive, sizes)
+    outline, off = po["outline"], po["offset_mm"]
+    width = sizes.bearing_width
+    z0, z1 = po["z_mm"] - 0.5 * width, po["z_mm"] + 0.5 * width
+    rho = _min_curvature_radius(po["neutral"])
+    if not drive.external and -off >= rho:
+        raise DesignError("parts.bearing_thickness", f"the bearing ({sizes.bearing_thickness:g} mm) does not fit the plug: its seat lies "
+                          f"{-off:.3f} mm inside the neutral line, beyond the line's smallest radius of curvature {rho:.3f} mm")
+    if not shapely.LinearRing(outline).is_simple:
+        raise DesignError("parts.bearing_thickness", f"the bearing ({sizes.bearing_thickness:g} mm) does not fit the plug: its outline crosses itself")
+    radii = np.hypot(*outline.T)
+    info = {"bearing_thickness_mm": sizes.bearing_thickness, "bearing_width_mm": width, "seat_offset_from_neutral_mm": off,
+            "generator_section_z_mm": po["z_mm"], "neutral_min_curvature_radius_mm": rho,
+            "plug_major_diameter_mm": 2 * float(radii.max()), "plug_minor_diameter_mm": 2 * float(radii.min())}
+    area = abs(shapely.Polygon(outline).area)
+    perim = float(np.sum(np.hypot(*(np.roll(outline, -1, axis=0) - outline).T)))
+    if not drive.external:
+        bore_d = sizes.plug_bore_diameter if sizes.plug_bore_diameter is not None else round(0.4 * 2 * float(radii.min()), 1)
+        if 0.5 * bore_d >= 0.9 * float(radii.min()):
+            raise DesignError("parts.plug_bore_diameter", f"{bore_d:g} mm does not fit the plug (smallest plug diameter {2 * radii.min():.3f} mm, "
+                              f"wall at least a tenth of its radius)")
+        r_b = 0.5 * bore_d
+        vol = (area - PI * r_b**2) * width
+        info["plug_bore_diameter_mm"] = bore_d
+        layers = [DxfLayer("PLUG", outlines=(outline,), color=2), DxfLayer("PLUG_BORE", circles=((0.0, 0.0, r_b),), color=2),
+                  DxfLayer("NEUTRAL_LINE", outlines=(po["neutral"],), color=3)]
+        name = "plug"
+
+        def solid():
+            return S.prism(S.bspline_wire(outline), [S.circle_wire(r_b)], width, z0)
+
+        def mesh():
+            return to_trimesh(prism_m(outline, [circle_points(r_b, tol)], z0, z1))
+
+        rmax = float(radii.max())
+    else:
+        R_out = float(radii.max()) + max(2.0, sizes.bearing_thickness)
+        vol = (PI * R_out**2 - area) * width
+        info["ring_outer_diameter_mm"] = 2 * R_out
+        layers = [DxfLayer("GENERATOR_RING", outlines=(outline,), circles=((0.0, 0.0, R_out),), color=2),
+                  DxfLayer("NEUTRAL_LINE", outlines=(po["neutral"],), color=3)]
+        name = "generator_ring"
+
+        def solid():
+            return S.prism(S.circle_wire(R_out), [S.bspline_wire(outline)], width, z0)
+
+        def mesh():
+            return to_trimesh(prism_m(circle_points(R_out, tol), [outline], z0, z1))
+
+        rmax = R_out
+    info["volume_tol_mm3"] = tol * perim * width  # outline known to the chord tolerance along its whole length
+    info["plug_outline"] = outline
+    info["neutral_line"] = po["neutral"]
+    return Part(name, layers, solid, mesh, vol, ((-rmax, -rmax, z0), (rmax, rmax, z1)), info)
+
+
+def rigid(drive, sizes, style: str, tol: float) -> Part:
+    """The rigid gear: internal teeth in a ring with a bolted mounting flange (internal deformation) or external teeth on a bolted hub."""
+    from wgcad.export import step as S
+
+    g = drive.rigid
+    bw = drive.design.drive.face_width
+    path = fit_gear(g, tol)
+    area = abs(path_area(path))
+    R = drive.rigid_rim_radius
+    dh = sizes.flange_bolt_hole_diameter
+    holes = bolt_circle(sizes.flange_bolt_circle_diameter, sizes.flange_bolt_count, dh, phase=PI / sizes.flange_bolt_count)
+    hole_circles = tuple((x, y, 0.5 * h) for x, y, h in holes)
+    hole_area = len(holes) * PI * (0.5 * dh) ** 2
+    tf = sizes.flange_thickness
+    info = {"bolt_circle_diameter_mm": sizes.flange_bolt_circle_diameter, "bolt_count": sizes.flange_bolt_count, "bolt_hole_diameter_mm": dh}
+    if not drive.external:
+        Rf = 0.5 * sizes.flange_outer_diameter
+        tip_r = Rf
+        vol = (PI * R * R - area) * (bw - tf) + (PI * Rf * Rf - area - hole_area) * tf
+        gl, data, _ = data_layer("rigid", g, tol, 1.15 * Rf, Rf, max(0.5, round(0.02 * 2 * R, 1)))
+        layers = [_teeth_layer("RIGID", g, path, style, 1), DxfLayer("RIGID_OUTER", circles=((0.0, 0.0, R),), color=1),
+                  DxfLayer("FLANGE", circles=((0.0, 0.0, Rf),), color=1), DxfLayer("FLANGE_BOLT_HOLES", circles=hole_circles, color=3), gl]
+        info.update({"kind": "rigid gear with mounting flange", "flange_outer_diameter_mm": 2 * Rf, "flange_thickness_mm": tf})
+
+        def solid():
+            # the whole gear at flange size, then the flange's excess cut away below it: a fuse of two
+            # prisms would share every tooth face (coincident faces are the slow case of OCCT booleans)
+            teeth = S.wire_from_path(path.vertices, path.bulges)
+            body = S.prism(S.circle_wire(Rf), [teeth] + [S.circle_wire(0.5 * h, x, y) for x, y, h in holes], bw)
+            if tf >= bw:
+                return body
+            return S.cut(body, S.prism(S.circle_wire(Rf + 1.0), [S.circle_wire(R)], bw - tf + 1.0, -1.0))
+
+        def mesh():
+            plate = prism_m(circle_points(Rf, tol), [g.outline] + [circle_points(0.5 * h, tol, x, y) for x, y, h in holes], bw - tf, bw)
+            if tf >= bw:
+                return to_trimesh(plate)
+            return to_trimesh(prism_m(circle_points(R, tol), [g.outline], 0.0, bw - tf) + plate)
+    else:
+        tip_r = float(np.hypot(*g.outline.T).max())
+        vol = (area - PI * R * R - hole_area) * bw
+        gl, data, _ = data_layer("rigid", g, tol, 1.15 * tip_r, tip_r, max(0.5, round(0.02 * 2 * tip_r, 1)))
+        layers = [_teeth_layer("RIGID", g, path, style, 1), DxfLayer("RIGID_BORE", circles=((0.0, 0.0, R),), color=1),
+                  DxfLayer("BOLT_HOLES", circles=hole_circles, color=3), gl]
+        info["kind"] = "rigid gear (external teeth) with bolted hub"
+
+        def solid():
+            return S.prism(S.wire_from_path(path.vertices, path.bulges),
+                           [S.circle_wire(R)] + [S.circle_wire(0.5 * h, x, y) for x, y, h in holes], bw)
+
+        def mesh():
+            return to_trimesh(prism_m(g.outline, [circle_points(R, tol)] + [circle_points(0.5 * h, tol, x, y) for x, y, h in holes], 0.0, bw))
+    info["gear_data"] = data
+    return Part("rigid", layers, solid, mesh, vol, ((-tip_r, -tip_r, 0.0), (tip_r, tip_r, bw)), info)

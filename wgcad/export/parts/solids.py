@@ -1,0 +1,77 @@
+"""Mesh building blocks for the parts (manifold3d, float64 out): prisms with holes, solids of revolution, bolt-hole cylinders."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+__all__ = ["n_segments", "circle_points", "prism_m", "revolve_m", "holes_m", "to_trimesh", "ccw"]
+
+
+def n_segments(radius: float, tol: float) -> int:
+    """Polygon sides that keep a circle of ``radius`` within ``tol`` (inscribed), at least 64."""
+    return max(64, int(math.ceil(math.pi / math.acos(max(-1.0, 1.0 - tol / radius)))))
+
+
+def circle_points(radius: float, tol: float, cx: float = 0.0, cy: float = 0.0) -> np.ndarray:
+    """Counter-clockwise inscribed polygon ``(n, 2)`` of a circle."""
+    n = n_segments(radius, tol)
+    t = np.linspace(0.0, 2.0 * np.pi, n, endpoint=False)
+    return np.column_stack([cx + radius * np.cos(t), cy + radius * np.sin(t)])
+
+
+def ccw(pts: np.ndarray, positive: bool = True) -> np.ndarray:
+    """The polygon oriented counter-clockwise (``positive``) or clockwise."""
+    x, y = pts[:, 0], pts[:, 1]
+    area = 0.5 * float(np.dot(x, np.roll(y, -1)) - np.dot(np.roll(x, -1), y))
+    return pts if (area > 0) == positive else pts[::-1]
+
+
+def prism_m(outer, holes, z0: float, z1: float):
+    """manifold3d prism of a polygon region between ``z0`` and ``z1``."""
+    import manifold3d
+
+    from wgcad.export.rings import clean_outline
+
+    polys = [ccw(clean_outline(outer))] + [ccw(clean_outline(h), positive=False) for h in holes]
+    sec = manifold3d.CrossSection(polys, manifold3d.FillRule.Positive)
+    return manifold3d.Manifold.extrude(sec, z1 - z0).translate((0.0, 0.0, z0))
+
+
+def revolve_m(rz, n: int):
+    """manifold3d solid of revolution about z of a closed (r, z) polygon, ``n`` segments."""
+    import manifold3d
+
+    sec = manifold3d.CrossSection([ccw(np.asarray(rz, dtype=float))], manifold3d.FillRule.Positive)
+    return manifold3d.Manifold.revolve(sec, n)
+
+
+def holes_m(holes, z0: float, z1: float, tol: float):
+    """Union of axial cylinders ``[(cx, cy, d)]`` reaching 1 mm beyond ``z0..z1`` (to subtract)."""
+    out = None
+    for cx, cy, d in holes:
+        c = prism_m(circle_points(d / 2.0, tol, cx, cy), [], z0 - 1.0, z1 + 1.0)
+        out = c if out is None else out + c
+    return out
+
+
+def to_trimesh(m):
+    """float64 trimesh of a manifold (``to_mesh64``: ``to_mesh`` would round to float32)."""
+    import trimesh
+
+    from wgcad.errors import GeometryError
+
+    mesh64 = m.to_mesh64()
+    v = np.asarray(mesh64.vert_properties, dtype=np.float64)[:, :3]
+    f = np.asarray(mesh64.tri_verts, dtype=np.int64)
+    mesh = trimesh.Trimesh(vertices=v, faces=f, process=False)
+    if len(f) == 0 or not mesh.is_watertight or not mesh.is_volume:
+        raise GeometryError("part mesh is empty or not a closed volume")
+    return mesh
+
+
+def bolt_circle(diameter: float, count: int, hole: float, phase: float = 0.0) -> list:
+    """``[(cx, cy, hole)]`` of ``count`` holes evenly on a bolt circle, the first at angle ``phase``."""
+    return [(0.5 * diameter * math.cos(phase + 2 * math.pi * k / count), 0.5 * diameter * math.sin(phase + 2 * math.pi * k / count), hole)
+            for k in range(count)]
