@@ -117,7 +117,7 @@ def register(sub) -> None:
 
     k = sub.add_parser("ke", help="no-load kinematic error, lost motion and the installation-angle lever of an imperfect drive",
                        epilog=EPILOG, formatter_class=argparse.RawDescriptionHelpFormatter)
-    k.add_argument("design")
+    k.add_argument("design", help="design file (TOML) with an optional [imperfections] table, e.g. templates/d2_imperfect.toml")
     k.add_argument("--optimize-install-angle", action="store_true",
                    help="scan the rigid gear's installation angle (36 angles, then finer) and the flexspline's position")
     k.add_argument("--json", help="write the figures as JSON here")

@@ -251,7 +251,7 @@ def register(sub) -> None:
     s = sub.add_parser("sector", help="discrete-motion drive: sectored rigid gear, variable tooth heights, motion law, audit",
                        epilog=EPILOG.replace("interference found (audit)", "interference found (audit); tip-to-tip contact left with the built heights (sector)"),
                        formatter_class=argparse.RawDescriptionHelpFormatter)
-    s.add_argument("design")
+    s.add_argument("design", help="design file (TOML) with a [sectors] table, e.g. templates/d4_sectored.toml")
     s.add_argument("--out", help="output folder (default: output/<design name>)")
     s.add_argument("--heights", choices=("closed_form", "simulated", "full", "list"), default=None,
                    help="which heights are built (default: [sectors] heights)")

@@ -210,6 +210,8 @@ def fold_breaks(working: np.ndarray, nonworking: np.ndarray, rel: float = 0.02) 
     the rigid tooth it faces changes from one flank's side to the other's:
     the per-flank clearance jumps while the geometry does not. Such a step
     shows as ``(w, n) -> (~n, ~w)`` with a jump larger than the exchange error.
+    A lone step of one curve 200 times its median step is the same kind of
+    change of the facing rigid tooth (a continuous curve cannot step so).
 
     Parameters
     ----------
@@ -229,6 +231,12 @@ def fold_breaks(working: np.ndarray, nonworking: np.ndarray, rel: float = 0.02) 
     with np.errstate(invalid="ignore"):
         typical = np.nanmedian(jump) if jump.size else 0.0
         hit = (miss < rel * jump) & (jump > 50.0 * max(typical, 1e-12))
+        # a clearance to one fixed rigid tooth moves continuously with the tooth, so a lone
+        # step of one curve far beyond its typical step is its nearest rigid tooth changing
+        # (teeth deformed by more than a pitch, e.g. W0 = 2 m): a break too, not a jump
+        for c in (w, n):
+            d = np.abs(np.diff(c))
+            hit |= d > 200.0 * max(np.nanmedian(d) if d.size else 0.0, 1e-12)
     return np.nonzero(hit)[0]
 
 

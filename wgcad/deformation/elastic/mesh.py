@@ -8,7 +8,8 @@ import numpy as np
 from scipy.optimize import brentq
 
 from wgcad.clearance.engine import Scene, clearance_at_poses
-from wgcad.placement import tooth_pose, transform
+from wgcad.clearance.scene import refine_min
+from wgcad.placement import tooth_pose
 
 __all__ = ["passing_poses", "entry_gap"]
 
@@ -27,9 +28,9 @@ def passing_poses(scene: Scene, law, phi):
 
 
 def _tip_excess(scene: Scene, law, phi):
+    # the exact tip arc against the rigid tip circle, as the engine's entry crossing (docs/models.md 5)
     rot, shift = passing_poses(scene, law, phi)
-    tips = transform(scene.flex_tip_local, rot, shift)
-    return np.hypot(tips[..., 0], tips[..., 1]).max(axis=1) - scene.r_tip_b
+    return -scene.tip_radial(rot, shift)
 
 
 def entry_gap(scene: Scene, law, step_deg: float = 0.5) -> tuple[float, float]:
@@ -55,7 +56,9 @@ def entry_gap(scene: Scene, law, step_deg: float = 0.5) -> tuple[float, float]:
     t0 = brentq(lambda x: float(_tip_excess(scene, law, np.array([sgn * x]))[0]), t[i], t[i + 1], xtol=1e-12)
     phi = sgn * t0
     rot, shift = passing_poses(scene, law, np.array([phi]))
-    return float(clearance_at_poses(scene, rot, shift)["min"][0]), float(phi)
+    # the gap on the exact tooth curves, as the audit reports it (polygons only find the pair)
+    det = refine_min(scene, rot, shift, clearance_at_poses(scene, rot, shift))
+    return float(det["min"][0]), float(phi)
 
 
 
