@@ -47,7 +47,7 @@ def bounded_keys():
 @pytest.mark.parametrize("side", ["lo", "hi"])
 def test_every_bound_refuses_just_outside(table, key, meta, side):
     """Each declared bound of each key, on D1 (D1 cycloidal for involute-only keys is not needed: bounds are per key)."""
-    base = data("d1_involute")
+    base = data("d4_sectored" if table == "sectors" else "d1_involute")  # a [sectors] key needs a sector layout
     if table == "generator" and key == "offset":
         base["generator"] = {"law": "ellipse", "w0_coef": 1.1}  # the offset belongs to the ellipse law
     if table == "generator" and key == "beta_deg":
@@ -65,7 +65,7 @@ def test_every_bound_refuses_just_outside(table, key, meta, side):
     outside = v - eps if side == "lo" else v + eps
     if open_:
         outside = v
-    ints = key in ("z_flex", "z_rigid", "waves")
+    ints = key in ("z_flex", "z_rigid", "waves", "balls")
     if ints:
         outside = int(v) - 1 if side == "lo" else int(v) + 1
     bad = {**base, table: {**base.get(table, {}), key: outside}}

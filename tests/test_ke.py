@@ -120,9 +120,9 @@ def test_poses_of_an_imperfect_drive(d2):
 
 
 @pytest.mark.parametrize("key,value,msg", [
-    ("rigid_runout_um", "-5.0", "imperfections.rigid_runout_um: must be >= 0"),
+    ("rigid_runout_um", "-5.0", "imperfections.rigid_runout_um: must be in [0, m/4"),
     ("flex_runout_phase_deg", "400.0", "imperfections.flex_runout_phase_deg: must be in [-360, 360]"),
-    ("cam_offset_cam_um", "900.0", "imperfections.cam_offset_cam_um: must be at most a quarter module"),
+    ("cam_offset_cam_um", "900.0", "imperfections.cam_offset_cam_um: must be in [0, m/4 (in um) = 200] um, got 900"),
     ("runout_um", "5.0", "imperfections.runout_um: unknown key"),
 ])
 def test_bad_imperfections_exit_2(tmp_path, capsys, key, value, msg):

@@ -7,6 +7,7 @@ import math
 from dataclasses import dataclass, fields
 
 from ..errors import DesignError
+from .rules import key as _key
 
 __all__ = ["SectorsSpec", "KINDS", "HEIGHT_MODES", "validate_sectors", "sector_pitch_z"]
 
@@ -59,14 +60,14 @@ class SectorsSpec:
         major axis on the nearest sector boundary).
     """
 
-    kinds: tuple = ()
-    teeth: tuple = ()
-    pitch_z: tuple | None = None
-    start_deg: float = 0.0
-    heights: str = "closed_form"
-    heights_mm: tuple | None = None
-    tip_clearance_um: float = 10.0
-    assign: str = "register"
+    kinds: tuple = _key("kind of each sector, counter-clockwise: \"transmission\" or \"coupling\"", rule="2 x drive.waves sectors, kinds alternating, sectors a half turn apart identical", default=())
+    teeth: tuple = _key("teeth in each sector", unit="teeth", rule="one count per sector; sum of teeth / pitch_z over the sectors = 1 (the sectors fill the circle)", default=())
+    pitch_z: tuple | None = _key("pitch of each sector as the tooth count of a whole gear of that pitch", rule="coupling sectors: drive.z_flex; transmission sectors: any other", default=None, default_doc="drive.z_rigid (transmission), drive.z_flex (coupling)")
+    start_deg: float = _key("angle where the first sector begins, counter-clockwise from +x", unit="deg", lo=-360.0, hi=360.0, why="one turn either way", default=0.0)
+    heights: str = _key("coupling-tooth heights that are built", rule="closed_form | simulated | full | list", default="closed_form")
+    heights_mm: tuple | None = _key("with heights = \"list\": tooth heights (root to tip) of one coupling sector from its first tooth on", unit="mm", rule="one per coupling tooth, each > 0 and at most the full tooth height", default=None)
+    tip_clearance_um: float = _key("smallest tip clearance the simulated heights keep", unit="um", lo=0.0, hi=1000.0, hi_open=True, why="not negative; a millimetre of tip clearance leaves no tooth of a fine-module sector gear", default=10.0)
+    assign: str = _key("how the closed form assigns a generator angle to a tooth", rule="register | boundary", default="register")
 
     @property
     def active(self) -> bool:
