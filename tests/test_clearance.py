@@ -1,4 +1,4 @@
-"""The 2D clearance engine: distances against closed forms, shortcuts against the full computation (theory.md 5, 7)."""
+"""The 2D clearance engine: distances against closed forms, shortcuts against the full computation (docs/models.md 5, 7)."""
 
 from math import pi
 
@@ -78,7 +78,7 @@ def d1():
 
 
 def test_tooth_angle_reduction_matches_the_real_tooth(d1):
-    # theory.md 7: the engine evaluates a tooth at angle phi with the material angle
+    # docs/models.md 7: the engine evaluates a tooth at angle phi with the material angle
     # phi (z_b - z_g)/z_b; the real tooth k at generator angle phi_h must be congruent
     scene = Scene(d1)
     zg, zb = 200, 202
@@ -127,7 +127,7 @@ def test_engine_equals_brute_force(d4):
 
 
 def test_odd_tooth_counts_interleave_the_waves(d1):
-    # 201/203: the waves are offset by half a pitch; folding still holds (theory.md 7)
+    # 201/203: the waves are offset by half a pitch; folding still holds (docs/models.md 7)
     odd = build_drive(with_changes(d1.design, drive={"z_flex": 201, "z_rigid": 203}))
     angles = np.deg2rad(np.arange(0, 360, 4.0))
     fast = audit(odd, AuditSettings(angles=angles, sections=odd.sections(2), refine=False))

@@ -1,4 +1,4 @@
-"""Tests of wgcad.deformation.coning: linear amplitude along a cup flexspline (theory.md 3.1)."""
+"""Tests of wgcad.deformation.coning: linear amplitude along a cup flexspline (docs/models.md 3.1)."""
 
 import math
 

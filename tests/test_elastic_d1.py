@@ -1,4 +1,4 @@
-"""The elastic contact model on drive D1 (theory.md 9): residuals, stability, physical sense, the loaded law, bad input."""
+"""The elastic contact model on drive D1 (docs/models.md 9): residuals, stability, physical sense, the loaded law, bad input."""
 
 import subprocess
 import sys
@@ -106,7 +106,7 @@ def test_wind_up_grows_and_stiffness_is_of_catalogue_order(sweep):
     wind = [st.wind_up for st in sweep["states"]]
     assert all(b > a for a, b in zip(wind, wind[1:]))
     # secant stiffness to a third of the rated torque: catalogue drives of ~160 mm pitch
-    # diameter are of order 1e5 - 1e6 N m/rad (theory.md 4.1)
+    # diameter are of order 1e5 - 1e6 N m/rad (docs/models.md 4.1)
     k = 1000.0 / (wind[1] - wind[0])
     assert 1e5 <= k <= 1e6
 
@@ -168,7 +168,7 @@ def test_bearing_that_cannot_carry_the_load(tmp_path):
 
 def test_teeth_that_never_meet(tmp_path):
     # flexspline tips cut down to 81.9 mm and W0 = 0.4 mm: the tips stay 0.26 mm inside the rigid tip circle
-    p = _design(tmp_path, [("fillet_coef = 0.25    # theory.md 2.1 default", "fillet_coef = 0.25\ntip_radius = 81.9"),
+    p = _design(tmp_path, [("fillet_coef = 0.25    # docs/models.md 2.1 default", "fillet_coef = 0.25\ntip_radius = 81.9"),
                            ("w0_coef = 1.1 ", "w0_coef = 0.5 ")])
     r = _cli("audit", str(p), "--torque-nm", "500")
     assert r.returncode == 2 and "never" in r.stderr and r.stderr.count("\n") == 1

@@ -46,7 +46,7 @@ def test_diameter_change_of_two_opposite_forces():
 
 
 def test_four_force_law_is_the_ring_under_four_forces():
-    # theory.md 3.4 is an independent closed form of the same ring: normalised, every field agrees
+    # docs/models.md 3.4 is an independent closed form of the same ring: normalised, every field agrees
     beta = np.radians(35.0)
     law = FourForce(w0=0.88, r_m=R_M, beta=beta)
     ring = Ring(R_M, EI)
@@ -73,7 +73,7 @@ def test_positive_definite_on_the_deformable_modes():
     ring = Ring(R_M, EI)
     psi = np.random.default_rng(5).uniform(0, 2 * np.pi, 15)
     B = ring.block(psi[:, None] - psi[None, :])
-    # radial influence coefficients d_ij (theory.md 4.1): point loads always excite n >= 2, so positive definite
+    # radial influence coefficients d_ij (docs/models.md 4.1): point loads always excite n >= 2, so positive definite
     ev = np.linalg.eigvalsh(B[:, :, 0, 0])
     assert ev.min() > 1e-9 * ev.max()
     # all generalized loads (couples as force pairs: couple / r_m): symmetric positive semi-definite

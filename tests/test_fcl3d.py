@@ -1,4 +1,4 @@
-"""The 3D engine (python-fcl) against closed forms and against the 2D engine (theory.md 5: both must agree where both apply)."""
+"""The 3D engine (python-fcl) against closed forms and against the 2D engine (docs/models.md 5: both must agree where both apply)."""
 
 import json
 import subprocess

@@ -11,7 +11,7 @@ from wgcad.kinematics import RingVelocities, flex_rotation, gear_ratios, ring_ge
 
 
 def test_ratios_internal_deformation_200_202():
-    # theory.md 1: u_hg = -z_g/(z_b - z_g), u_hb = z_b/(z_b - z_g)
+    # docs/models.md 1: u_hg = -z_g/(z_b - z_g), u_hb = z_b/(z_b - z_g)
     assert gear_ratios(200, 202) == {"u_hg": -100.0, "u_hb": 101.0}
 
 
@@ -45,7 +45,7 @@ def test_flex_rotation_directions():
 
 @pytest.mark.parametrize("z_g,z_b", [(200, 202), (300, 298), (201, 203)])
 def test_mesh_period_one_pitch_each(z_g, z_b):
-    # theory.md 7: after the generator turns 2 pi / z_b relative to the rigid
+    # docs/models.md 7: after the generator turns 2 pi / z_b relative to the rigid
     # gear, the flexspline has moved exactly one of its pitches relative to
     # the generator (and the rigid gear one of its own).
     phi_h = 2 * math.pi / z_b
@@ -81,7 +81,7 @@ def test_velocities_against_time_finite_differences(law):
         red = np.abs(phi - math.pi * np.round(phi / math.pi))
         phi = phi[np.abs(red - law.beta) > 1e-2]
     vel = ring_generator_velocities(law, phi, OMEGA, H_C, A_W)
-    t = phi / OMEGA  # theory.md 3.5: phi = omega_h t
+    t = phi / OMEGA  # docs/models.md 3.5: phi = omega_h t
     h = 1e-3 / OMEGA  # 1e-3 rad of phi
 
     def field(name):

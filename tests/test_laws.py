@@ -237,7 +237,7 @@ def test_symmetry_and_periodicity(key):
 def test_ring_theory_relations(key):
     law = CASES[key]
     s = law.state(np.random.default_rng(3).uniform(-7, 7, 500))
-    # theory.md 3.1: v' = -w, theta = (v - w')/r_m, theta' = (v' - w'')/r_m.
+    # docs/models.md 3.1: v' = -w, theta = (v - w')/r_m, theta' = (v' - w'')/r_m.
     # dv is built as -w in the code, so the first is also checked by finite
     # differences below; theta of the disc law is an independent closed form.
     np.testing.assert_array_equal(s.dv, -s.w)
@@ -264,7 +264,7 @@ def test_derivatives_against_finite_differences(key):
 
 
 def test_harmonic_theta_example_of_theory():
-    # theory.md 3.1: w = W0 cos 2phi gives theta = (3 W0 / (2 r_m)) sin 2phi
+    # docs/models.md 3.1: w = W0 cos 2phi gives theta = (3 W0 / (2 r_m)) sin 2phi
     law = CASES["harmonic2"]
     phi = np.linspace(-3, 3, 31)
     np.testing.assert_allclose(
@@ -281,7 +281,7 @@ def test_two_wave_oval(key):
 
 
 def test_four_force_45_degrees_is_rejected_and_band_edges():
-    # theory.md 3.4 claims the 45 deg shape is four-fold symmetric: the closed
+    # docs/models.md 3.4 claims the 45 deg shape is four-fold symmetric: the closed
     # form gives w(pi/2) = w(0) there, i.e. four waves, hence rejected.
     beta = math.radians(45)
     D = 8 / math.cos(beta) - math.pi * (math.pi - 2 * beta + 2 * math.tan(beta))
@@ -337,7 +337,7 @@ def _disc_series(beta, phi):
     # pressure p, plus concentrated forces F at the contact edges (shear jumps).
     # q_n = (4/pi) [p sin(n beta)/n + F cos(n beta)], n even. The ratio F/p is
     # fixed by collocation: on the disc w = alpha cos(phi) + gamma, checked at
-    # phi = 0, beta/2, beta. Nothing of theory.md 3.3 is used.
+    # phi = 0, beta/2, beta. Nothing of docs/models.md 3.3 is used.
     qp = 4.0 * np.sin(_N * beta) / (np.pi * _N)
     qf = 4.0 * np.cos(_N * beta) / np.pi
     pts = np.array([0.0, 0.5 * beta, beta])
@@ -437,7 +437,7 @@ def test_ellipse_lies_on_offset_ellipse(key):
 
 def test_ellipse_agrees_with_harmonic_to_first_order():
     # To first order in W0/r_m the inextensible ellipse is the harmonic law
-    # (theory.md 3.1/3.2): the difference must shrink like W0^2.
+    # (docs/models.md 3.1/3.2): the difference must shrink like W0^2.
     phi = np.linspace(0, np.pi, 181)
     diffs = []
     for w0 in (0.8, 0.4):

@@ -164,7 +164,7 @@ def test_thickness_at_mid_depth_equals_the_outline_cut_by_the_circle(gear):
 
 
 def test_thickness_closed_form_by_hand():
-    # external involute tooth, theory.md 2.1: s(R) = 2R [s/(2r) + inv(a) - inv(a_R)]
+    # external involute tooth, docs/models.md 2.1: s(R) = 2R [s/(2r) + inv(a) - inv(a_R)]
     z, m, x, a = 40, 1.0, 0.2, np.deg2rad(20.0)
     g = make_gear(ToothSpec(z=z, module=m, internal=False, shift=x, fillet_coef=0.3))
     r, rb = z * m / 2, z * m / 2 * cos(a)

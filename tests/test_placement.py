@@ -1,4 +1,4 @@
-"""Placement of flexspline teeth on the deformed neutral line (theory.md 3.1, 7)."""
+"""Placement of flexspline teeth on the deformed neutral line (docs/models.md 3.1, 7)."""
 
 from math import pi
 
@@ -86,7 +86,7 @@ def test_ellipse_neutral_line_keeps_its_length():
 
 
 def test_mesh_period_maps_the_scene_onto_itself(d1):
-    # theory.md 7: after 2 pi / z_b of generator rotation, every tooth moved one position
+    # docs/models.md 7: after 2 pi / z_b of generator rotation, every tooth moved one position
     zb = d1.design.drive.z_rigid
     a = place_flex_teeth(d1, 0.3)
     b = place_flex_teeth(d1, 0.3 + 2 * pi / zb)
@@ -103,7 +103,7 @@ def test_tooth_on_major_axis_seated_in_rigid_space(d1):
     teeth = place_flex_teeth(d1, 0.0, teeth=[0])
     tip = teeth[0][np.argmax(np.hypot(*teeth[0].T))]
     assert np.hypot(*tip) == pytest.approx(d1.flex.r_a + d1.law.w0, abs=1e-9)
-    # symmetric about +x, the middle of a rigid space (reference position, theory.md 1)
+    # symmetric about +x, the middle of a rigid space (reference position, docs/models.md 1)
     assert np.allclose(np.sort(teeth[0][:, 1]), np.sort(-teeth[0][:, 1]), atol=1e-9)
 
 

@@ -1,4 +1,4 @@
-"""Tooth profiles against closed forms and independent computations (theory.md 2, 8)."""
+"""Tooth profiles against closed forms and independent computations (docs/models.md 2, 8)."""
 
 from math import pi
 
@@ -31,7 +31,7 @@ def _inv(a):
 
 
 def s_of_R(z, m, x, R, internal, alpha=ALPHA):
-    """Tooth thickness at radius R, theory.md 2.1, written out independently of wgcad."""
+    """Tooth thickness at radius R, docs/models.md 2.1, written out independently of wgcad."""
     r = m * z / 2
     rb = r * np.cos(alpha)
     aR = np.arccos(rb / R)
@@ -74,7 +74,7 @@ def test_involute_thickness_at_vertices_matches_closed_form(case):
 def test_base_pitch_between_all_teeth(case):
     # Every involute flank vertex, unrolled back to the base circle, gives the
     # angle where its involute starts; same-hand flanks of neighbouring teeth
-    # start one base pitch p_b = pi m cos(alpha) apart (theory.md 8), checked
+    # start one base pitch p_b = pi m cos(alpha) apart (docs/models.md 8), checked
     # on the assembled outline of the whole gear.
     z, m, internal, x, fc = case
     g = gear(z, m, internal, x, fc, tol=1e-5)
@@ -156,7 +156,7 @@ def _fillet_numeric(g, internal):
 @pytest.mark.parametrize("case", INVOLUTE_CASES)
 def test_area_against_radial_integral(case):
     # Area inside the toothed boundary = disc + z * integral of R * (angular width) dR,
-    # with the flank from theory.md 2.1 and the fillet centre found numerically.
+    # with the flank from docs/models.md 2.1 and the fillet centre found numerically.
     # Chord error of the polyline: |dA| <= perimeter * tol.
     z, m, internal, x, fc = case
     tol = 1e-5
@@ -186,7 +186,7 @@ def test_area_against_radial_integral(case):
 
 @pytest.mark.parametrize("internal", [False, True])
 def test_cycloid_vertices_on_closed_form(internal):
-    # Exact epi/hypocycloid on the pitch circle (theory.md 2.2): flank vertices at the
+    # Exact epi/hypocycloid on the pitch circle (docs/models.md 2.2): flank vertices at the
     # closed-form angle for their radius; thickness on the pitch circle p/2.
     z, m = (200, 0.8) if not internal else (202, 0.8)
     g = make_gear(ToothSpec(z=z, module=m, internal=internal, form="cycloidal", clearance_coef=0.1))

@@ -1,4 +1,4 @@
-"""Derived figures of the templates against hand calculation (theory.md 2.1, 3.3, 3.4, 9)."""
+"""Derived figures of the templates against hand calculation (docs/models.md 2.1, 3.3, 3.4, 9)."""
 
 from math import cos, pi, sin, tan
 
@@ -16,7 +16,7 @@ def drive(name):
 
 
 def test_theory_check_d1_depth_2m_clearances_quarter_m():
-    # theory.md 2.1: x_g 3.1, x_b 3.2, h_a* 1, c* 0.25, W0 = 1.1 m -> depth 2 m, both clearances 0.25 m
+    # docs/models.md 2.1: x_g 3.1, x_b 3.2, h_a* 1, c* 0.25, W0 = 1.1 m -> depth 2 m, both clearances 0.25 m
     m = 0.8
     mf = mesh_figures(drive("d1_involute"))
     assert mf["depth_of_engagement_mm"] == pytest.approx(2 * m, abs=1e-9)
@@ -25,7 +25,7 @@ def test_theory_check_d1_depth_2m_clearances_quarter_m():
 
 
 def test_d1_minor_axis_tip_gap_by_hand():
-    # four-force law, section II at phi = pi/2 (theory.md 3.4), written out here
+    # four-force law, section II at phi = pi/2 (docs/models.md 3.4), written out here
     m, beta, W0 = 0.8, np.deg2rad(35.0), 1.1 * 0.8
     D = 8 / cos(beta) - pi * (pi - 2 * beta + 2 * tan(beta))
     w_minor = W0 * (8 / cos(beta) - 2 * pi * (1 + beta * tan(beta))) / D
@@ -37,7 +37,7 @@ def test_d1_minor_axis_tip_gap_by_hand():
 
 
 def test_d4_disc_law_by_hand():
-    # disc law (theory.md 3.3) at phi = pi/2, section II; D4 template: m 0.4, x = 1, h_a* 0.75, W0 = 1.1 m
+    # disc law (docs/models.md 3.3) at phi = pi/2, section II; D4 template: m 0.4, x = 1, h_a* 0.75, W0 = 1.1 m
     m, beta, W0, ha, c = 0.4, np.deg2rad(30.0), 1.1 * 0.4, 0.75, 0.25
     A = pi / 2 - sin(beta) * cos(beta) - beta
     B = -2 * sin(beta) + 4 * beta / pi * sin(beta) + 4 / pi * cos(beta)
@@ -55,7 +55,7 @@ def test_d4_disc_law_by_hand():
 
 def test_d3_external_deformation_by_hand():
     # internal-toothed flexspline squeezed inward by W0 = m onto an external rigid gear, x = 0:
-    # depth 2 m, clearances 0.25 m (the mirror image of theory.md 2.1's check)
+    # depth 2 m, clearances 0.25 m (the mirror image of docs/models.md 2.1's check)
     m = 0.9
     mf = mesh_figures(drive("d3_external"))
     assert mf["w_major_mm"] == pytest.approx(-m)

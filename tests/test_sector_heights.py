@@ -1,4 +1,4 @@
-"""Variable tooth heights of the sectored rigid gear (theory.md 2.3): closed form and simulation, their properties and agreement."""
+"""Variable tooth heights of the sectored rigid gear (docs/models.md 2.3): closed form and simulation, their properties and agreement."""
 
 from math import pi
 

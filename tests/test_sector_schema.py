@@ -12,7 +12,7 @@ D4 = TEMPLATES / "d4_sectored.toml"
 
 # (table, key, new value, field named in the message, words of the rule)
 BAD = [
-    # theory.md 9 as printed: 86 flexspline teeth and 2 x 22 + 2 x 21 = 86 rigid teeth; with the flexspline's pitch in the
+    # docs/models.md 9 as printed: 86 flexspline teeth and 2 x 22 + 2 x 21 = 86 rigid teeth; with the flexspline's pitch in the
     # coupling sectors and 2 pi / 88 in the transmission sectors they cover 2 x (90 + 87.907) = 355.81 deg
     ("drive", "z_flex", "86", "sectors.teeth", "sectors must fill the circle"),
     ("sectors", "teeth", "[21, 22, 21, 23]", "sectors.teeth", "must be identical"),

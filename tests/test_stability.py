@@ -52,9 +52,9 @@ def inv(a):
     return math.tan(a) - a
 
 
-# ----------------------------------------------------------------------------- closed forms (theory.md 2.1, 2.2)
+# ----------------------------------------------------------------------------- closed forms (docs/models.md 2.1, 2.2)
 def closed_radii(form, m, z, internal, x, ha, c, tip=None, root=None):
-    """Tip and root radii of one gear, written out from theory.md 2.1/2.2 (overrides win)."""
+    """Tip and root radii of one gear, written out from docs/models.md 2.1/2.2 (overrides win)."""
     r = m * z / 2
     if form == "involute":
         r_a = r + m * (x - ha) if internal else r + m * (ha + x)
@@ -214,7 +214,7 @@ def check_drive(data, drive, rep) -> None:
         assert gear.tip_thickness >= constants.MIN_TIP_THICKNESS_COEF * m * (1 - 1e-12)
         assert (r_a < r_f) == internal
         heights[which] = abs(r_f - r_a)
-    # theory.md 1 gear ratios
+    # docs/models.md 1 gear ratios
     dz = d["z_rigid"] - d["z_flex"]
     assert rep["drive"]["ratio_rigid_fixed"] == pytest.approx(-d["z_flex"] / dz, abs=1e-9)
     assert rep["drive"]["ratio_flexspline_fixed"] == pytest.approx(d["z_rigid"] / dz, abs=1e-9)
@@ -223,7 +223,7 @@ def check_drive(data, drive, rep) -> None:
     if drive.coned:
         g = data["generator"]
         for key, z in (("z_0_mm", 0.0), (f"z_{d['face_width']:g}_mm", d["face_width"])):
-            w0z = w0 * (g["cone_length"] - z) / (g["cone_length"] - g["generator_z"])  # theory.md 3.1, coning
+            w0z = w0 * (g["cone_length"] - z) / (g["cone_length"] - g["generator_z"])  # docs/models.md 3.1, coning
             sets.append((key, rep["mesh_at_face_ends"][key], w0z))
     for where, mesh, w0z in sets:
         sgn = -1.0 if ext else 1.0
@@ -472,7 +472,7 @@ def test_tiny_perturbation_changes_figures_continuously(name, table, key, monkey
 
 # ----------------------------------------------------------------------------- near-degenerate: tip thickness at the minimum
 def _tip_thickness(form, m, z, internal, x, alpha, thinning, R):
-    """Tip thickness at tip radius R (closed form, theory.md 2.1/2.2)."""
+    """Tip thickness at tip radius R (closed form, docs/models.md 2.1/2.2)."""
     r = m * z / 2
     if form == "cycloidal":
         return 2 * R * (float(cy.exact_half_angle(r, m / 4, np.array([R]), internal)[0]) - thinning / (2 * r))

@@ -21,7 +21,7 @@ def tooth_spec(design: Design, which: str) -> ToothSpec:
     """The :class:`ToothSpec` of ``which`` (``"flexspline"`` or ``"rigid"``) of a design.
 
     Internal deformation: external-toothed flexspline, internal rigid gear;
-    external deformation the other way round (theory.md 1). The flexspline's
+    external deformation the other way round (docs/models.md 1). The flexspline's
     tooth 0 is centred on +x, the rigid gear's space is (reference position).
     """
     d = design
@@ -60,7 +60,7 @@ class Drive:
         centre section (``W0`` of the design).
     r_m : float
         Neutral-line radius of the flexspline rim, mm: the middle of the rim
-        under the teeth (theory.md 1).
+        under the teeth (docs/models.md 1).
     flex_rim_radius, rigid_rim_radius : float
         The other boundary of each gear body, mm (flexspline bore or outer
         surface; rigid gear outer surface or bore).
@@ -84,7 +84,7 @@ class Drive:
         return self.design.generator.cone_length is not None
 
     def law_at(self, z: float) -> Law:
-        """The deformation law of the cross-section at axial position ``z`` (mm from the open end), theory.md 3.1."""
+        """The deformation law of the cross-section at axial position ``z`` (mm from the open end), docs/models.md 3.1."""
         g = self.design.generator
         if g.cone_length is None:
             return self.law
@@ -98,11 +98,11 @@ class Drive:
 
 
 def _check_teeth_meet(design: Design) -> None:
-    """Refuse a drive whose teeth never meet: on the major axis the flexspline tips must reach past the rigid tips (theory.md 2.1, 3)."""
+    """Refuse a drive whose teeth never meet: on the major axis the flexspline tips must reach past the rigid tips (docs/models.md 2.1, 3)."""
     f, b = _radii(tooth_spec(design, "flexspline")), _radii(tooth_spec(design, "rigid"))
     w0 = design.w0
     g = design.generator
-    if g.cone_length is not None:  # the largest W0 over the face is at the open end (theory.md 3.1, coning)
+    if g.cone_length is not None:  # the largest W0 over the face is at the open end (docs/models.md 3.1, coning)
         w0 *= g.cone_length / (g.cone_length - g.generator_z)
     sgn = -1.0 if design.external else 1.0  # +: flexspline teeth point outward
     depth = sgn * (f[0] + sgn * w0 - b[0])

@@ -1,4 +1,4 @@
-"""Gear ratios, rotations and external-deformation generator velocities (theory.md 1, 3.5)."""
+"""Gear ratios, rotations and external-deformation generator velocities (docs/models.md 1, 3.5)."""
 
 from __future__ import annotations
 
@@ -21,7 +21,7 @@ def _teeth(value, field_name: str) -> int:
 
 
 def gear_ratios(z_flex: int, z_rigid: int) -> dict[str, float]:
-    """Gear ratios of a perfect strain-wave drive (theory.md 1, [S3 eq. 21-24]).
+    """Gear ratios of a perfect strain-wave drive (docs/models.md 1, [S3 eq. 21-24]).
 
     Parameters
     ----------
@@ -56,12 +56,12 @@ def gear_ratios(z_flex: int, z_rigid: int) -> dict[str, float]:
     if z_g == z_b:
         raise DesignError("drive.z_rigid", f"must differ from the flexspline's {z_g} teeth")
     dz = z_b - z_g
-    # theory.md 1, gear ratios
+    # docs/models.md 1, gear ratios
     return {"u_hg": -z_g / dz, "u_hb": z_b / dz}
 
 
 def flex_rotation(phi_h, z_flex: int, z_rigid: int) -> np.ndarray:
-    """Flexspline rotation relative to the rigid gear: phi_g = phi_h / u_hg (theory.md 1).
+    """Flexspline rotation relative to the rigid gear: phi_g = phi_h / u_hg (docs/models.md 1).
 
     Parameters
     ----------
@@ -86,7 +86,7 @@ def flex_rotation(phi_h, z_flex: int, z_rigid: int) -> np.ndarray:
 
 @dataclass(frozen=True)
 class RingVelocities:
-    """Velocities of the flexspline and washers of an external ring generator (theory.md 3.5).
+    """Velocities of the flexspline and washers of an external ring generator (docs/models.md 3.5).
 
     Every field an array of phi's shape (read-only), speeds in mm/s (with
     omega_h in rad/s), dtheta_dt in rad/s.
@@ -132,9 +132,9 @@ class RingVelocities:
 def ring_generator_velocities(
     law: Law, phi, omega_h: float, h_c: float, a_w: float
 ) -> RingVelocities:
-    """Velocity fields of an external-deformation ring generator (theory.md 3.5).
+    """Velocity fields of an external-deformation ring generator (docs/models.md 3.5).
 
-    Follows [S3] as theory.md 3.5 writes it: phi = omega_h t, i.e. the angle
+    Follows [S3] as docs/models.md 3.5 writes it: phi = omega_h t, i.e. the angle
     of the observed flexspline point from the generator axis grows at
     omega_h, so d/dt = omega_h d/dphi. (A generator turning counter-clockwise
     past a flexspline point makes that point's phi *decrease*; pass a negative
@@ -178,14 +178,14 @@ def ring_generator_velocities(
         raise DesignError("a_w", f"washer eccentricity must be >= 0 mm, got {a_w:g}")
     s = law.state(phi)
     phi = s.phi
-    # theory.md 3.5: phi = omega_h t, so d/dt = omega_h d/dphi
+    # docs/models.md 3.5: phi = omega_h t, so d/dt = omega_h d/dphi
     V_w = omega_h * s.dw
     V_v = omega_h * s.dv
     dtheta_dt = omega_h * s.dtheta
-    # theory.md 3.5: w_K = w + h_c/2 (h_c constant), v_K = v + (h_c/2) theta
+    # docs/models.md 3.5: w_K = w + h_c/2 (h_c constant), v_K = v + (h_c/2) theta
     V_wK = V_w
     V_vK = V_v + 0.5 * h_c * dtheta_dt
-    # theory.md 3.5: washers in circular translation at the generator speed
+    # docs/models.md 3.5: washers in circular translation at the generator speed
     # (omega_d = omega_h); projections and V_sl exactly as written there
     # (V_sl = V_d - V_v, not V_dv - V_v: we keep the source's definition).
     V_d = np.full_like(phi, omega_h * a_w)

@@ -1,4 +1,4 @@
-"""Flexspline teeth placed as rigid bodies on the deformed neutral line (theory.md 3.1)."""
+"""Flexspline teeth placed as rigid bodies on the deformed neutral line (docs/models.md 3.1)."""
 
 from __future__ import annotations
 
@@ -27,7 +27,7 @@ __all__ = [
 def tooth_angles(z_flex: int, z_rigid: int, phi_h: float, teeth=None) -> tuple[np.ndarray, np.ndarray]:
     """Angles of flexspline teeth for generator angle ``phi_h`` (rigid-gear frame).
 
-    The flexspline turns by ``phi_h / u_hg`` (theory.md 1, rigid gear as the
+    The flexspline turns by ``phi_h / u_hg`` (docs/models.md 1, rigid gear as the
     reference frame: with the flexspline fixed the relative motion is the
     same, only the frame that is drawn turns).
 
@@ -48,7 +48,7 @@ def tooth_frames(law: Law, phi, r_m: float):
     """Origin and orientation of the rim cross-section carrying each tooth.
 
     ``P = (r_m + w) e_r(phi) + v e_t(phi)`` with the tooth turned by
-    ``theta`` (theory.md 3.1), in the generator frame (major axis on +x).
+    ``theta`` (docs/models.md 3.1), in the generator frame (major axis on +x).
 
     Returns
     -------
@@ -99,7 +99,7 @@ def tooth_pose(law: Law, phi, r_m: float, frame_angle=0.0):
 
     A tooth point ``p`` sits at height ``d = p_x - r_m`` above the neutral
     line and tangential offset ``s = p_y``; it goes to
-    ``R(fa) [origin + R(phi + theta) (d, s)]`` (theory.md 3.1), i.e.
+    ``R(fa) [origin + R(phi + theta) (d, s)]`` (docs/models.md 3.1), i.e.
     ``rot = fa + phi + theta`` and ``shift = R(fa) origin - R(rot) (r_m, 0)``.
 
     Returns
@@ -113,7 +113,7 @@ def tooth_pose(law: Law, phi, r_m: float, frame_angle=0.0):
 
 
 def place_points(local: np.ndarray, law: Law, phi, r_m: float, frame_angle=0.0) -> np.ndarray:
-    """Exact placement: each tooth outline turned with its rim cross-section (theory.md 3.1).
+    """Exact placement: each tooth outline turned with its rim cross-section (docs/models.md 3.1).
 
     Parameters
     ----------
@@ -143,7 +143,7 @@ def place_points_first_order(local: np.ndarray, law: Law, phi, r_m: float, centr
     first order in ``theta`` (tens of um on a flank). Kept as a cross-check
     of :func:`place_points`: the linearised form differs from the exact one
     by ``O(theta^2)`` times the tooth size, i.e. ``O(W0^2 / r_m)`` for teeth
-    of size ~ m ~ W0 (theory.md 3.1). Generator frame, ``(K, N, 2)``.
+    of size ~ m ~ W0 (docs/models.md 3.1). Generator frame, ``(K, N, 2)``.
     """
     phi = np.atleast_1d(np.asarray(phi, dtype=float))
     st = law.state(phi)

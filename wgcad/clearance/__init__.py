@@ -1,4 +1,4 @@
-"""Clearance and interference between the deformed flexspline and the rigid gear (theory.md 5, 7)."""
+"""Clearance and interference between the deformed flexspline and the rigid gear (docs/models.md 5, 7)."""
 
 from .distance import signed_clearance
 from .engine import AuditSettings, AuditResult, audit, tooth_clearance

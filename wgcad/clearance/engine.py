@@ -1,8 +1,8 @@
-"""The 2D clearance engine: every flexspline tooth against its nearest rigid teeth over generator angles and sections (theory.md 5, 7).
+"""The 2D clearance engine: every flexspline tooth against its nearest rigid teeth over generator angles and sections (docs/models.md 5, 7).
 
 Why it can skip work (each switchable, each tested against the full computation):
 
-* **mesh period** (theory.md 7): for perfect gears the state of a tooth
+* **mesh period** (docs/models.md 7): for perfect gears the state of a tooth
   depends only on its angle ``phi`` from the generator's major axis. A tooth
   at ``phi`` has its material angle at ``phi (z_b - z_g)/z_b`` modulo a rigid
   pitch, so every (generator angle, tooth) sample is a sample of one
@@ -346,7 +346,7 @@ def clearance_profile(scene: Scene, sections, step_deg: float = 0.1) -> dict:
     """Per-tooth clearance against the tooth's angle from the major axis over one wave, per flank and section.
 
     This is the function ``c(phi)`` every tooth follows (perfect gears,
-    theory.md 7): the picture designers reason with. Working flank: the
+    docs/models.md 7): the picture designers reason with. Working flank: the
     side facing the rigid tooth that carries the load (:attr:`Scene.working`).
 
     Returns

@@ -1,4 +1,4 @@
-"""The 3D engine at the edge: tooth solids (coned lofts, prisms) and their exact distance in python-fcl, checking the 2D engine's tightest pairs (theory.md 3.1, 5)."""
+"""The 3D engine at the edge: tooth solids (coned lofts, prisms) and their exact distance in python-fcl, checking the 2D engine's tightest pairs (docs/models.md 3.1, 5)."""
 
 from __future__ import annotations
 

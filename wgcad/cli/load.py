@@ -1,4 +1,4 @@
-"""``wgcad audit DESIGN --torque-nm ...``: the drive under load (elastic contact model, theory.md 4.1)."""
+"""``wgcad audit DESIGN --torque-nm ...``: the drive under load (elastic contact model, docs/models.md 4.1)."""
 
 from __future__ import annotations
 

@@ -1,4 +1,4 @@
-"""Flexspline deformation: neutral-line laws (theory.md 3) and coning along the axis."""
+"""Flexspline deformation: neutral-line laws (docs/models.md 3) and coning along the axis."""
 
 from wgcad.deformation.coning import coned_w0
 from wgcad.deformation.laws import (

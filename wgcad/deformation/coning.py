@@ -1,4 +1,4 @@
-"""Coning of a cup flexspline: the deformation amplitude along the axis (theory.md 3.1)."""
+"""Coning of a cup flexspline: the deformation amplitude along the axis (docs/models.md 3.1)."""
 
 from __future__ import annotations
 
@@ -16,7 +16,7 @@ def coned_w0(w0, z, *, length, z_h):
 
     The rim pivots about the diaphragm, so the amplitude falls linearly from
     the open end to zero at the diaphragm:
-    W0(z) = W0 (l - z) / (l - z_h)   (theory.md 3.1, coning).
+    W0(z) = W0 (l - z) / (l - z_h)   (docs/models.md 3.1, coning).
 
     Parameters
     ----------
@@ -67,7 +67,7 @@ def coned_w0(w0, z, *, length, z_h):
             f"cross-sections must lie on the flexspline, 0 <= z <= length = {length:g} mm; "
             f"got z in [{z.min():g}, {z.max():g}] mm",
         )
-    # theory.md 3.1, coning; the ratio first so that W0(z_h) == W0 exactly
+    # docs/models.md 3.1, coning; the ratio first so that W0(z_h) == W0 exactly
     out = np.asarray(w0 * ((length - z) / (length - z_h)))
     out.flags.writeable = False
     return out

@@ -1,4 +1,4 @@
-"""Deformation laws of the flexspline neutral line: w, v, theta and derivatives (theory.md 3)."""
+"""Deformation laws of the flexspline neutral line: w, v, theta and derivatives (docs/models.md 3)."""
 
 from __future__ import annotations
 
@@ -27,14 +27,14 @@ __all__ = [
 
 _HALF_PI = 0.5 * math.pi
 
-#: W0 must stay below r_m / W0_MAX_DIVISOR. The ring model of theory.md 3.1 is
+#: W0 must stay below r_m / W0_MAX_DIVISOR. The ring model of docs/models.md 3.1 is
 #: linear in W0/r_m (its first-order kinematics err by O(W0/r_m)); a rim bent
 #: by a quarter of its radius would be far past yield. Real drives use W0 of
 #: about one module, i.e. ~1 % of r_m.
 _W0_MAX_DIVISOR = 4.0
 
 #: Largest wrap half-angle of the disc law (and of the external ring). A - B of
-#: theory.md 3.3 vanishes like 0.24 (pi/2 - beta)^3 as beta -> 90 deg, and the
+#: docs/models.md 3.3 vanishes like 0.24 (pi/2 - beta)^3 as beta -> 90 deg, and the
 #: closed form subtracts O(1) terms to get it: at 85 deg A - B = 1.6e-4, so K
 #: and w keep ~12 significant digits; beyond, the law degrades quickly
 #: (89 deg: ~10 digits) while no real disc generator wraps that far.
@@ -52,7 +52,7 @@ def _ff_band_edge() -> float:
     return b
 
 
-#: Four-force law (theory.md 3.4): for beta in (BETA_LO, BETA_HI) the shape is
+#: Four-force law (docs/models.md 3.4): for beta in (BETA_LO, BETA_HI) the shape is
 #: no two-wave oval. At BETA_LO (40.7065 deg), tan(beta) = pi/2 - beta and
 #: w''(0) changes sign (w(0) stops being the largest radius); D vanishes at
 #: 43.89 deg, where no finite force gives w(0) = W0; at BETA_HI = pi/2 - BETA_LO,
@@ -137,7 +137,7 @@ def _check_w0_rm(w0, r_m) -> tuple[float, float]:
         raise DesignError(
             "generator.w0_coef",
             f"W0 = {w0:g} mm must be < r_m/4 = {r_m / _W0_MAX_DIVISOR:g} mm: the ring model "
-            "(theory.md 3.1) is linear in W0/r_m and a rim bent that far would yield "
+            "(docs/models.md 3.1) is linear in W0/r_m and a rim bent that far would yield "
             "(W0 is usually about one module)",
         )
     return w0, r_m
@@ -167,7 +167,7 @@ def _check_two_waves(n_waves, law: str) -> None:
 
 
 class Law(abc.ABC):
-    """Abstract deformation law of the neutral line (theory.md 3.1, 3.6).
+    """Abstract deformation law of the neutral line (docs/models.md 3.1, 3.6).
 
     Subclasses are frozen dataclasses with at least the attributes below.
 
@@ -221,7 +221,7 @@ class Law(abc.ABC):
 class _TwoWaveLaw(Law):
     """A two-wave law computed on [0, pi/2] and extended by symmetry.
 
-    w is even about phi = 0 and about pi/2 (theory.md 3.3: "extend by
+    w is even about phi = 0 and about pi/2 (docs/models.md 3.3: "extend by
     symmetry"), hence pi-periodic; v, w', theta are odd about both. Folding
     into the quarter first makes these symmetries exact in floating point.
     """
@@ -244,7 +244,7 @@ class _TwoWaveLaw(Law):
 
 @dataclass(frozen=True)
 class Harmonic(Law):
-    """Harmonic law w = W0 cos(n_w phi), any number of waves (theory.md 3.2).
+    """Harmonic law w = W0 cos(n_w phi), any number of waves (docs/models.md 3.2).
 
     Parameters
     ----------
@@ -278,7 +278,7 @@ class Harmonic(Law):
         object.__setattr__(self, "n_waves", int(n))
 
     def _state(self, phi: np.ndarray) -> RimState:
-        # theory.md 3.2; theta = (v - w')/r_m, theory.md 3.1
+        # docs/models.md 3.2; theta = (v - w')/r_m, docs/models.md 3.1
         n, w0, r = self.n_waves, self.w0, self.r_m
         c, s = np.cos(n * phi), np.sin(n * phi)
         w = w0 * c
@@ -300,7 +300,7 @@ class Harmonic(Law):
 
 @dataclass(frozen=True)
 class _SectionedLaw(_TwoWaveLaw):
-    """A two-wave law given by two closed-form sections meeting at ``beta`` (theory.md 3.3, 3.4).
+    """A two-wave law given by two closed-form sections meeting at ``beta`` (docs/models.md 3.3, 3.4).
 
     Subclasses provide ``_sections(phi) -> (section I fields, section II fields)``.
     """
@@ -332,7 +332,7 @@ class _SectionedLaw(_TwoWaveLaw):
 
 @dataclass(frozen=True)
 class _DiscShape(_SectionedLaw):
-    """Disc-generator shape of theory.md 3.3 times a sign (+1 disc, -1 external ring)."""
+    """Disc-generator shape of docs/models.md 3.3 times a sign (+1 disc, -1 external ring)."""
 
     _sign: ClassVar[float] = 1.0
 
@@ -352,11 +352,11 @@ class _DiscShape(_SectionedLaw):
             raise DesignError(
                 "generator.beta_deg",
                 f"must be <= 85 degrees for law '{self.name}', got {math.degrees(beta):.10g}: "
-                "A - B of theory.md 3.3 vanishes as beta -> 90 deg and the closed form "
+                "A - B of docs/models.md 3.3 vanishes as beta -> 90 deg and the closed form "
                 "loses its precision to cancellation",
             )
         sb, cb = math.sin(beta), math.cos(beta)
-        # theory.md 3.3
+        # docs/models.md 3.3
         A = _HALF_PI - sb * cb - beta
         B = -2.0 * sb + (4.0 * beta / math.pi) * sb + (4.0 / math.pi) * cb
         C = (4.0 / math.pi) * (beta * sb + cb)  # = B + 2 sin(beta)
@@ -368,7 +368,7 @@ class _DiscShape(_SectionedLaw):
         A, B, C, K, r = self._A, self._B, self._C, self._K * self._sign, self.r_m
         sb2 = math.sin(self.beta) ** 2
         c, s = np.cos(phi), np.sin(phi)
-        # theory.md 3.3, section I (on the disc, constant curvature)
+        # docs/models.md 3.3, section I (on the disc, constant curvature)
         w1 = K * (A * c - B)
         sec1 = (
             w1,
@@ -379,7 +379,7 @@ class _DiscShape(_SectionedLaw):
             K * B * phi / r,
             np.full_like(phi, K * B / r),
         )
-        # theory.md 3.3, section II (free span)
+        # docs/models.md 3.3, section II (free span)
         q = _HALF_PI - phi
         w2 = K * ((1.0 + sb2) * s + q * c - 2.0 * math.sin(self.beta) - B)
         sec2 = (
@@ -397,7 +397,7 @@ class _DiscShape(_SectionedLaw):
 
 @dataclass(frozen=True)
 class Disc(_DiscShape):
-    """Disc generator with wrap half-angle beta (theory.md 3.3), two waves.
+    """Disc generator with wrap half-angle beta (docs/models.md 3.3), two waves.
 
     Parameters
     ----------
@@ -421,7 +421,7 @@ class Disc(_DiscShape):
 
 @dataclass(frozen=True)
 class ExternalRing(_DiscShape):
-    """External-deformation ring generator (theory.md 3.5): the disc law with the opposite sign.
+    """External-deformation ring generator (docs/models.md 3.5): the disc law with the opposite sign.
 
     Washers squeeze the flexspline from outside on the major axis, so the
     neutral line moves inward there: ``state(0).w == -w0``. Every field (w, v,
@@ -453,7 +453,7 @@ class ExternalRing(_DiscShape):
 
 @dataclass(frozen=True)
 class FourForce(_SectionedLaw):
-    """Cam shaped as a ring deformed by four radial forces at +-beta, pi+-beta (theory.md 3.4).
+    """Cam shaped as a ring deformed by four radial forces at +-beta, pi+-beta (docs/models.md 3.4).
 
     Parameters
     ----------
@@ -491,7 +491,7 @@ class FourForce(_SectionedLaw):
                 f"degrees for law 'four_force', got {math.degrees(beta):.10g}: there the ring's "
                 "largest radius leaves the major axis or its smallest the minor axis, and "
                 "D = 8/cos(beta) - pi(pi - 2 beta + 2 tan(beta)) vanishes at 43.89 deg "
-                "(theory.md 3.4)",
+                "(docs/models.md 3.4)",
             )
         D = 8.0 / math.cos(beta) - math.pi * (math.pi - 2.0 * beta + 2.0 * math.tan(beta))
         for k, val in (("w0", w0), ("r_m", r_m), ("beta", beta), ("_D", D)):
@@ -505,7 +505,7 @@ class FourForce(_SectionedLaw):
         c, s = np.cos(phi), np.sin(phi)
         pi = math.pi
 
-        # theory.md 3.4, section I; v = -int_0^phi w (v' = -w, v(0) = 0, theory.md 3.1)
+        # docs/models.md 3.4, section I; v = -int_0^phi w (v' = -w, v(0) = 0, docs/models.md 3.1)
         a1 = pi * (pi - 2.0 * beta + 2.0 * tb)
         g1 = 2.0 * pi * tb
         w1 = k * (c0 - a1 * c - g1 * phi * s)
@@ -513,7 +513,7 @@ class FourForce(_SectionedLaw):
         d2w1 = k * (a1 * c - g1 * (2.0 * c - phi * s))
         v1 = -k * (c0 * phi - a1 * s - g1 * (s - phi * c))
 
-        # theory.md 3.4, section II; v = int_phi^(pi/2) w (v(pi/2) = 0)
+        # docs/models.md 3.4, section II; v = int_phi^(pi/2) w (v(pi/2) = 0)
         a2 = 2.0 * pi * (1.0 + beta * tb)
         q = pi - 2.0 * phi
         w2 = k * (c0 - a2 * s - pi * q * c)
@@ -522,7 +522,7 @@ class FourForce(_SectionedLaw):
         v2 = k * (0.5 * c0 * q - a2 * c - pi * (2.0 * c - q * s))
 
         def full(w, dw, d2w, v):
-            # theta = (v - w')/r_m, theory.md 3.1; dtheta = (v' - w'')/r_m with v' = -w
+            # theta = (v - w')/r_m, docs/models.md 3.1; dtheta = (v' - w'')/r_m with v' = -w
             return (w, dw, d2w, v, -w, (v - dw) / r, (-w - d2w) / r)
 
         return full(w1, dw1, d2w1, v1), full(w2, dw2, d2w2, v2)
@@ -570,7 +570,7 @@ class Ellipse(_TwoWaveLaw):
     Not a ring-theory law: the geometry is exact. The base ellipse (semi-axes
     `a` > `b`, major axis on +x) is chosen so that the neutral line's largest
     radius is r_m + W0 (at phi = 0) and its perimeter is 2 pi r_m (the rim is
-    inextensible, theory.md 3.1). The material point of undeformed angle phi
+    inextensible, docs/models.md 3.1). The material point of undeformed angle phi
     sits at arc length r_m phi from the major-axis vertex. w, v are the
     components of P(phi) - r_m e_r(phi) on e_r(phi), e_t(phi); theta is the
     angle of the deformed tangent from e_t(phi). Exact relations used
@@ -645,7 +645,7 @@ class Ellipse(_TwoWaveLaw):
 
     def _quarter(self, psi):
         a, b, d, r = self.a, self.b, self.offset, self.r_m
-        target = r * psi  # teeth placed by arc length (theory.md 3.1)
+        target = r * psi  # teeth placed by arc length (docs/models.md 3.1)
         t = psi.copy()
         for _ in range(60):
             s, ds = self._arc(t)

@@ -1,4 +1,4 @@
-"""Design tables of the elastic model: ``[material]``, ``[bearing]``, ``[load]`` (theory.md 4.1), units in the key names."""
+"""Design tables of the elastic model: ``[material]``, ``[bearing]``, ``[load]`` (docs/models.md 4.1), units in the key names."""
 
 from __future__ import annotations
 

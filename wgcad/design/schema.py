@@ -26,7 +26,7 @@ __all__ = [
     "LAW_NAMES",
 ]
 
-#: generator laws selectable in ``generator.law`` (theory.md 3); internal
+#: generator laws selectable in ``generator.law`` (docs/models.md 3); internal
 #: deformation accepts all but ``external_ring``, external deformation only it
 LAW_NAMES = ("harmonic", "disc", "four_force", "ellipse", "external_ring")
 _BETA_LAWS = ("disc", "four_force", "external_ring")
@@ -56,7 +56,7 @@ class DriveSpec:
     face_width: float = _key("toothed face width b_w", unit="mm", lo=0.0, lo_open=True,
                             hi=Rel("d_flex", lambda c: c["d_flex"]),
                             why="harmonic drives have b_w/d of 0.1-0.3; wider than the pitch diameter the plane "
-                                "cross-section model of the rim (theory.md 3.1) no longer holds")
+                                "cross-section model of the rim (docs/models.md 3.1) no longer holds")
     waves: int = _key("waves n_w of the generator", unit="", lo=2, hi=8, default=2,
                      why="one wave only shifts the rim off-centre; drives use 2 or 3, and the laws other than "
                          "harmonic have exactly 2")
@@ -68,7 +68,7 @@ class DriveSpec:
 
 @dataclass(frozen=True)
 class ToothFormSpec:
-    """``[tooth]``: tooth form shared by both gears (theory.md 2)."""
+    """``[tooth]``: tooth form shared by both gears (docs/models.md 2)."""
 
     form: str = _key("tooth form", choices=("involute", "cycloidal"), default="involute")
     pressure_angle_deg: float = _key("pressure angle alpha (involute)", unit="deg", lo=5.0, hi=45.0, default=20.0,
@@ -96,13 +96,13 @@ class GearSpec:
     tip_radius: float | None = _key("tip radius, overrides the standard tip", unit="mm",
                                    lo=Rel("r - 15 m", lambda c: c["r"] - 15 * c["m"]),
                                    hi=Rel("r + 15 m", lambda c: c["r"] + 15 * c["m"]), default=None,
-                                   default_doc="standard (theory.md 2.1, 2.2)",
+                                   default_doc="standard (docs/models.md 2.1, 2.2)",
                                    rule="> 0; external teeth: outside the root; internal: inside" + _P,
                                    why="the band the shift, addendum and clearance bounds allow around the pitch radius r")
     root_radius: float | None = _key("root radius, overrides the standard root", unit="mm",
                                     lo=Rel("r - 15 m", lambda c: c["r"] - 15 * c["m"]),
                                     hi=Rel("r + 15 m", lambda c: c["r"] + 15 * c["m"]), default=None,
-                                    default_doc="standard (theory.md 2.1, 2.2)", rule="> 0" + _P,
+                                    default_doc="standard (docs/models.md 2.1, 2.2)", rule="> 0" + _P,
                                     why="as tip_radius")
     thinning: float = _key("tooth-thickness allowance at the pitch circle (backlash)", unit="mm", default=0.0,
                           rule="|thinning| < half the pitch, pi m / 2",
@@ -125,13 +125,13 @@ class GearSpec:
 
 @dataclass(frozen=True)
 class GeneratorSpec:
-    """``[generator]``: the wave generator and its deformation law (theory.md 3)."""
+    """``[generator]``: the wave generator and its deformation law (docs/models.md 3)."""
 
     law: str = _key("deformation law of the neutral line", choices=LAW_NAMES, default="harmonic",
                    rule="external deformation: external_ring only; internal: all others")
     w0_coef: float = _key("radial deformation on the major axis W0 / m", lo=0.0, lo_open=True, hi=5.0, default=1.0,
                          rule="W0 < r_m / 4 (checked when the law is built)",
-                         why="W0 is about k m for a tooth difference of k waves; the ring model of theory.md 3.1 "
+                         why="W0 is about k m for a tooth difference of k waves; the ring model of docs/models.md 3.1 "
                              "needs W0 small against the rim radius")
     beta_deg: float | None = _key("disc wrap / force half-angle beta", unit="deg", lo=0.0, hi=90.0, lo_open=True,
                                  hi_open=True, default=None, default_doc="none; required by disc, four_force, external_ring",
@@ -148,7 +148,7 @@ class GeneratorSpec:
     generator_z: float | None = _key("generator centre line z_h from the open end", unit="mm", lo=0.0,
                                     hi=Rel("cone_length / 2", lambda c: 0.5 * c["cone_length"]), default=None,
                                     default_doc="none (no coning)", rule="together with cone_length",
-                                    why="W0 at the open end is W0 l / (l - z_h) (theory.md 3.1): z_h <= l/2 keeps it "
+                                    why="W0 at the open end is W0 l / (l - z_h) (docs/models.md 3.1): z_h <= l/2 keeps it "
                                         "within 2 W0; generators sit near the open end")
 
 
@@ -162,7 +162,7 @@ class Design:
     rigid: GearSpec
     generator: GeneratorSpec
     source: str = "<memory>"
-    sectors: SectorsSpec = SectorsSpec()  # [sectors]: sectored rigid gear (theory.md 2.3); empty = plain
+    sectors: SectorsSpec = SectorsSpec()  # [sectors]: sectored rigid gear (docs/models.md 2.3); empty = plain
     material: MaterialSpec = MaterialSpec()  # [material], [bearing], [load]: design/load.py
     bearing: BearingSpec = BearingSpec()
     load: LoadSpec = LoadSpec()
@@ -293,7 +293,7 @@ def validate(d: Design) -> Design:
     _choice("drive.deformation", dr.deformation, ("internal", "external"))
     _choice("drive.fixed", dr.fixed, ("rigid", "flexspline"))
     _choice("drive.rotation", dr.rotation, ("ccw", "cw"))
-    # theory.md 1: z_b - z_g = k n_w, k >= 1 (external deformation: z_g - z_b)
+    # docs/models.md 1: z_b - z_g = k n_w, k >= 1 (external deformation: z_g - z_b)
     diff = dr.z_rigid - dr.z_flex if dr.deformation == "internal" else dr.z_flex - dr.z_rigid
     expr = "z_rigid - z_flex" if dr.deformation == "internal" else "z_flex - z_rigid"
     if diff <= 0 or diff % dr.waves:

@@ -1,4 +1,4 @@
-"""The ``[sectors]`` table: a sectored rigid gear of a discrete-motion drive, its layout rules and heights (theory.md 2.3)."""
+"""The ``[sectors]`` table: a sectored rigid gear of a discrete-motion drive, its layout rules and heights (docs/models.md 2.3)."""
 
 from __future__ import annotations
 
@@ -14,7 +14,7 @@ __all__ = ["SectorsSpec", "KINDS", "HEIGHT_MODES", "validate_sectors", "sector_p
 #: sector kinds: "transmission" sectors have a pitch other than the flexspline's
 #: (the output moves), "coupling" sectors the flexspline's pitch (it dwells)
 KINDS = ("transmission", "coupling")
-#: which coupling-tooth heights are built: the closed form of theory.md 2.3, the
+#: which coupling-tooth heights are built: the closed form of docs/models.md 2.3, the
 #: simulated ones, full height everywhere, or the design's own ``heights_mm``
 HEIGHT_MODES = ("closed_form", "simulated", "full", "list")
 
@@ -25,7 +25,7 @@ _FILL_TOL = 1e-9
 
 @dataclass(frozen=True)
 class SectorsSpec:
-    """``[sectors]``: the rigid gear built from sectors (theory.md 2.3), listed counter-clockwise.
+    """``[sectors]``: the rigid gear built from sectors (docs/models.md 2.3), listed counter-clockwise.
 
     Every sector's teeth sit at its own angular pitch ``2 pi / pitch_z``; each
     tooth owns one pitch of arc, centred on it, so a sector spans
@@ -134,7 +134,7 @@ def sector_pitch_z(spec: SectorsSpec, z_flex: int, z_rigid: int) -> tuple:
 def validate_sectors(spec: SectorsSpec, z_flex: int, z_rigid: int, waves: int) -> SectorsSpec:
     """Check the layout rules of a sectored rigid gear; return ``spec`` or raise :class:`DesignError`.
 
-    Rules (theory.md 2.3): known kinds, both kinds present, alternating; as
+    Rules (docs/models.md 2.3): known kinds, both kinds present, alternating; as
     many sectors as ``2 waves`` so each wave meets one sector of each kind;
     sectors a half turn apart (``waves`` apart in the list) identical; coupling
     pitch equal to the flexspline's, transmission pitch not; the sectors fill

@@ -1,4 +1,4 @@
-"""PNG pictures of the loaded drive: entry gap against torque, and the force distribution around the rim (theory.md 4.1, 5)."""
+"""PNG pictures of the loaded drive: entry gap against torque, and the force distribution around the rim (docs/models.md 4.1, 5)."""
 
 from __future__ import annotations
 

@@ -1,4 +1,4 @@
-"""Cycloidal teeth: exact epi/hypocycloids on the pitch circle and the rack approximation of [S1] (theory.md 2.2)."""
+"""Cycloidal teeth: exact epi/hypocycloids on the pitch circle and the rack approximation of [S1] (docs/models.md 2.2)."""
 
 from __future__ import annotations
 
@@ -87,7 +87,7 @@ def exact_half_angle(r: float, rho: float, radius, tooth_inside: bool):
 
 
 def rack_half_thickness(rho: float, height, addendum_side) -> np.ndarray:
-    """Half tooth thickness of the rack approximation at ``height`` from the pitch line (theory.md 2.2).
+    """Half tooth thickness of the rack approximation at ``height`` from the pitch line (docs/models.md 2.2).
 
     ``x_M = rho (phi - sin phi - pi)``, ``y_M = rho (1 - cos phi)``; on the
     addendum side ``s = 2|x_M|``, on the dedendum side

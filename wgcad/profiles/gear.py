@@ -1,4 +1,4 @@
-"""Whole-gear geometry: radii, derived-geometry checks and the toothed outline of one gear (theory.md 2.1, 2.2)."""
+"""Whole-gear geometry: radii, derived-geometry checks and the toothed outline of one gear (docs/models.md 2.1, 2.2)."""
 
 from __future__ import annotations
 
@@ -59,7 +59,7 @@ class Gear:
     spec : ToothSpec
     r, r_a, r_f : float
         Pitch, tip and root radii (for an internal gear the tip is the
-        innermost radius, theory.md 2.1).
+        innermost radius, docs/models.md 2.1).
     r_base : float or None
         Base radius (involute only).
     half_period : (n, 2) float
@@ -100,7 +100,7 @@ class Gear:
 
     @property
     def rho(self) -> float:
-        """Rolling-circle radius of cycloidal teeth, ``m/4`` (theory.md 2.2)."""
+        """Rolling-circle radius of cycloidal teeth, ``m/4`` (docs/models.md 2.2)."""
         return self.spec.module / 4.0
 
     def half_angle(self, radius) -> np.ndarray:
@@ -114,7 +114,7 @@ class Gear:
         return cy.exact_half_angle(self.r, self.rho, radius, sp.internal) - _thin_angle(sp, self.r)
 
     def tooth_thickness(self, radius) -> np.ndarray:
-        """Arc tooth thickness at ``radius`` (flank zone), mm: ``s(R)`` of theory.md 2.1."""
+        """Arc tooth thickness at ``radius`` (flank zone), mm: ``s(R)`` of docs/models.md 2.1."""
         radius = np.asarray(radius, dtype=float)
         return 2.0 * radius * self.half_angle(radius)
 
@@ -148,12 +148,12 @@ class Gear:
 
 def _thin_angle(sp: ToothSpec, r: float) -> float:
     # thinning reduces the arc tooth thickness at the pitch circle: each flank
-    # turns by thinning / (2 r) toward the tooth centre (theory.md 2.1)
+    # turns by thinning / (2 r) toward the tooth centre (docs/models.md 2.1)
     return sp.thinning / (2.0 * r)
 
 
 def _involute_base_angle(sp: ToothSpec) -> float:
-    """``s/(2r) + inv(alpha)`` (external tooth) or ``e/(2r) + inv(alpha)`` (internal space), theory.md 2.1."""
+    """``s/(2r) + inv(alpha)`` (external tooth) or ``e/(2r) + inv(alpha)`` (internal space), docs/models.md 2.1."""
     r = sp.module * sp.z / 2.0
     nominal = sp.module * (pi / 2.0 + 2.0 * sp.shift * np.tan(sp.alpha))
     width = nominal + sp.thinning if sp.internal else nominal - sp.thinning
@@ -169,7 +169,7 @@ def _radii(sp: ToothSpec) -> tuple[float, float]:
         else:
             r_a = r + m * (sp.addendum_coef + sp.shift)
             r_f = r - m * (sp.addendum_coef + sp.clearance_coef - sp.shift)
-    else:  # cycloidal, theory.md 2.2 (rho = m/4)
+    else:  # cycloidal, docs/models.md 2.2 (rho = m/4)
         rho = m / 4.0
         if sp.internal:
             r_a, r_f = r - 2 * rho + sp.clearance_coef * m, r + 2 * rho
@@ -201,7 +201,7 @@ def make_gear(sp: ToothSpec, tol: float = constants.CHORD_TOL) -> Gear:
         raise DesignError(f"{f}.tip_radius", f"tip radius {r_a:.4f} mm must be outside the root radius {r_f:.4f} mm for external teeth")
     if r_f <= 0 or r_a <= 0:
         raise DesignError(f"{f}.root_radius", f"radii must be positive (tip {r_a:.4f} mm, root {r_f:.4f} mm)")
-    # the field that sets the tip and how to blunt it: cycloidal teeth have no shift, c* truncates them (theory.md 2.2)
+    # the field that sets the tip and how to blunt it: cycloidal teeth have no shift, c* truncates them (docs/models.md 2.2)
     if sp.form == "involute":
         tip_field = f"{f}.tip_radius" if sp.tip_radius is not None else f"{f}.shift"
         fix = "lower the shift or truncate the tip"
@@ -315,7 +315,7 @@ def _short_arc(center, p0, p1, tol) -> np.ndarray:
 
 
 def _involute_half_period(sp: ToothSpec, r, r_a, r_f, tol, tip_field):
-    """Upper half of one pitch, tooth frame, increasing angle (theory.md 2.1)."""
+    """Upper half of one pitch, tooth frame, increasing angle (docs/models.md 2.1)."""
     f = sp.field
     gamma2 = pi / sp.z
     r_b = r * np.cos(sp.alpha)
@@ -404,17 +404,17 @@ def _involute_half_period(sp: ToothSpec, r, r_a, r_f, tol, tip_field):
 
 
 def _cycloid_half_period(sp: ToothSpec, r, r_a, r_f, tol, tip_field, fix):
-    """Upper half of one pitch of an exact cycloidal tooth, tooth frame (theory.md 2.2)."""
+    """Upper half of one pitch of an exact cycloidal tooth, tooth frame (docs/models.md 2.2)."""
     f = sp.field
     if sp.shift != 0.0:
-        raise DesignError(f"{f}.shift", "must be 0 for cycloidal teeth (theory.md 2.2 has no profile shift)")
+        raise DesignError(f"{f}.shift", "must be 0 for cycloidal teeth (docs/models.md 2.2 has no profile shift)")
     gamma2 = pi / sp.z
     rho = sp.module / 4.0
     q = pi * rho / r - _thin_angle(sp, r)  # pitch point of the upper flank
     add_epi = not sp.internal  # external teeth: epicycloid addendum
     lo, hi = (r - 2 * rho, r + 2 * rho)
     # the addendum flank runs from the pitch circle to the tip, the dedendum flank from it to the
-    # root: a tip or root across the pitch circle has no flank to end on (theory.md 2.2)
+    # root: a tip or root across the pitch circle has no flank to end on (docs/models.md 2.2)
     reach = {"tip": (r, hi) if add_epi else (lo, r), "root": (lo, r) if add_epi else (r, hi)}
     for name, where, val in (("tip", tip_field, r_a), ("root", f"{f}.root_radius", r_f)):
         a, b = reach[name]

@@ -1,4 +1,4 @@
-"""Involute tooth geometry: thickness at any radius, flank points and the tangent root fillet (theory.md 2.1)."""
+"""Involute tooth geometry: thickness at any radius, flank points and the tangent root fillet (docs/models.md 2.1)."""
 
 from __future__ import annotations
 
@@ -20,7 +20,7 @@ def inv(alpha):
 
 
 def pressure_angle_at(r_base: float, radius):
-    """Profile angle at ``radius``: ``cos(alpha_R) = r_base / R`` (theory.md 2.1)."""
+    """Profile angle at ``radius``: ``cos(alpha_R) = r_base / R`` (docs/models.md 2.1)."""
     return np.arccos(np.clip(r_base / np.asarray(radius, dtype=float), -1.0, 1.0))
 
 
@@ -28,7 +28,7 @@ def half_angle_at(psi_base: float, r_base: float, radius):
     """Angular half-width at ``radius`` of a region bounded by two involutes.
 
     For an external tooth ``psi_base = s/(2r) + inv(alpha)`` and the result
-    is half the tooth's angular thickness, ``s(R)/(2R)`` of theory.md 2.1; for
+    is half the tooth's angular thickness, ``s(R)/(2R)`` of docs/models.md 2.1; for
     an internal gear the same with the space width ``e`` gives half the
     space's angular width.
     """

@@ -1,4 +1,4 @@
-"""Sectored rigid gear of a discrete-motion drive: tooth positions per sector and variable-height teeth (theory.md 2.3)."""
+"""Sectored rigid gear of a discrete-motion drive: tooth positions per sector and variable-height teeth (docs/models.md 2.3)."""
 
 from __future__ import annotations
 
@@ -106,7 +106,7 @@ class TeethByHeight:
     """Rigid teeth of one tooth form at any height, built by :func:`make_gear` with a tip-radius override and cached.
 
     A shorter tooth keeps the flanks, fillets and root of the full one and is
-    cut at another tip circle (theory.md 2.3: ``h_i = r_fix - r_ari``). Where
+    cut at another tip circle (docs/models.md 2.3: ``h_i = r_fix - r_ari``). Where
     the root fillet would reach the lowered tip circle, the fillet is made as
     large as still fits (and the fact recorded in :attr:`fillet_cut`).
     """

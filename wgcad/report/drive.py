@@ -21,7 +21,7 @@ def _r(x, nd=6):
 
 
 def cycloid_rack_error(gear, n: int = 2001) -> float:
-    """Largest difference, mm, between the rack-approximation and the exact cycloidal tooth thickness (theory.md 2.2)."""
+    """Largest difference, mm, between the rack-approximation and the exact cycloidal tooth thickness (docs/models.md 2.2)."""
     r, rho, internal = gear.r, gear.rho, gear.spec.internal
     lo, hi = sorted((gear.r_a, gear.r_f))
     R = np.linspace(lo, hi, n)
@@ -70,7 +70,7 @@ def workshop(gear, gs=None) -> dict:
 
 
 def gear_figures(gear, rim_radius: float, gs=None) -> dict:
-    """Radii, thicknesses and the workshop's measurements of one gear (theory.md 2); ``gs`` its design table."""
+    """Radii, thicknesses and the workshop's measurements of one gear (docs/models.md 2); ``gs`` its design table."""
     sp = gear.spec
     within = bool(min(gear.r_a, gear.r_f) <= gear.r <= max(gear.r_a, gear.r_f))
     out = {
@@ -102,7 +102,7 @@ def gear_figures(gear, rim_radius: float, gs=None) -> dict:
 
 
 def mesh_figures(drive, law=None) -> dict:
-    """Depth of engagement and radial clearances at the major and minor axes (theory.md 2.1, 3).
+    """Depth of engagement and radial clearances at the major and minor axes (docs/models.md 2.1, 3).
 
     Teeth on the major axis (phi = 0) and the minor axis (phi = pi/n_w) are
     carried radially by ``w`` alone (``v = theta = 0`` there by symmetry), so
@@ -125,7 +125,7 @@ def mesh_figures(drive, law=None) -> dict:
 
 
 def placement_check(drive) -> dict:
-    """Largest distance between exact and first-order tooth placement over all teeth at phi_h = 0, um (theory.md 3.1)."""
+    """Largest distance between exact and first-order tooth placement over all teeth at phi_h = 0, um (docs/models.md 3.1)."""
     d = drive.design.drive
     _, phi = tooth_angles(d.z_flex, d.z_rigid, 0.0)
     exact = place_points(drive.flex.period, drive.law, phi, drive.r_m)

@@ -1,4 +1,4 @@
-"""Discrete-motion drive with a sectored rigid gear: motion law, sectored clearance sweep, tooth heights, audit (theory.md 2.3)."""
+"""Discrete-motion drive with a sectored rigid gear: motion law, sectored clearance sweep, tooth heights, audit (docs/models.md 2.3)."""
 
 from .motion import MotionLaw, Phase, motion_law
 from .heights import ClosedFormHeights, SimulatedHeights, closed_form_heights, listed_heights, simulated_heights

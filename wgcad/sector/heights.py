@@ -1,4 +1,4 @@
-"""Variable heights of the coupling-sector teeth: the closed form of theory.md 2.3 and the same heights found by a clearance sweep."""
+"""Variable heights of the coupling-sector teeth: the closed form of docs/models.md 2.3 and the same heights found by a clearance sweep."""
 
 from __future__ import annotations
 
@@ -17,7 +17,7 @@ __all__ = ["ClosedFormHeights", "SimulatedHeights", "closed_form_heights", "simu
 
 @dataclass(frozen=True)
 class ClosedFormHeights:
-    """Heights by ``h_i = r_fix - (r_cr + w(phi_i) + h_s)``, at most the full height (theory.md 2.3, [S5]).
+    """Heights by ``h_i = r_fix - (r_cr + w(phi_i) + h_s)``, at most the full height (docs/models.md 2.3, [S5]).
 
     Attributes
     ----------
@@ -60,7 +60,7 @@ def assigned_angles(layout: SectorLayout) -> tuple[np.ndarray, np.ndarray]:
     stand in register with its teeth, out of register only while the axis
     crosses a transmission sector. A coupling tooth is then at least its
     distance ``delta`` to the nearer boundary away from the axis, and ``w``
-    falls monotonically from the major axis (every two-wave law of theory.md
+    falls monotonically from the major axis (every two-wave law of docs/models.md
     3 does), so the axis on the boundary is the worst case: ``phi_i = delta_i``.
     It ignores the wave's own tangential displacement ``v`` inside the
     coupling sector (see :func:`register_angles`).
@@ -79,7 +79,7 @@ def register_angles(scene: SectoredScene, step_deg: float = DEFAULT_STEP_DEG, cu
     """``assign = "register"``: per coupling tooth, the generator angle of the sweep where a flexspline tip faces its tip land
     (out of register: the two tip lands overlap in angle) closest to the major axis; the flexspline tooth's angle from the axis then.
 
-    Uses only the motion law and the tooth poses of theory.md 3.1 (no
+    Uses only the motion law and the tooth poses of docs/models.md 3.1 (no
     distances): a flexspline tooth is out of register with a coupling tooth
     while the axis crosses a transmission sector (the flexspline moves) and,
     inside a coupling sector, where the wave's tangential displacement
@@ -111,7 +111,7 @@ def register_angles(scene: SectoredScene, step_deg: float = DEFAULT_STEP_DEG, cu
 
 def closed_form_heights(drive, layout: SectorLayout, teeth: TeethByHeight, assign: str = "register",
                         step_deg: float = DEFAULT_STEP_DEG) -> ClosedFormHeights:
-    """The closed-form heights of theory.md 2.3 with every parameter explicit.
+    """The closed-form heights of docs/models.md 2.3 with every parameter explicit.
 
     ``assign`` chooses the generator angle of each tooth: ``"register"``
     (:func:`register_angles`) or ``"boundary"`` (:func:`assigned_angles`).

@@ -1,4 +1,4 @@
-"""Motion law of a discrete-motion drive: flexspline rotation against generator angle, its dwell and move phases (theory.md 2.3)."""
+"""Motion law of a discrete-motion drive: flexspline rotation against generator angle, its dwell and move phases (docs/models.md 2.3)."""
 
 from __future__ import annotations
 
@@ -39,7 +39,7 @@ class MotionLaw:
     """Flexspline rotation ``phi_g`` (rigid gear fixed) against generator angle ``phi_h``.
 
     Kinematic model: when the generator's major axis points at the centre of
-    a rigid space, a flexspline tooth is centred in it (theory.md 1
+    a rigid space, a flexspline tooth is centred in it (docs/models.md 1
     reference position, applied to every space), and successive spaces
     receive successive flexspline teeth; in between, ``phi_g`` is linear in
     ``phi_h``. For a plain rigid gear this is exactly ``phi_h / u_hg``; in a

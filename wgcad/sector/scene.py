@@ -1,6 +1,6 @@
-"""Clearance sweep of a sectored drive: flexspline teeth against variable-height sector teeth over the cycle, tip-to-tip findings (theory.md 2.3, 5).
+"""Clearance sweep of a sectored drive: flexspline teeth against variable-height sector teeth over the cycle, tip-to-tip findings (docs/models.md 2.3, 5).
 
-Which shortcuts of theory.md 7 still hold:
+Which shortcuts of docs/models.md 7 still hold:
 
 * **mesh period**: none. The rigid teeth do not repeat with one pitch, so
   the state at ``phi_h`` and ``phi_h + 2 pi / N`` differ; every generator
@@ -300,7 +300,7 @@ def sectored_audit(scene: SectoredScene, step_deg: float = DEFAULT_STEP_DEG, cul
     A pair meets *tip-to-tip* when its tip lands face each other
     (:meth:`SectoredScene.facing`) and its clearance is at most the contact
     tolerance: the flexspline tip lands on the rigid tip instead of entering
-    a space (theory.md 5). Other pairs below ``-interference_tol`` are flank
+    a space (docs/models.md 5). Other pairs below ``-interference_tol`` are flank
     (or root) interference.
     """
     import time

@@ -1,4 +1,4 @@
-"""Elastic contact model of the loaded drive: ring compliance, flexible bearing, tooth contacts, contact solver (theory.md 4)."""
+"""Elastic contact model of the loaded drive: ring compliance, flexible bearing, tooth contacts, contact solver (docs/models.md 4)."""
 
 from wgcad.deformation.elastic.loaded import LoadedLaw
 from wgcad.deformation.elastic.model import ElasticModel, build_model

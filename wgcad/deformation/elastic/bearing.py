@@ -1,4 +1,4 @@
-"""The flexible bearing: balls as Hertz point contacts (P ~ delta^(3/2)) with radial clearance (theory.md 4.1)."""
+"""The flexible bearing: balls as Hertz point contacts (P ~ delta^(3/2)) with radial clearance (docs/models.md 4.1)."""
 
 from __future__ import annotations
 

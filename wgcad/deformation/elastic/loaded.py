@@ -1,4 +1,4 @@
-"""The loaded flexspline as a deformation law: analytic cam law + elastic ring field + rigid-body motion (theory.md 3.1, 4.1)."""
+"""The loaded flexspline as a deformation law: analytic cam law + elastic ring field + rigid-body motion (docs/models.md 3.1, 4.1)."""
 
 from __future__ import annotations
 

@@ -1,4 +1,4 @@
-"""Entry gap and clearance of teeth passing through a loaded (or any) rim shape, with the exact 2D engine (theory.md 5)."""
+"""Entry gap and clearance of teeth passing through a loaded (or any) rim shape, with the exact 2D engine (docs/models.md 5)."""
 
 from __future__ import annotations
 
@@ -18,7 +18,7 @@ def passing_poses(scene: Scene, law, phi):
     """Poses of a tooth at angles ``phi`` from the major axis as it passes the rigid teeth (rigid frame).
 
     The generator angle that brings a tooth to ``phi`` puts its material
-    angle at ``phi (z_b - z_g)/z_b`` (the mesh period, theory.md 7), so every
+    angle at ``phi (z_b - z_g)/z_b`` (the mesh period, docs/models.md 7), so every
     tooth at ``phi`` sees the rigid teeth alike; ``law`` holds the rim shape in
     the generator frame (quasi-static: the loaded shape travels with the cam).
     """
@@ -34,7 +34,7 @@ def _tip_excess(scene: Scene, law, phi):
 
 
 def entry_gap(scene: Scene, law, step_deg: float = 0.5) -> tuple[float, float]:
-    """Entry gap (theory.md 5) of teeth entering the mesh through ``law``'s first wave.
+    """Entry gap (docs/models.md 5) of teeth entering the mesh through ``law``'s first wave.
 
     The clearance when a tooth's tip circle crosses the rigid tip circle on
     the entry side (outermost crossing between the major axis and a quarter

@@ -1,4 +1,4 @@
-"""The elastic model of a whole drive built from its design: ring stiffness, bearing, tooth compliance, sections (theory.md 4.1)."""
+"""The elastic model of a whole drive built from its design: ring stiffness, bearing, tooth compliance, sections (docs/models.md 4.1)."""
 
 from __future__ import annotations
 
@@ -82,7 +82,7 @@ def build_model(drive, sections: int = 3) -> ElasticModel:
 
     Ring stiffness by a Ritz reduction of the cup: the rim's displacement at
     axial position ``z`` is ``f(z)`` times the displacement at the generator's
-    centre line (``f`` the coning law of theory.md 3.1, ``f = 1`` without
+    centre line (``f`` the coning law of docs/models.md 3.1, ``f = 1`` without
     coning), so a load at section ``z`` acts on the reduced ring with weight
     ``f(z)`` and the ring's bending stiffness is
     ``EI = E [h_eq^3/12 int_rim f^2 dz + t_cup^3/12 int_cup f^2 dz + b_o t_o^3/12]``:

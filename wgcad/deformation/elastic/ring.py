@@ -1,4 +1,4 @@
-"""Compliance of a thin inextensible ring under radial, tangential and couple point loads (theory.md 4.1)."""
+"""Compliance of a thin inextensible ring under radial, tangential and couple point loads (docs/models.md 4.1)."""
 
 from __future__ import annotations
 
@@ -15,7 +15,7 @@ __all__ = ["Ring", "ring_kernels", "series_kernels"]
 # closed forms of the Fourier sums (docs/models.md 4.1)
 #
 # A displacement field v = sum_{n>=2} (a_n cos n phi + b_n sin n phi) of the
-# inextensible ring (v' = -w, theta = (v + v'')/r, theory.md 3.1) stores
+# inextensible ring (v' = -w, theta = (v + v'')/r, docs/models.md 3.1) stores
 # U = pi EI n^2 (n^2 - 1)^2 (a_n^2 + b_n^2) / (2 r^3); the n = 0, 1 terms are
 # the rigid-body modes and carry no energy. Unit loads at psi (radial,
 # tangential, couple) do work on the shapes (n sin, -n cos), (cos, sin) and
@@ -138,7 +138,7 @@ class Ring:
     (outward positive, N), a tangential force (counter-clockwise positive, N)
     and a couple (counter-clockwise, N mm). Responses are the neutral line's
     ``w`` (outward), ``v`` (counter-clockwise) and the cross-section rotation
-    ``theta`` of theory.md 3.1. Only the deformable modes n >= 2 respond: the
+    ``theta`` of docs/models.md 3.1. Only the deformable modes n >= 2 respond: the
     rigid-body modes (n = 0 rotation, n = 1 translation) are left to the
     equilibrium equations (docs/models.md 4.1), so a load set that is not
     self-equilibrated is answered as if balanced by its n = 0, 1 components.

@@ -1,4 +1,4 @@
-"""Contact problem with equilibrium equalities: an exact active-set solver of the mixed LCP / convex QP (theory.md 4, 4.1)."""
+"""Contact problem with equilibrium equalities: an exact active-set solver of the mixed LCP / convex QP (docs/models.md 4, 4.1)."""
 
 from __future__ import annotations
 
@@ -68,7 +68,7 @@ def solve_contact_qp(M, q, A, f, active=None, tol_gap: float = 1e-12, max_iter: 
 
     ``gap = q + M F - A a >= 0,  F >= 0,  F . gap = 0,  A' F = f``
 
-    (the KKT conditions of the strictly convex QP above, theory.md 4), by
+    (the KKT conditions of the strictly convex QP above, docs/models.md 4), by
     block principal pivoting (Judice & Pires 1994) with Murty's single pivot
     as the anti-cycling fallback. ``M`` must be symmetric positive definite
     (ring compliance plus positive contact compliances).

@@ -1,4 +1,4 @@
-"""One load state of the drive: contact problem re-linearised on the exact tooth geometry until the teeth stop moving (theory.md 4, 4.1)."""
+"""One load state of the drive: contact problem re-linearised on the exact tooth geometry until the teeth stop moving (docs/models.md 4, 4.1)."""
 
 from __future__ import annotations
 

@@ -1,4 +1,4 @@
-"""A torque sweep of the loaded drive as data: entry gap, contacts, forces, ball loads, wind-up, stiffness (theory.md 4.1, 5)."""
+"""A torque sweep of the loaded drive as data: entry gap, contacts, forces, ball loads, wind-up, stiffness (docs/models.md 4.1, 5)."""
 
 from __future__ import annotations
 

@@ -1,4 +1,4 @@
-"""Tooth contacts: points, normals and gaps from the exact 2D engine, and the tooth pair's compliance (theory.md 4.1, 5)."""
+"""Tooth contacts: points, normals and gaps from the exact 2D engine, and the tooth pair's compliance (docs/models.md 4.1, 5)."""
 
 from __future__ import annotations
 
