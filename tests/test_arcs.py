@@ -39,11 +39,11 @@ def corner_angles(pieces):
     out = []
     for i, p in enumerate(pieces):
         q = pieces[(i + 1) % len(pieces)]
-        # derivatives a hair inside each piece: at a cusp (zero first derivative, cycloids on the pitch
-        # circle) their direction still tends to the tangent, with an O(eps) error
-        eps = 1e-7
-        a = p.deriv(np.array([p.t1 - eps * (p.t1 - p.t0)])) * np.sign(p.t1 - p.t0)
-        b = q.deriv(np.array([q.t0 + eps * (q.t1 - q.t0)])) * np.sign(q.t1 - q.t0)
+        # derivatives at the ends themselves: every piece's parameter has a non-zero speed there
+        # (cycloids run on u = 1 - cos(phi/2), whose speed is constant through the pitch-point cusp,
+        # where the tangent turns fast: a point inside the piece would not do)
+        a = p.deriv(np.array([p.t1])) * np.sign(p.t1 - p.t0)
+        b = q.deriv(np.array([q.t0])) * np.sign(q.t1 - q.t0)
         a, b = a[0] / np.hypot(*a[0]), b[0] / np.hypot(*b[0])
         out.append(math.acos(max(-1.0, min(1.0, float(a @ b)))))
     return np.array(out)

