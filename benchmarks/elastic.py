@@ -26,6 +26,9 @@ import numpy as np
 
 ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+
+from _timing import best_of  # noqa: E402
 
 from wgcad.deformation.elastic import build_model, solve_load  # noqa: E402
 from wgcad.deformation.elastic.sweep import torque_sweep  # noqa: E402
@@ -38,14 +41,6 @@ D1 = ROOT / "templates" / "d1_involute.toml"
 OUT = ROOT / "output" / "bench"
 
 
-def best_of(fn, n=3):
-    """Fastest of n runs and that run's result (so a state's own time split belongs to the time shown)."""
-    best = (float("inf"), None)
-    for _ in range(n):
-        t = time.perf_counter()
-        val = fn()
-        best = min(best, (time.perf_counter() - t, val), key=lambda x: x[0])
-    return best
 
 
 def main() -> int:

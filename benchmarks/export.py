@@ -19,13 +19,15 @@ import argparse
 import json
 import sys
 import tempfile
-import time
 from pathlib import Path
 
 import numpy as np
 
 ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+
+from _timing import best_of  # noqa: E402
 
 from wgcad.design import load_design  # noqa: E402
 from wgcad.design.parts import load_parts, part_sizes  # noqa: E402
@@ -34,13 +36,6 @@ from wgcad.drive import build_drive  # noqa: E402
 OUT = ROOT / "output" / "bench"
 
 
-def best_of(fn, n=3):
-    ts, val = [], None
-    for _ in range(n):
-        t = time.perf_counter()
-        val = fn()
-        ts.append(time.perf_counter() - t)
-    return min(ts), val
 
 
 def bench(design_path: Path, step: bool, tmp: Path, parts_step: bool = False) -> list[dict]:

@@ -26,6 +26,9 @@ import numpy as np
 
 ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+
+from _timing import best_of  # noqa: E402
 
 from wgcad.clearance.engine import AuditSettings, audit, brute_force_min  # noqa: E402
 from wgcad.design import load_design  # noqa: E402
@@ -35,13 +38,6 @@ OUT = ROOT / "output" / "bench"
 D1 = ROOT / "templates" / "d1_involute.toml"
 
 
-def best_of(fn, n=3):
-    ts, val = [], None
-    for _ in range(n):
-        t = time.perf_counter()
-        val = fn()
-        ts.append(time.perf_counter() - t)
-    return min(ts), val
 
 
 def machine() -> str:

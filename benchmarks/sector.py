@@ -16,13 +16,15 @@ import json
 import os
 import platform
 import sys
-import time
 from pathlib import Path
 
 import numpy as np
 
 ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+
+from _timing import best_of  # noqa: E402
 
 import wgcad.sector.scene as scene_mod  # noqa: E402
 from wgcad.design import load_design  # noqa: E402
@@ -34,13 +36,6 @@ OUT = ROOT / "output" / "bench"
 D4 = ROOT / "templates" / "d4_sectored.toml"
 
 
-def best_of(fn, n=3):
-    ts, val = [], None
-    for _ in range(n):
-        t = time.perf_counter()
-        val = fn()
-        ts.append(time.perf_counter() - t)
-    return min(ts), val
 
 
 def setup():
