@@ -34,8 +34,33 @@ class Template:
         ins = shapely.contains_xy(self.polygon, flat[:, 0], flat[:, 1])
         out = np.zeros(K * N)
         if ins.any():
-            out[ins] = shapely.distance(self.ring, shapely.points(flat[ins]))
+            out[ins] = self.boundary_distance(flat[ins])
         return out.reshape(K, N).max(axis=1)
+
+    def boundary_distance(self, pts: np.ndarray) -> np.ndarray:
+        """Distance ``(M,)`` of points ``(M, 2)`` to the outline, point against every edge in numpy.
+
+        The outlines have tens of edges: one vectorised pass beats a GEOS
+        call per point (and its point objects) by an order of magnitude.
+        Points are taken in chunks so memory stays bounded.
+        """
+        if not hasattr(self, "_seg_a"):
+            a = self.local
+            self._seg_a = a
+            self._seg_d = np.roll(a, -1, axis=0) - a
+            self._seg_l2 = np.maximum((self._seg_d ** 2).sum(-1), 1e-300)
+        a, d, l2 = self._seg_a, self._seg_d, self._seg_l2
+        out = np.empty(len(pts))
+        step = max(1, 400_000 // len(a))
+        for i in range(0, len(pts), step):
+            p = pts[i : i + step]
+            rx = p[:, None, 0] - a[None, :, 0]
+            ry = p[:, None, 1] - a[None, :, 1]
+            u = np.clip((rx * d[None, :, 0] + ry * d[None, :, 1]) / l2[None, :], 0.0, 1.0)
+            ex = rx - u * d[None, :, 0]
+            ey = ry - u * d[None, :, 1]
+            out[i : i + step] = np.sqrt((ex * ex + ey * ey).min(axis=1))
+        return out
 
 
 def _relative(rot_a, shift_a, rot_b, shift_b):

@@ -142,10 +142,15 @@ def cmd_generate(args) -> int:
 
     step(_COST["design"], "DXF")
     f, b = drive.flex, drive.rigid
+    from ..profiles.band import gear_band_outline
+
+    # the exported outlines run in a symmetric band around the exact curves (docs/models.md 2.3):
+    # chords through curve points would make every convex flank thin, every space narrow
+    band = {"flexspline": gear_band_outline(f), "rigid": gear_band_outline(b)}
     layers = [
-        DxfLayer("FLEXSPLINE", outlines=(f.outline,), color=5),
+        DxfLayer("FLEXSPLINE", outlines=(band["flexspline"],), color=5),
         DxfLayer("FLEXSPLINE_RIM", circles=((0.0, 0.0, drive.flex_rim_radius),), color=5),
-        DxfLayer("RIGID", outlines=(b.outline,), color=1),
+        DxfLayer("RIGID", outlines=(band["rigid"],), color=1),
         DxfLayer("RIGID_RIM", circles=((0.0, 0.0, drive.rigid_rim_radius),), color=1),
     ]
     rep = drive_report(drive)
@@ -166,9 +171,9 @@ def cmd_generate(args) -> int:
                 bar.set(done / total, f"STL {name}")
                 rim_circle = circle(rim, tol)
                 if rim < min(gear.r_a, gear.r_f):  # bore inside the teeth
-                    mesh = ring_solid(gear.outline, [rim_circle], bw)
+                    mesh = ring_solid(band[name], [rim_circle], bw)
                 else:  # teeth inside a ring
-                    mesh = ring_solid(rim_circle, [gear.outline], bw)
+                    mesh = ring_solid(rim_circle, [band[name]], bw)
                 rep[name]["solid_volume_mm3"] = round(float(mesh.volume), 4)
                 path = out / f"{stem}_{name}.stl"
                 write_stl(batch.temp_path(path), mesh)

@@ -16,7 +16,7 @@ import numpy as np
 
 from .sampling import chord_deviation, sample_curve
 
-__all__ = ["band_points", "band_outline", "band_deviation"]
+__all__ = ["band_points", "band_outline", "band_deviation", "gear_band_outline"]
 
 
 def _offset_dir(piece, t):
@@ -95,3 +95,28 @@ def band_outline(pieces, tol: float) -> np.ndarray:
     """Closed polyline ``(N, 2)`` of a path of pieces (e.g. :meth:`wgcad.profiles.gear.Gear.outline_pieces`), symmetric band ``tol``."""
     parts = [band_points(p, tol)[:-1] for p in pieces]
     return np.ascontiguousarray(np.concatenate(parts))
+
+
+def gear_band_outline(gear, tol: float | None = None) -> np.ndarray:
+    """The whole toothed boundary of ``gear`` in a symmetric band ``tol`` (default the gear's chord tolerance).
+
+    Same order, start and orientation as :attr:`wgcad.profiles.gear.Gear.outline`
+    (one pitch from the exact pieces, turned by ``k 2 pi/z + phase``), so an
+    export can use either; vertices closer than
+    :data:`wgcad.constants.MIN_VERTEX_SPACING` to the previous one are dropped
+    (they would merge in a float32 STL).
+    """
+    from .. import constants
+
+    tol = gear.tol if tol is None else float(tol)
+    one = band_outline(gear.pieces, tol)
+    step = np.hypot(*np.diff(np.vstack([one, one[:1]]), axis=0).T)
+    one = one[np.concatenate([[True], step[:-1] > constants.MIN_VERTEX_SPACING])] if len(one) > 2 else one
+    z = gear.spec.z
+    ang = np.arange(z) * 2.0 * np.pi / z + gear.spec.phase
+    c, s = np.cos(ang)[:, None], np.sin(ang)[:, None]
+    x = c * one[None, :, 0] - s * one[None, :, 1]
+    y = s * one[None, :, 0] + c * one[None, :, 1]
+    out = np.stack([x, y], axis=-1).reshape(-1, 2)
+    out.setflags(write=False)
+    return out
