@@ -152,6 +152,9 @@ def drive_report(drive) -> dict:
         "design": d.name,
         "source": des.source,
         "chord_tol_um": _r(drive.tol * 1e3, 6),
+        "outline_error": ("undeformed gears (DXF layers FLEXSPLINE, RIGID and the STL solids): a symmetric band, "
+                          "within chord_tol_um of the exact curves on either side; deformed-state DXFs: chords "
+                          "through points of the exact curves, so within chord_tol_um on the concave side only"),
         "drive": {
             "module_mm": d.module,
             "z_flex": d.z_flex,
