@@ -40,33 +40,73 @@ import numpy as np
 from .. import constants
 from ..placement import tooth_pose
 from .backlash import backlash
+from .findings import Finding
 from .entry import entry_crossings, entry_gap, entry_pinch, lipschitz_min
 from .scene import Scene, _classify, clearance_at_poses, refine_min, tooth_clearance, tooth_clearance_sections
 from .search import AuditSettings, _evaluate, _fold, _sample_phi, _SectionSearch
 
-__all__ = ["AuditSettings", "AuditResult", "Scene", "tooth_clearance", "clearance_at_poses", "clearance_profile",
+__all__ = ["AuditSettings", "AuditResult", "Finding", "Scene", "tooth_clearance", "clearance_at_poses", "clearance_profile",
            "clearance_vs_angle", "audit", "brute_force_min", "backlash", "entry_crossings", "entry_gap", "entry_pinch",
            "lipschitz_min", "refine_min", "tooth_clearance_sections"]
 
 
 @dataclass
 class AuditResult:
-    """Figures of an audit (lengths mm, angles rad inside; :meth:`to_json` converts at the edge)."""
+    """Figures of an audit as :class:`~wgcad.clearance.findings.Finding` records (mm, rad inside).
+
+    The report layer (:mod:`wgcad.report.audit`) shapes them for JSON and
+    the printed summary; the properties below are the figures programs use
+    most, read off the records.
+    """
 
     settings: dict
-    min_clearance: float
-    worst: dict
-    entry_gap: float
-    entry: dict
-    backlash: float
-    backlash_range: dict
+    findings: dict
     interference: bool
     interference_tol: float
     counts: dict
     settings_angles: np.ndarray = field(default_factory=lambda: np.zeros(0), repr=False)
-    #: unrounded tooth angles (rad) of the tightest sample, the entry crossing and the pinch
-    raw: dict = field(default_factory=dict)
     elapsed_s: float = 0.0
+
+    @property
+    def min_clearance(self) -> float:
+        return self.findings["min_clearance"].value
+
+    @property
+    def entry_gap(self) -> float:
+        return self.findings["entry_gap"].value
+
+    @property
+    def backlash(self) -> float:
+        return self.findings["backlash"].value
+
+    @property
+    def worst(self) -> dict:
+        from ..report.audit import worst_json
+
+        return worst_json(self.findings["min_clearance"])
+
+    @property
+    def entry(self) -> dict:
+        from ..report.audit import entry_json
+
+        return entry_json(self.findings["entry_gap"], self.findings["entry_pinch"], self.entry_side)
+
+    @property
+    def backlash_range(self) -> dict:
+        from ..report.audit import backlash_at_json
+
+        return backlash_at_json(self.findings["backlash"])
+
+    @property
+    def entry_side(self) -> str:
+        return self.settings.get("entry_side", "entry (+phi)")
+
+    @property
+    def raw(self) -> dict:
+        """Unrounded tooth angles (rad) of the tightest spot, the entry crossing and the pinch."""
+        f = self.findings
+        return {"worst_phi": f["min_clearance"].tooth_angle, "entry_phi": f["entry_gap"].tooth_angle,
+                "pinch_phi": f["entry_pinch"].tooth_angle, "min_clearance_polygon": f["min_clearance"].polygon_value}
 
     def to_json(self) -> dict:
         """The JSON document (shaped in :func:`wgcad.report.audit.audit_json`)."""
@@ -222,56 +262,32 @@ def audit(drive, settings: AuditSettings, progress=None) -> AuditResult:
         where = (int(cand_s[0]), int(cand_i[0]))
     si, i = where
     z_w = sections[si]
-    phi_c, loc, mirror_loc, flat, sgn_c = _canonical(scene, phi_all, period, float(phi_sorted[i]), z_w, settings.refine)
-    ai, k = divmod(flat, scene.z_g)
-    phi_rep = sgn_c * phi_c
-    detail = tooth_clearance(scene, np.array([phi_rep]), z_w, area=True)
-    side_val = {"lower": detail["lower"][0], "upper": detail["upper"][0], "third": detail["third"][0]}
-    side = min(side_val, key=side_val.get)
-    area = detail.get(f"{side}_area", np.zeros(1))[0] if side != "third" else 0.0
-    worst = {
-        "clearance_um": round(1e3 * best, 4),
-        "tooth": int(k),
-        "generator_angle_deg": round(float(np.rad2deg(angles[ai])), 6),
-        "tooth_angle_deg": round(float(np.rad2deg(phi_c)), 6),
-        "section_z_mm": None if z_w is None else round(z_w, 6),
-        "location": loc,
-        "mirror": {"tooth_angle_deg": round(float(np.rad2deg(-phi_c)), 6), "location": mirror_loc},
-        "sample_tooth_angle_deg": round(float(np.rad2deg(phi_rep)), 6),
-        "overlap_area_um2": round(1e6 * float(area), 4),
-        "polygon_clearance_um": round(1e3 * best_poly, 4),
-    }
+    exact = "exact" if settings.refine else "polygon"
+    worst = _worst_finding(scene, phi_all, period, float(phi_sorted[i]), z_w, settings.refine, angles, best, best_poly)
     ste = _stage(tick, "entry gap")
     ste(0.0)
     gaps = list(zip(entry_crossings(scene, sections, exact=settings.refine), sections))
     (eg, ephi), ez = min(gaps, key=lambda t: (np.inf if np.isnan(t[0][0]) else t[0][0]))
     crossed = bool(np.isfinite(eg))  # NaN: the tips never cross the rigid tip circle (no angle, no section)
-    entry = {
-        "tooth_angle_deg": round(float(np.rad2deg(ephi)), 6) if crossed else None,
-        "section_z_mm": None if ez is None or not crossed else round(ez, 6),
-        "side": "entry (+phi)" if scene.entry_sign > 0 else "entry (-phi)",
-    }
+    entry = Finding("entry_gap", float(eg) if crossed else float("nan"), exact,
+                    tooth_angle=float(ephi) if crossed else None, section_z=ez if crossed else None,
+                    details={"crossing": "flexspline tip arc crossing the rigid tip circle"})
     stp = _stage(tick, "pinch")
     stp(0.0)
     pinch = entry_pinch(scene, [(g[1], z) for g, z in gaps if np.isfinite(g[0])], exact=settings.refine) if crossed else None
     if pinch is None:
-        pp = None
-        entry.update({"pinch_um": None, "pinch_tooth_angle_deg": None, "pinch_section_z_mm": None,
-                      "pinch_location": None, "tip_to_tip_risk": False})
+        pinch_f = Finding("entry_pinch", float("nan"), exact, details={"tip_to_tip_risk": False})
     else:
         pc, pp, pz, ploc = pinch
-        entry.update({
-            "pinch_um": round(1e3 * pc, 4),
-            "pinch_tooth_angle_deg": round(float(np.rad2deg(pp)), 6),
-            "pinch_section_z_mm": None if pz is None else round(pz, 6),
-            "pinch_location": ploc,
-            # tip-to-tip jamming: the tooth tip meets a rigid tooth before its flank engages
-            "tip_to_tip_risk": bool(pc < settings.interference_tol and ploc == "tip"),
-        })
+        # tip-to-tip jamming: the tooth tip meets a rigid tooth before its flank engages
+        pinch_f = Finding("entry_pinch", float(pc), exact, tooth_angle=float(pp), section_z=pz, location=ploc,
+                          details={"tip_to_tip_risk": bool(pc < settings.interference_tol and ploc == "tip")})
     _stage(tick, "backlash")(0.0)
     # backlash at the first requested generator angle, middle section
     z_mid = sections[len(sections) // 2]
-    bl = [backlash(scene, float(angles[0]), z_mid)]
+    bl = float(backlash(scene, float(angles[0]), z_mid))
+    backlash_f = Finding("backlash", bl if np.isfinite(bl) else float("nan"), "brent",
+                         generator_angle=float(angles[0]), section_z=z_mid)
     tick(1.0, "done")
     evaluated = int(sum(r.evaluated.sum() for r in results))
     counts = {
@@ -305,24 +321,34 @@ def audit(drive, settings: AuditSettings, progress=None) -> AuditResult:
                        "polygon figures: chords lie inside convex and outside concave curve parts, "
                        "so each figure is within 2 x chord_tol_um of the exact one, either side"),
         "working_flank": scene.working,
+        "entry_side": "entry (+phi)" if scene.entry_sign > 0 else "entry (-phi)",
         "rigid_pitch_radius_mm": drive.rigid.r,
     }
     res = AuditResult(
         settings=rs,
-        min_clearance=best,
-        worst=worst,
-        entry_gap=eg,
-        entry=entry,
-        backlash=float(min(bl)),
-        backlash_range={"generator_angle_deg": round(float(np.rad2deg(angles[0])), 6), "section_z_mm": None if z_mid is None else round(z_mid, 6)},
+        findings={"min_clearance": worst, "entry_gap": entry, "entry_pinch": pinch_f, "backlash": backlash_f},
         interference=best < -settings.interference_tol,
         interference_tol=settings.interference_tol,
         counts=counts,
         settings_angles=angles,
-        raw={"worst_phi": phi_c, "entry_phi": ephi, "pinch_phi": pp, "min_clearance_polygon": best_poly},
     )
     res.elapsed_s = time.perf_counter() - t0
     return res
+
+
+def _worst_finding(scene: Scene, phi_all, period, phi_w: float, z_w, exact: bool, angles, best: float, best_poly: float) -> Finding:
+    """The smallest clearance as a :class:`Finding`: its canonical spot, the mirror image, the overlap area."""
+    phi_c, loc, mirror_loc, flat, sgn_c = _canonical(scene, phi_all, period, phi_w, z_w, exact)
+    ai, k = divmod(flat, scene.z_g)
+    phi_rep = sgn_c * phi_c
+    detail = tooth_clearance(scene, np.array([phi_rep]), z_w, area=True)
+    side_val = {"lower": detail["lower"][0], "upper": detail["upper"][0], "third": detail["third"][0]}
+    side = min(side_val, key=side_val.get)
+    area = detail.get(f"{side}_area", np.zeros(1))[0] if side != "third" else 0.0
+    return Finding("min_clearance", float(best), "exact" if exact else "polygon", tooth_angle=float(phi_c), section_z=z_w,
+                   location=loc, generator_angle=float(angles[ai]), tooth=int(k), polygon_value=float(best_poly),
+                   details={"mirror": (float(-phi_c), mirror_loc), "sample_tooth_angle": float(phi_rep),
+                            "overlap_area": float(area)})
 
 
 def brute_force_min(drive, angles: np.ndarray, sections) -> float:

@@ -144,7 +144,7 @@ def cmd_generate(args) -> int:
     f, b = drive.flex, drive.rigid
     from ..profiles.band import gear_band_outline
 
-    # the exported outlines run in a symmetric band around the exact curves (docs/models.md 2.3):
+    # the exported outlines run in a symmetric band around the exact curves (docs/models.md, appendix A):
     # chords through curve points would make every convex flank thin, every space narrow
     band = {"flexspline": gear_band_outline(f), "rigid": gear_band_outline(b)}
     layers = [

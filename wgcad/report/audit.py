@@ -4,7 +4,61 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["audit_json", "audit_summary"]
+__all__ = ["audit_json", "audit_summary", "worst_json", "entry_json", "backlash_at_json"]
+
+
+def _deg(x, nd=6):
+    return None if x is None else round(float(np.rad2deg(x)), nd)
+
+
+def _z(z):
+    return None if z is None else round(float(z), 6)
+
+
+def worst_json(f) -> dict:
+    """The tightest spot (a ``min_clearance`` :class:`~wgcad.clearance.findings.Finding`) for the JSON document."""
+    mirror_phi, mirror_loc = f.details["mirror"]
+    return {
+        "clearance_um": round(1e3 * f.value, 4),
+        "tooth": f.tooth,
+        "generator_angle_deg": _deg(f.generator_angle),
+        "tooth_angle_deg": _deg(f.tooth_angle),
+        "section_z_mm": _z(f.section_z),
+        "location": f.location,
+        "mirror": {"tooth_angle_deg": _deg(mirror_phi), "location": mirror_loc},
+        "sample_tooth_angle_deg": _deg(f.details["sample_tooth_angle"]),
+        "overlap_area_um2": round(1e6 * f.details["overlap_area"], 4),
+        "polygon_clearance_um": None if f.polygon_value is None else round(1e3 * f.polygon_value, 4),
+        "method": f.method,
+    }
+
+
+def entry_json(gap, pinch, side: str) -> dict:
+    """The entry crossing and the pinch after it (``entry_gap`` and ``entry_pinch`` findings) for the JSON document."""
+    crossed = bool(np.isfinite(gap.value))
+    out = {
+        "tooth_angle_deg": _deg(gap.tooth_angle) if crossed else None,
+        "section_z_mm": _z(gap.section_z) if crossed else None,
+        "side": side,
+    }
+    if np.isfinite(pinch.value):
+        out.update({
+            "pinch_um": round(1e3 * pinch.value, 4),
+            "pinch_tooth_angle_deg": _deg(pinch.tooth_angle),
+            "pinch_section_z_mm": _z(pinch.section_z),
+            "pinch_location": pinch.location,
+            "tip_to_tip_risk": bool(pinch.details.get("tip_to_tip_risk", False)),
+        })
+    else:
+        out.update({"pinch_um": None, "pinch_tooth_angle_deg": None, "pinch_section_z_mm": None,
+                    "pinch_location": None, "tip_to_tip_risk": False})
+    out["method"] = gap.method
+    return out
+
+
+def backlash_at_json(f) -> dict:
+    """Where the backlash (a ``backlash`` finding) was computed."""
+    return {"generator_angle_deg": _deg(f.generator_angle), "section_z_mm": _z(f.section_z)}
 
 
 def audit_json(result) -> dict:
