@@ -80,6 +80,8 @@ def test_default_sizes_are_derived_and_reported():
     ("shell_thickness = 5.0", "parts.shell_thickness"),
     ("cup_lenght = 5.0", "parts.cup_lenght"),
     ("cup_length = -5.0", "parts.cup_length"),
+    ("cup_length = 1e300", "parts.cup_length"),  # above the stated 10 m bound
+    ("flange_bolt_count = 100000", "parts.flange_bolt_count"),
 ])
 def test_bad_sizes_one_line_error_exit_2_nothing_written(tmp_path, capsys, line, field):
     design = small_design(tmp_path, line)

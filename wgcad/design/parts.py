@@ -10,7 +10,7 @@ from pathlib import Path
 
 from ..errors import DesignError, InputFileError
 
-__all__ = ["PartsSpec", "PartSizes", "parse_parts", "load_parts", "part_sizes"]
+__all__ = ["PartsSpec", "PartSizes", "parse_parts", "load_parts", "part_sizes", "MAX_PART_MM", "MAX_BOLTS", "PARTS_DOC"]
 
 
 @dataclass(frozen=True)
@@ -32,6 +32,32 @@ class PartsSpec:
     flange_bolt_circle_diameter: float | None = None
     flange_bolt_count: int | None = None
     flange_bolt_hole_diameter: float | None = None
+
+
+#: largest size any [parts] length may have, mm: ten metres, far beyond any strain-wave drive built
+#: (the largest catalogue units are about 1 m); it keeps absurd values from reaching the CAD kernel
+MAX_PART_MM = 10_000.0
+#: bolt counts: one to one per degree
+MAX_BOLTS = 360
+
+#: what each [parts] key is (for the key reference, docs/design-keys.md)
+PARTS_DOC = {
+    "cup_length": "flexspline cup: open end to the diaphragm's outer face",
+    "shell_thickness": "cup wall between the toothed rim and the diaphragm",
+    "diaphragm_thickness": "the cup's bottom",
+    "hub_bore_diameter": "bore of the diaphragm",
+    "cup_bolt_circle_diameter": "bolt circle on the diaphragm",
+    "cup_bolt_count": "holes on that circle",
+    "cup_bolt_hole_diameter": "their diameter",
+    "bearing_thickness": "radial section of the flexible bearing (races and balls)",
+    "bearing_width": "axial width of the flexible bearing",
+    "plug_bore_diameter": "bore of the wave-generator plug",
+    "flange_outer_diameter": "rigid gear's mounting flange",
+    "flange_thickness": "axial thickness of that flange",
+    "flange_bolt_circle_diameter": "bolt circle on the flange",
+    "flange_bolt_count": "holes on that circle",
+    "flange_bolt_hole_diameter": "their diameter",
+}
 
 
 @dataclass(frozen=True)
@@ -63,11 +89,12 @@ def parse_parts(data) -> PartsSpec:
             raise DesignError(f"parts.{key}", f"unknown key{hint}")
         where = f"parts.{key}"
         if key.endswith("_count"):
-            if isinstance(value, bool) or not isinstance(value, int) or not 1 <= value <= 360:
-                raise DesignError(where, f"must be a whole number 1..360, got {value!r}")
+            if isinstance(value, bool) or not isinstance(value, int) or not 1 <= value <= MAX_BOLTS:
+                raise DesignError(where, f"must be a whole number 1..{MAX_BOLTS}, got {value!r}")
         else:
-            if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value) or not value > 0:
-                raise DesignError(where, f"must be a positive number of mm, got {value!r}")
+            if (isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value)
+                    or not 0 < value <= MAX_PART_MM):
+                raise DesignError(where, f"must be a positive number of mm up to {MAX_PART_MM:g}, got {value!r}")
             value = float(value)
         kw[key] = value
     return PartsSpec(**kw)
