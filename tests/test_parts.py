@@ -198,6 +198,13 @@ def test_polyline_style_and_format_choice(tmp_path):
     assert names == ["parts.json", "small_flexspline.dxf", "small_plug.dxf", "small_rigid.dxf"]
     back = read_dxf(tmp_path / "o" / "small_flexspline.dxf")
     assert back["FLEXSPLINE"]["outlines"] and not back["FLEXSPLINE"]["paths"]
+    # the polyline is the symmetric band around the exact curves (issue 8), not one-sided chords
+    from wgcad.design import load_design
+    from wgcad.drive import build_drive
+    from wgcad.profiles.band import gear_band_outline
+
+    (o,) = back["FLEXSPLINE"]["outlines"]
+    np.testing.assert_allclose(o, gear_band_outline(build_drive(load_design(design)).flex), atol=1e-9)
 
 
 def test_parts_json_reports_sizes_and_defaults(tmp_path, capsys):

@@ -27,10 +27,17 @@ def data_layer(name: str, gear, tol: float, x: float, y: float, height: float) -
     return DxfLayer("GEAR_DATA", texts=texts, color=7), data, lines
 
 
-def _teeth_layer(name, gear, path, style, color):
+def _band(gear):
+    """The toothed outline as polyline: a symmetric band around the exact curves (docs/models.md, appendix A)."""
+    from wgcad.profiles.band import gear_band_outline
+
+    return gear_band_outline(gear)
+
+
+def _teeth_layer(name, gear, path, style, color, band=None):
     if style == "arcs":
         return DxfLayer(name, paths=(path,), color=color)
-    return DxfLayer(name, outlines=(gear.outline,), color=color)
+    return DxfLayer(name, outlines=(_band(gear) if band is None else band,), color=color)
 
 
 def _pappus(rz) -> float:
@@ -54,12 +61,13 @@ def flexspline(drive, sizes, style: str, tol: float) -> Part:
     d = drive.design
     bw = d.drive.face_width
     path = fit_gear(g, tol)
+    band = _band(g)
     area = abs(path_area(path))
     r_rim = drive.flex_rim_radius
     tip_r = float(np.hypot(*g.outline.T).max())
     text_h = max(0.5, round(0.02 * 2 * tip_r, 1))
     gl, data, lines = data_layer("flexspline", g, tol, 1.15 * tip_r, tip_r, text_h)
-    layers = [_teeth_layer("FLEXSPLINE", g, path, style, 5)]
+    layers = [_teeth_layer("FLEXSPLINE", g, path, style, 5, band)]
     info = {"gear_data": data}
     if drive.external:
         R = r_rim
@@ -71,7 +79,7 @@ def flexspline(drive, sizes, style: str, tol: float) -> Part:
             return S.prism(S.circle_wire(R), [S.wire_from_path(path.vertices, path.bulges)], bw)
 
         def mesh():
-            return to_trimesh(prism_m(circle_points(R, tol), [g.outline], 0.0, bw))
+            return to_trimesh(prism_m(circle_points(R, tol), [band], 0.0, bw))
 
         info["kind"] = "toothed flexible ring (external deformation: no cup)"
         return Part("flexspline", layers, solid, mesh, vol, ((-R, -R, 0.0), (R, R, bw)), info)
@@ -94,7 +102,7 @@ def flexspline(drive, sizes, style: str, tol: float) -> Part:
         return S.fuse(ring, S.drill(S.revolve_profile(rz), holes, L - td, L))
 
     def mesh():
-        ring = prism_m(g.outline, [circle_points(r_rim, tol)], 0.0, bw)
+        ring = prism_m(band, [circle_points(r_rim, tol)], 0.0, bw)
         n = n_segments(r_rim + ts, tol)
         return to_trimesh(ring + (revolve_m(rz, n) - holes_m(holes, L - td, L, tol)))
 
@@ -215,6 +223,7 @@ def rigid(drive, sizes, style: str, tol: float) -> Part:
     g = drive.rigid
     bw = drive.design.drive.face_width
     path = fit_gear(g, tol)
+    band = _band(g)
     area = abs(path_area(path))
     R = drive.rigid_rim_radius
     dh = sizes.flange_bolt_hole_diameter
@@ -228,7 +237,7 @@ def rigid(drive, sizes, style: str, tol: float) -> Part:
         tip_r = Rf
         vol = (PI * R * R - area) * (bw - tf) + (PI * Rf * Rf - area - hole_area) * tf
         gl, data, _ = data_layer("rigid", g, tol, 1.15 * Rf, Rf, max(0.5, round(0.02 * 2 * R, 1)))
-        layers = [_teeth_layer("RIGID", g, path, style, 1), DxfLayer("RIGID_OUTER", circles=((0.0, 0.0, R),), color=1),
+        layers = [_teeth_layer("RIGID", g, path, style, 1, band), DxfLayer("RIGID_OUTER", circles=((0.0, 0.0, R),), color=1),
                   DxfLayer("FLANGE", circles=((0.0, 0.0, Rf),), color=1), DxfLayer("FLANGE_BOLT_HOLES", circles=hole_circles, color=3), gl]
         info.update({"kind": "rigid gear with mounting flange", "flange_outer_diameter_mm": 2 * Rf, "flange_thickness_mm": tf})
 
@@ -242,15 +251,15 @@ def rigid(drive, sizes, style: str, tol: float) -> Part:
             return S.cut(body, S.prism(S.circle_wire(Rf + 1.0), [S.circle_wire(R)], bw - tf + 1.0, -1.0))
 
         def mesh():
-            plate = prism_m(circle_points(Rf, tol), [g.outline] + [circle_points(0.5 * h, tol, x, y) for x, y, h in holes], bw - tf, bw)
+            plate = prism_m(circle_points(Rf, tol), [band] + [circle_points(0.5 * h, tol, x, y) for x, y, h in holes], bw - tf, bw)
             if tf >= bw:
                 return to_trimesh(plate)
-            return to_trimesh(prism_m(circle_points(R, tol), [g.outline], 0.0, bw - tf) + plate)
+            return to_trimesh(prism_m(circle_points(R, tol), [band], 0.0, bw - tf) + plate)
     else:
         tip_r = float(np.hypot(*g.outline.T).max())
         vol = (area - PI * R * R - hole_area) * bw
         gl, data, _ = data_layer("rigid", g, tol, 1.15 * tip_r, tip_r, max(0.5, round(0.02 * 2 * tip_r, 1)))
-        layers = [_teeth_layer("RIGID", g, path, style, 1), DxfLayer("RIGID_BORE", circles=((0.0, 0.0, R),), color=1),
+        layers = [_teeth_layer("RIGID", g, path, style, 1, band), DxfLayer("RIGID_BORE", circles=((0.0, 0.0, R),), color=1),
                   DxfLayer("BOLT_HOLES", circles=hole_circles, color=3), gl]
         info["kind"] = "rigid gear (external teeth) with bolted hub"
 
@@ -259,6 +268,6 @@ def rigid(drive, sizes, style: str, tol: float) -> Part:
                            [S.circle_wire(R)] + [S.circle_wire(0.5 * h, x, y) for x, y, h in holes], bw)
 
         def mesh():
-            return to_trimesh(prism_m(g.outline, [circle_points(R, tol)] + [circle_points(0.5 * h, tol, x, y) for x, y, h in holes], 0.0, bw))
+            return to_trimesh(prism_m(band, [circle_points(R, tol)] + [circle_points(0.5 * h, tol, x, y) for x, y, h in holes], 0.0, bw))
     info["gear_data"] = data
     return Part("rigid", layers, solid, mesh, vol, ((-tip_r, -tip_r, 0.0), (tip_r, tip_r, bw)), info)
