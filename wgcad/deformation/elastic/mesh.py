@@ -11,7 +11,7 @@ from wgcad.clearance.engine import Scene, clearance_at_poses
 from wgcad.clearance.scene import refine_min
 from wgcad.placement import tooth_pose
 
-__all__ = ["passing_poses", "entry_gap"]
+__all__ = ["passing_poses", "entry_gap", "entry_gaps"]
 
 
 def passing_poses(scene: Scene, law, phi):
@@ -33,6 +33,38 @@ def _tip_excess(scene: Scene, law, phi):
     return -scene.tip_radial(rot, shift)
 
 
+def _crossing(scene: Scene, law, step_deg: float) -> float:
+    """Tooth angle of the entry crossing of ``law`` (NaN when the tips never cross), rad."""
+    sgn = scene.entry_sign
+    t = np.deg2rad(np.arange(step_deg, 90.0 + 0.5 * step_deg, step_deg))
+    f = _tip_excess(scene, law, sgn * t)
+    cross = np.nonzero((f[:-1] >= 0.0) & (f[1:] < 0.0))[0]
+    if cross.size == 0:
+        return float("nan")
+    i = int(cross[-1])
+    t0 = brentq(lambda x: float(_tip_excess(scene, law, np.array([sgn * x]))[0]), t[i], t[i + 1], xtol=1e-12)
+    return float(sgn * t0)
+
+
+def entry_gaps(scene: Scene, laws, step_deg: float = 0.5) -> list[tuple[float, float]]:
+    """:func:`entry_gap` of several laws; the exact-curve refinement of all of them in one engine call."""
+    phis = [_crossing(scene, law, step_deg) for law in laws]
+    ok = [i for i, p in enumerate(phis) if np.isfinite(p)]
+    out = [(float("nan"), float("nan"))] * len(laws)
+    if not ok:
+        return out
+    rot = np.empty(len(ok))
+    shift = np.empty((len(ok), 2))
+    for k, i in enumerate(ok):
+        r, s = passing_poses(scene, laws[i], np.array([phis[i]]))
+        rot[k], shift[k] = r[0], s[0]
+    # the gap on the exact tooth curves, as the audit reports it (polygons only find the pair)
+    det = refine_min(scene, rot, shift, clearance_at_poses(scene, rot, shift))
+    for k, i in enumerate(ok):
+        out[i] = (float(det["min"][k]), phis[i])
+    return out
+
+
 def entry_gap(scene: Scene, law, step_deg: float = 0.5) -> tuple[float, float]:
     """Entry gap (docs/models.md 5) of teeth entering the mesh through ``law``'s first wave.
 
@@ -46,19 +78,4 @@ def entry_gap(scene: Scene, law, step_deg: float = 0.5) -> tuple[float, float]:
     (gap mm, phi rad)
         NaN, NaN when the tips never cross.
     """
-    sgn = scene.entry_sign
-    t = np.deg2rad(np.arange(step_deg, 90.0 + 0.5 * step_deg, step_deg))
-    f = _tip_excess(scene, law, sgn * t)
-    cross = np.nonzero((f[:-1] >= 0.0) & (f[1:] < 0.0))[0]
-    if cross.size == 0:
-        return float("nan"), float("nan")
-    i = int(cross[-1])
-    t0 = brentq(lambda x: float(_tip_excess(scene, law, np.array([sgn * x]))[0]), t[i], t[i + 1], xtol=1e-12)
-    phi = sgn * t0
-    rot, shift = passing_poses(scene, law, np.array([phi]))
-    # the gap on the exact tooth curves, as the audit reports it (polygons only find the pair)
-    det = refine_min(scene, rot, shift, clearance_at_poses(scene, rot, shift))
-    return float(det["min"][0]), float(phi)
-
-
-
+    return entry_gaps(scene, [law], step_deg)[0]

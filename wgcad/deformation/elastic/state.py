@@ -31,6 +31,10 @@ RADIAL_MARGIN = 0.2
 #: (checked again at every re-linearisation on the loaded geometry, so a pair
 #: enters as soon as the rim brings it this close).
 GAP_MARGIN = 0.1
+#: A pair is measured again when its linearised gap is below twice its tooth's motion since the last
+#: measurement plus this, mm (0.5 um: any positive margin keeps unmeasured pairs open, this one absorbs
+#: round-off and the engine's own tolerance).
+REFRESH_MARGIN = 5e-4
 #: Contact forces below this are floored when the Hertz secants are taken, N
 #: (the approach error it leaves is below 1e-5 mm for the balls and teeth of D1).
 FORCE_FLOOR = 1e-2
@@ -111,8 +115,9 @@ def _rim(model: ElasticModel, loads: np.ndarray, rigid) -> tuple:
     return w, v, th, el
 
 
-def _geometry(model: ElasticModel, loads: np.ndarray, rigid):
-    """Tooth contacts of the current state, linearised: arrays for every pair within GAP_MARGIN (all sections at once)."""
+def _poses(model: ElasticModel, loads: np.ndarray, rigid):
+    """Poses of every tooth of every section (flattened ``section * z_g + tooth``), their neutral-line origins and
+    the elastic field, plus the indices of the teeth whose tips reach within RADIAL_MARGIN of the rigid tips."""
     d = model.drive
     z_g = model.tables.z_g
     S = len(model.zs)
@@ -120,35 +125,101 @@ def _geometry(model: ElasticModel, loads: np.ndarray, rigid):
     phi = np.broadcast_to(model.tables.angles[:z_g], (S, z_g))
     rot, shift = pose_from_displacements(phi, w, v, th, d.r_m)
     rot, shift = rot.ravel(), shift.reshape(-1, 2)
+    c, sn = np.cos(phi).ravel(), np.sin(phi).ravel()
+    w, v = w.ravel(), v.ravel()
+    origin = np.stack([(d.r_m + w) * c - v * sn, (d.r_m + w) * sn + v * c], axis=-1)
     tips = transform(model.scene.flex_tip_local, rot, shift)
     R = np.hypot(tips[..., 0], tips[..., 1]).max(axis=1)
-    idx = np.nonzero(R >= model.scene.r_tip_b - RADIAL_MARGIN)[0]
-    if idx.size == 0:
-        return None
-    sec, tooth = np.divmod(idx, z_g)
-    geo = flank_contacts(model.scene, rot[idx], shift[idx])
-    ph = phi.ravel()[idx]
-    c, sn = np.cos(ph), np.sin(ph)
-    wi, vi = w.ravel()[idx], v.ravel()[idx]
-    o = np.stack([(d.r_m + wi) * c - vi * sn, (d.r_m + wi) * sn + vi * c], axis=-1)
-    rows = []
-    for fl, key in enumerate(("lower", "upper")):
-        g = geo[key]
-        keep = g.gap < GAP_MARGIN
-        if keep.any():
-            rows.append(dict(section=sec[keep], tooth=tooth[keep], flank=np.full(keep.sum(), fl), phi=ph[keep],
-                             gap=g.gap[keep], point=g.point[keep], normal=g.normal[keep], origin=o[keep],
-                             rigid_tooth=g.rigid[keep]))
-    if not rows:
-        return None
-    out = {k: np.concatenate([r[k] for r in rows]) for k in rows[0]}
-    out["key"] = (out["section"] * z_g + out["tooth"]) * 2 + out["flank"]
-    out["el"] = el
-    return out
+    cand = np.nonzero(R >= model.scene.r_tip_b - RADIAL_MARGIN)[0]
+    return rot, shift, origin, el, cand
 
 
-def _assemble(model: ElasticModel, geo, rigid, e, F_prev_ball, F_prev_teeth):
-    """Vectors of the linearised contact problem (balls first, then teeth): angle index, b, f, A, q, s."""
+class _Pairs:
+    """The linearised contacts of every tooth pair (key ``(section z_g + tooth) 2 + flank``), kept between passes.
+
+    A pair is measured again on the exact geometry (the clearance engine)
+    when it is new, or when it could be closing: its linearised gap is less
+    than twice the largest distance any point of its tooth has moved since it
+    was measured, plus REFRESH_MARGIN. Gaps and their linearisations are both
+    1-Lipschitz in the tooth's motion, so a pair that is not measured again
+    is open on the exact geometry too: it carries no force and the contact
+    solution is the one full re-measurement gives (the same iterates).
+    """
+
+    def __init__(self, model: ElasticModel):
+        z_g = model.tables.z_g
+        n = len(model.zs) * z_g * 2
+        self.model = model
+        self.have = np.zeros(n, dtype=bool)
+        self.q_geo = np.zeros(n)  # gap + f b.U + A.rigid at the measurement: the constant part of the linear gap
+        self.gap = np.zeros(n)
+        self.b = np.zeros((n, 3))
+        self.A = np.zeros((n, 3))
+        self.point = np.zeros((n, 2))
+        self.normal = np.zeros((n, 2))
+        self.rigid_tooth = np.zeros(n, dtype=int)
+        self.at_origin = np.zeros((n, 2))
+        self.at_rot = np.zeros(n)
+        loc = model.scene.flex_local - np.array([model.drive.r_m, 0.0])
+        self.lever = float(np.hypot(loc[:, 0], loc[:, 1]).max())
+        self.measured = 0
+
+    def linear_gap(self, keys, fU, rigid):
+        """Linearised gap of pairs ``keys`` at the current state (``fU``: scaled elastic ``w, v, theta`` at each pair's tooth)."""
+        return self.q_geo[keys] - (self.b[keys] * fU).sum(axis=1) - self.A[keys] @ rigid
+
+    def update(self, rot, shift, origin, el, cand, rigid, full: bool = False):
+        """Measure again the pairs of teeth ``cand`` (flat tooth indices) that need it; return the keys within GAP_MARGIN."""
+        m = self.model
+        z_g = m.tables.z_g
+        sec, tooth = np.divmod(cand, z_g)
+        keys = np.stack([2 * cand, 2 * cand + 1], axis=1)  # (k, 2): lower, upper
+        fU = (m.scales[sec][:, None] * el[:, tooth].T)  # (k, 3)
+        need = np.ones(len(cand), dtype=bool)
+        if not full:
+            seen = self.have[keys].all(axis=1)
+            k0 = keys[seen]
+            move = (np.hypot(*(origin[cand[seen]] - self.at_origin[k0[:, 0]]).T)
+                    + np.abs(rot[cand[seen]] - self.at_rot[k0[:, 0]]) * self.lever)
+            lin = np.minimum(self.linear_gap(k0[:, 0], fU[seen], rigid), self.linear_gap(k0[:, 1], fU[seen], rigid))
+            need[seen] = lin < 2.0 * move + REFRESH_MARGIN
+        idx = np.nonzero(need)[0]
+        if idx.size:
+            self.measured += idx.size
+            t = cand[idx]
+            geo = flank_contacts(m.scene, rot[t], shift[t])
+            ph = m.tables.angles[tooth[idx]]
+            c, sn = np.cos(ph), np.sin(ph)
+            for fl, key in enumerate(("lower", "upper")):
+                g = geo[key]
+                k = keys[idx, fl]
+                n, p = g.normal, g.point
+                rel = p - origin[t]
+                b = np.stack([n[:, 0] * c + n[:, 1] * sn, -n[:, 0] * sn + n[:, 1] * c, rel[:, 0] * n[:, 1] - rel[:, 1] * n[:, 0]], axis=-1)
+                A = np.stack([n[:, 0], n[:, 1], p[:, 0] * n[:, 1] - p[:, 1] * n[:, 0]], axis=-1)
+                self.have[k] = True
+                self.gap[k] = g.gap
+                self.b[k], self.A[k], self.point[k], self.normal[k] = b, A, p, n
+                self.rigid_tooth[k] = g.rigid
+                self.q_geo[k] = g.gap + (b * fU[idx]).sum(axis=1) + A @ rigid
+                self.at_origin[k] = origin[t]
+                self.at_rot[k] = rot[t]
+        flat = keys.ravel()
+        fU2 = np.repeat(fU, 2, axis=0)
+        lin = self.linear_gap(flat, fU2, rigid)
+        return flat[lin < GAP_MARGIN]
+
+
+def _geometry(model: ElasticModel, loads: np.ndarray, rigid):
+    """Exact gaps of every tooth pair within GAP_MARGIN at the state ``(loads, rigid)``: dict ``key -> gap`` arrays."""
+    rot, shift, origin, el, cand = _poses(model, loads, rigid)
+    pairs = _Pairs(model)
+    keys = pairs.update(rot, shift, origin, el, cand, rigid, full=True)
+    return keys, pairs.gap[keys]
+
+
+def _assemble(model: ElasticModel, pairs: _Pairs, keys, el, rigid, e, F_prev_ball, F_prev_teeth):
+    """Vectors of the linearised contact problem (balls first, then the tooth pairs ``keys``): angle index, b, f, A, q, s."""
     br = model.bearing
     tab = model.tables
     Z = len(br.psi)
@@ -160,21 +231,16 @@ def _assemble(model: ElasticModel, geo, rigid, e, F_prev_ball, F_prev_teeth):
     A_b = np.stack([-cb, -sb, v_nom], axis=-1)
     o_b, s_b = br.tangent(F_prev_ball, FORCE_FLOOR)
     q_b = br.clearance - (e[0] * cb + e[1] * sb) + o_b
-    if geo is None:
+    if len(keys) == 0:
         return idx_b, b_b, np.ones(Z), A_b, q_b, s_b
-    n, p, o, phi = geo["normal"], geo["point"], geo["origin"], geo["phi"]
-    c, sn = np.cos(phi), np.sin(phi)
-    rel = p - o
-    b_t = np.stack([n[:, 0] * c + n[:, 1] * sn, -n[:, 0] * sn + n[:, 1] * c, rel[:, 0] * n[:, 1] - rel[:, 1] * n[:, 0]], axis=-1)
-    f_t = model.scales[geo["section"]]
-    A_t = np.stack([n[:, 0], n[:, 1], p[:, 0] * n[:, 1] - p[:, 1] * n[:, 0]], axis=-1)
-    Uv = geo["el"][:, geo["tooth"]].T
-    width = model.widths[geo["section"]]
+    sec, tooth = np.divmod(keys // 2, tab.z_g)
+    f_t = model.scales[sec]
+    width = model.widths[sec]
     o_t, s_t = model.teeth.tangent(F_prev_teeth, width, FORCE_FLOOR)
-    s_t = s_t + model.teeth.bending(p, n, width)
-    q_t = geo["gap"] + f_t * (b_t * Uv).sum(axis=1) + A_t @ rigid + o_t
-    return (np.concatenate([idx_b, geo["tooth"]]), np.concatenate([b_b, b_t]), np.concatenate([np.ones(Z), f_t]),
-            np.concatenate([A_b, A_t]), np.concatenate([q_b, q_t]), np.concatenate([s_b, s_t]))
+    s_t = s_t + model.teeth.bending(pairs.point[keys], pairs.normal[keys], width)
+    q_t = pairs.q_geo[keys] + o_t
+    return (np.concatenate([idx_b, tooth]), np.concatenate([b_b, pairs.b[keys]]), np.concatenate([np.ones(Z), f_t]),
+            np.concatenate([A_b, pairs.A[keys]]), np.concatenate([q_b, q_t]), np.concatenate([s_b, s_t]))
 
 
 def _merge_loads(phi, loads):
@@ -242,26 +308,26 @@ def solve_load(model: ElasticModel, torque_nm: float, cam_offset_um: float = 0.0
     omega, last_change, prev_omega = 1.0, np.inf, 1.0
     settled, relaxed = 0, False
     change = 0.0
+    pairs = _Pairs(model)
     for it in range(_MAX_LINEARISATIONS):
         t0 = time.perf_counter()
-        geo = _geometry(model, loads, rigid)
-        if geo is None and torque_nm > 0:
+        rot, shift, origin, el, cand = _poses(model, loads, rigid)
+        if cand.size == 0 and torque_nm > 0:
             raise DesignError("generator.w0_coef", "the flexspline teeth never reach the rigid teeth (no tooth tip within "
                               f"{RADIAL_MARGIN:g} mm of the rigid tip circle): no torque can be carried")
-        keys = np.zeros(0, dtype=int) if geo is None else geo["key"]
+        keys = pairs.update(rot, shift, origin, el, cand, rigid) if cand.size else np.zeros(0, dtype=int)
         # tooth positions (the carried poses of the engaging teeth) for the convergence test
         pos = np.full((n_keys, 2), np.nan)
-        if geo is not None:
-            pos[keys] = geo["origin"]
+        pos[keys] = origin[keys // 2]
         rigid_pos = float(rigid[2])
         t1 = time.perf_counter()
-        idx, b, f, A, q, s_c = _assemble(model, geo, rigid, e, F_ball, F_teeth_prev[keys])
+        idx, b, f, A, q, s_c = _assemble(model, pairs, keys, el, rigid, e, F_ball, F_teeth_prev[keys])
         M = Compliance(tab, idx, b * f[:, None], s_c)
         active = np.concatenate([F_ball > 0, prev_active[keys]])
         try:
             sol = solve_contact_qp(M, q, A, f_ext, active=active if it else None)
         except ContactSolveError as exc:
-            if torque_nm > 0 and geo is not None and "balance" in str(exc):
+            if torque_nm > 0 and len(keys) and "balance" in str(exc):
                 raise DesignError("generator.w0_coef", f"no set of tooth contacts can carry {torque_nm:g} N m: the teeth never meet "
                                   "on the working flanks") from None
             raise
@@ -269,7 +335,7 @@ def solve_load(model: ElasticModel, torque_nm: float, cam_offset_um: float = 0.0
         t_sol += time.perf_counter() - t1
         t_geo += t1 - t0
         F = sol.F
-        last = (geo, keys, F, sol, idx, b, f)
+        last = (keys, F, sol, idx, b, f, pairs.point[keys], pairs.normal[keys])
         omega_used = omega
         # under-relaxed update once the plain iteration stops contracting: the exact gaps are piecewise
         # smooth in the poses (polygon vertices), which can leave a 2-cycle of sub-micrometre amplitude
@@ -313,25 +379,25 @@ def solve_load(model: ElasticModel, torque_nm: float, cam_offset_um: float = 0.0
         raise ContactSolveError(f"load state at {torque_nm:g} N m: tooth positions still moving after {_MAX_LINEARISATIONS} re-linearisations")
     # the reported state is the last contact solution itself (not a relaxed mixture): its forces, points and
     # normals are in equilibrium to round-off; the exact gaps are then measured on the final poses
-    geo, keys, F, sol, idx, b, f = last
+    keys, F, sol, idx, b, f, point, normal = last
     loads = _dense_loads(n_ang, idx, F, f, b)
     rigid = sol.a.copy()
     F_ball, Ft = F[:Z], F[Z:]
     model.bearing.check(F_ball)
     t0 = time.perf_counter()
-    geo2 = _geometry(model, loads, rigid)
+    keys2, gaps2 = _geometry(model, loads, rigid)
     t_geo += time.perf_counter() - t0
     psi, law_loads = _merge_loads(tab.angles, loads)
     laws = [LoadedLaw(centre, model.section_law(i), model.ring, psi, law_loads, model.scales[i], tuple(rigid))
             for i in range(len(model.zs))]
     n_t = len(keys)
+    sec_t, tooth_t = np.divmod(keys // 2, tab.z_g)
     if n_t:
-        width = model.widths[geo["section"]]
-        appr_t = model.teeth.bending(geo["point"], geo["normal"], width) * Ft + model.teeth.hertz(Ft, width)
+        width = model.widths[sec_t]
+        appr_t = model.teeth.bending(point, normal, width) * Ft + model.teeth.hertz(Ft, width)
         # a pair that left the GAP_MARGIN band on the final poses is open by at least that much
         exact = np.full(n_keys, GAP_MARGIN)
-        if geo2 is not None:
-            exact[geo2["key"]] = geo2["gap"]
+        exact[keys2] = gaps2
         gap_t = exact[keys]
     else:
         appr_t = gap_t = np.zeros(0)
@@ -350,15 +416,15 @@ def solve_load(model: ElasticModel, torque_nm: float, cam_offset_um: float = 0.0
     empty2 = np.zeros((0, 2))
     contacts = {
         "kind": np.concatenate([np.zeros(Z, int), np.ones(n_t, int)]),
-        "section": np.concatenate([np.zeros(Z, int), geo["section"] if n_t else np.zeros(0, int)]),
-        "tooth": np.concatenate([np.full(Z, -1), geo["tooth"] if n_t else np.zeros(0, int)]),
-        "flank": np.concatenate([np.full(Z, -1), geo["flank"] if n_t else np.zeros(0, int)]),
-        "phi": np.concatenate([model.bearing.psi, geo["phi"] if n_t else np.zeros(0)]),
+        "section": np.concatenate([np.zeros(Z, int), sec_t]),
+        "tooth": np.concatenate([np.full(Z, -1), tooth_t]),
+        "flank": np.concatenate([np.full(Z, -1), keys % 2]),
+        "phi": np.concatenate([model.bearing.psi, tab.angles[tooth_t]]),
         "force": F_all,
         "gap": np.concatenate([gap_b, gap_t]),
         "approach": np.concatenate([appr_b, appr_t]),
-        "point": np.concatenate([ball_pt, geo["point"] if n_t else empty2]),
-        "normal": np.concatenate([-np.stack([cb, sb], axis=-1), geo["normal"] if n_t else empty2]),
+        "point": np.concatenate([ball_pt, point if n_t else empty2]),
+        "normal": np.concatenate([-np.stack([cb, sb], axis=-1), normal if n_t else empty2]),
     }
     residuals = {
         "equilibrium": sol.equilibrium,
