@@ -39,6 +39,12 @@ REFRESH_MARGIN = 5e-4
 #: (the approach error it leaves is below 1e-5 mm for the balls and teeth of D1).
 FORCE_FLOOR = 1e-2
 _MAX_LINEARISATIONS = 100
+#: Solutions the re-linearisation's Anderson acceleration combines (0: plain fixed-point iteration).
+ANDERSON_DEPTH = 3
+#: The acceleration starts once the teeth move less than this per pass, mm: before, contact sets change.
+ANDERSON_START = 0.02
+_LEVER = 2.0  # mm, a tooth's lever: weighs ring couples against forces in the acceleration's metric
+_KREF = 1e5  # N/mm, a contact stiffness: weighs rim motions against forces there
 _TRACE = None  # a list to record (pass, change, relaxation, pairs, loaded contacts) while debugging
 
 
@@ -57,7 +63,9 @@ class LoadState:
         Rim translation ``dx, dy`` (mm) and rotation (rad, counter-clockwise) relative to the rigid gear.
     contacts : dict of arrays
         ``kind`` (0 ball, 1 tooth), ``section``, ``tooth``, ``flank`` (0 lower, 1 upper, -1 ball),
-        ``phi`` (rad), ``force`` (N), ``gap`` (exact geometric gap at the solution, mm),
+        ``phi`` (rad), ``force`` (N), ``gap`` (geometric gap at the solution, mm: exact, from the
+        clearance engine, for every pair that carries load or could hold the smallest clearance, ``gap_exact``;
+        the others are open wider and report their linearised gap),
         ``approach`` (contact compliance's share, mm), ``point`` (K, 2).
     residuals : dict
         ``equilibrium`` (relative), ``complementarity`` (relative), ``linearisation_mm``
@@ -74,6 +82,8 @@ class LoadState:
     contacts: dict
     residuals: dict
     timing: dict = field(default_factory=dict)
+    #: the tooth pairs measured on the exact geometry at this state (a warm start's first pass reuses them)
+    pairs: object = field(default=None, repr=False, compare=False)
 
     @property
     def mesh_wind_up(self) -> float:
@@ -164,58 +174,105 @@ class _Pairs:
         self.lever = float(np.hypot(loc[:, 0], loc[:, 1]).max())
         self.measured = 0
 
+    def copy(self) -> "_Pairs":
+        new = object.__new__(_Pairs)
+        new.__dict__.update({k: (v.copy() if isinstance(v, np.ndarray) else v) for k, v in self.__dict__.items()})
+        return new
+
     def linear_gap(self, keys, fU, rigid):
         """Linearised gap of pairs ``keys`` at the current state (``fU``: scaled elastic ``w, v, theta`` at each pair's tooth)."""
         return self.q_geo[keys] - (self.b[keys] * fU).sum(axis=1) - self.A[keys] @ rigid
 
+    def _move(self, keys, rot, origin):
+        """Largest motion of any point of each pair's tooth since the pair was measured, mm."""
+        t = keys // 2
+        return np.hypot(*(origin[t] - self.at_origin[keys]).T) + np.abs(rot[t] - self.at_rot[keys]) * self.lever
+
     def update(self, rot, shift, origin, el, cand, rigid, full: bool = False):
         """Measure again the pairs of teeth ``cand`` (flat tooth indices) that need it; return the keys within GAP_MARGIN."""
         m = self.model
-        z_g = m.tables.z_g
-        sec, tooth = np.divmod(cand, z_g)
+        sec, tooth = np.divmod(cand, m.tables.z_g)
         keys = np.stack([2 * cand, 2 * cand + 1], axis=1)  # (k, 2): lower, upper
         fU = (m.scales[sec][:, None] * el[:, tooth].T)  # (k, 3)
         need = np.ones(len(cand), dtype=bool)
         if not full:
             seen = self.have[keys].all(axis=1)
             k0 = keys[seen]
-            move = (np.hypot(*(origin[cand[seen]] - self.at_origin[k0[:, 0]]).T)
-                    + np.abs(rot[cand[seen]] - self.at_rot[k0[:, 0]]) * self.lever)
+            move = self._move(k0[:, 0], rot, origin)
             lin = np.minimum(self.linear_gap(k0[:, 0], fU[seen], rigid), self.linear_gap(k0[:, 1], fU[seen], rigid))
-            need[seen] = lin < 2.0 * move + REFRESH_MARGIN
-        idx = np.nonzero(need)[0]
-        if idx.size:
-            self.measured += idx.size
-            t = cand[idx]
-            geo = flank_contacts(m.scene, rot[t], shift[t])
-            ph = m.tables.angles[tooth[idx]]
-            c, sn = np.cos(ph), np.sin(ph)
-            for fl, key in enumerate(("lower", "upper")):
-                g = geo[key]
-                k = keys[idx, fl]
-                n, p = g.normal, g.point
-                rel = p - origin[t]
-                b = np.stack([n[:, 0] * c + n[:, 1] * sn, -n[:, 0] * sn + n[:, 1] * c, rel[:, 0] * n[:, 1] - rel[:, 1] * n[:, 0]], axis=-1)
-                A = np.stack([n[:, 0], n[:, 1], p[:, 0] * n[:, 1] - p[:, 1] * n[:, 0]], axis=-1)
-                self.have[k] = True
-                self.gap[k] = g.gap
-                self.b[k], self.A[k], self.point[k], self.normal[k] = b, A, p, n
-                self.rigid_tooth[k] = g.rigid
-                self.q_geo[k] = g.gap + (b * fU[idx]).sum(axis=1) + A @ rigid
-                self.at_origin[k] = origin[t]
-                self.at_rot[k] = rot[t]
+            # a tooth that has not moved (a warm start's first pass) keeps its exact measurement
+            need[seen] = (lin < 2.0 * move + REFRESH_MARGIN) & (move > 1e-9)
+        self._measure(np.nonzero(need)[0], cand, keys, fU, rot, shift, origin, rigid)
         flat = keys.ravel()
-        fU2 = np.repeat(fU, 2, axis=0)
-        lin = self.linear_gap(flat, fU2, rigid)
+        lin = self.linear_gap(flat, np.repeat(fU, 2, axis=0), rigid)
         return flat[lin < GAP_MARGIN]
+
+    def _measure(self, idx, cand, keys, fU, rot, shift, origin, rigid):
+        if idx.size == 0:
+            return
+        m = self.model
+        self.measured += idx.size
+        t = cand[idx]
+        geo = flank_contacts(m.scene, rot[t], shift[t])
+        ph = m.tables.angles[t % m.tables.z_g]
+        c, sn = np.cos(ph), np.sin(ph)
+        for fl, key in enumerate(("lower", "upper")):
+            g = geo[key]
+            k = keys[idx, fl]
+            n, p = g.normal, g.point
+            rel = p - origin[t]
+            b = np.stack([n[:, 0] * c + n[:, 1] * sn, -n[:, 0] * sn + n[:, 1] * c, rel[:, 0] * n[:, 1] - rel[:, 1] * n[:, 0]], axis=-1)
+            A = np.stack([n[:, 0], n[:, 1], p[:, 0] * n[:, 1] - p[:, 1] * n[:, 0]], axis=-1)
+            self.have[k] = True
+            self.gap[k] = g.gap
+            self.b[k], self.A[k], self.point[k], self.normal[k] = b, A, p, n
+            self.rigid_tooth[k] = g.rigid
+            self.q_geo[k] = g.gap + (b * fU[idx]).sum(axis=1) + A @ rigid
+            self.at_origin[k] = origin[t]
+            self.at_rot[k] = rot[t]
+
+    def report(self, rot, shift, origin, el, cand, rigid):
+        """The pairs within GAP_MARGIN at a solved state and their gaps, exact wherever it can matter.
+
+        Measured on the exact geometry: every pair that could be closing (as
+        in :meth:`update`) and then every pair whose linearised gap, less
+        twice its tooth's motion since measured, is below the smallest exact
+        open gap (it could be the smallest clearance). The others are open by
+        more than that and report the linearised gap (``exact`` False).
+
+        Returns
+        -------
+        keys : (k,) int
+        gap : (k,) float, mm
+        exact : (k,) bool
+        """
+        self.update(rot, shift, origin, el, cand, rigid)
+        m = self.model
+        sec, tooth = np.divmod(cand, m.tables.z_g)
+        keys = np.stack([2 * cand, 2 * cand + 1], axis=1)
+        fU = (m.scales[sec][:, None] * el[:, tooth].T)
+        while True:
+            flat = keys.ravel()
+            lin = self.linear_gap(flat, np.repeat(fU, 2, axis=0), rigid)
+            move = self._move(flat, rot, origin)
+            exact = move <= 1e-9
+            op = exact & (lin > 0.0)
+            m0 = float(lin[op].min()) if op.any() else np.inf
+            need = (~exact) & (lin - 2.0 * move < max(m0, REFRESH_MARGIN) + REFRESH_MARGIN)
+            if not need.any():
+                break
+            tn = np.unique(np.nonzero(need)[0] // 2)
+            self._measure(tn, cand, keys, fU, rot, shift, origin, rigid)
+        band = lin < GAP_MARGIN
+        return flat[band], np.where(exact, self.gap[flat], lin)[band], exact[band]
 
 
 def _geometry(model: ElasticModel, loads: np.ndarray, rigid):
-    """Exact gaps of every tooth pair within GAP_MARGIN at the state ``(loads, rigid)``: dict ``key -> gap`` arrays."""
+    """Every tooth pair within GAP_MARGIN measured on the exact geometry at the state ``(loads, rigid)``: keys, gaps, pairs."""
     rot, shift, origin, el, cand = _poses(model, loads, rigid)
     pairs = _Pairs(model)
-    keys = pairs.update(rot, shift, origin, el, cand, rigid, full=True)
-    return keys, pairs.gap[keys]
+    keys = pairs.update(rot, shift, origin, el, cand, rigid, full=True) if cand.size else np.zeros(0, dtype=int)
+    return keys, pairs.gap[keys], pairs
 
 
 def _assemble(model: ElasticModel, pairs: _Pairs, keys, el, rigid, e, F_prev_ball, F_prev_teeth):
@@ -303,12 +360,13 @@ def solve_load(model: ElasticModel, torque_nm: float, cam_offset_um: float = 0.0
         F_ball = warm.contacts["force"][warm.contacts["kind"] == 0].copy()
     centre = model.drive.law
     t_geo = t_sol = 0.0
-    prev_pos = None
     pivots = 0
-    omega, last_change, prev_omega = 1.0, np.inf, 1.0
+    omega, last_change = 1.0, np.inf
+    acc = _Anderson(model.drive.r_m, ANDERSON_DEPTH)
     settled, relaxed = 0, False
     change = 0.0
-    pairs = _Pairs(model)
+    # a warm start's pairs were measured at exactly its state: the first pass measures only what moves
+    pairs = warm.pairs.copy() if warm is not None and warm.pairs is not None and warm.pairs.model is model else _Pairs(model)
     for it in range(_MAX_LINEARISATIONS):
         t0 = time.perf_counter()
         rot, shift, origin, el, cand = _poses(model, loads, rigid)
@@ -316,10 +374,6 @@ def solve_load(model: ElasticModel, torque_nm: float, cam_offset_um: float = 0.0
             raise DesignError("generator.w0_coef", "the flexspline teeth never reach the rigid teeth (no tooth tip within "
                               f"{RADIAL_MARGIN:g} mm of the rigid tip circle): no torque can be carried")
         keys = pairs.update(rot, shift, origin, el, cand, rigid) if cand.size else np.zeros(0, dtype=int)
-        # tooth positions (the carried poses of the engaging teeth) for the convergence test
-        pos = np.full((n_keys, 2), np.nan)
-        pos[keys] = origin[keys // 2]
-        rigid_pos = float(rigid[2])
         t1 = time.perf_counter()
         idx, b, f, A, q, s_c = _assemble(model, pairs, keys, el, rigid, e, F_ball, F_teeth_prev[keys])
         M = Compliance(tab, idx, b * f[:, None], s_c)
@@ -336,45 +390,43 @@ def solve_load(model: ElasticModel, torque_nm: float, cam_offset_um: float = 0.0
         t_geo += t1 - t0
         F = sol.F
         last = (keys, F, sol, idx, b, f, pairs.point[keys], pairs.normal[keys])
-        omega_used = omega
         # under-relaxed update once the plain iteration stops contracting: the exact gaps are piecewise
         # smooth in the poses (polygon vertices), which can leave a 2-cycle of sub-micrometre amplitude
         loads_new = _dense_loads(n_ang, idx, F, f, b)
         F_t_new = np.zeros(n_keys)
         F_t_new[keys] = F[Z:]
+        # convergence: the largest move of an engaging tooth from the linearisation's poses to the solution's
+        # (the fixed-point residual itself, from the tables: no engine call)
+        o_new = _origins(model, loads_new, sol.a)
+        k2 = keys // 2
+        d = np.hypot(*(o_new[k2] - origin[k2]).T)
+        change = max(float(d.max()) if d.size else 0.0, abs(float(sol.a[2] - rigid[2])) * model.drive.r_m)
+        if _TRACE is not None:
+            _TRACE.append((it, change, omega, len(keys), int((F > 0).sum())))
+        if change < tol:
+            break
+        # a contact toggling between passes (a linearisation that closes a pair the exact geometry
+        # opens) has no fixed point: the relaxed passes settle where it switches; the residual of the
+        # nonlinear contact law on the exact geometry is then reported (linearisation_mm)
+        settled = settled + 1 if (omega < 1.0 and change * omega < 0.25 * tol) else 0
+        if settled >= 3:
+            relaxed = True
+            break
+        if it >= 5 and change > 0.95 * last_change:  # a cycle, not a slow contraction
+            omega = max(omega * 0.5, 1.0 / 16.0)
+            acc.reset()
+        last_change = change
         if omega < 1.0:
             loads = (1 - omega) * loads + omega * loads_new
             rigid = (1 - omega) * rigid + omega * sol.a
             F_ball = (1 - omega) * F_ball + omega * F[:Z]
             F_teeth_prev = (1 - omega) * F_teeth_prev + omega * F_t_new
         else:
-            loads, rigid = loads_new, sol.a.copy()
+            loads, rigid = acc.step(loads, rigid, loads_new, sol.a, change)
             F_ball = F[:Z].copy()
             F_teeth_prev = F_t_new
         prev_active = np.zeros(n_keys, dtype=bool)
         prev_active[keys] = F[Z:] > 0
-        # convergence: largest move of an engaging tooth between two passes
-        if prev_pos is not None:
-            d = np.hypot(*(pos - prev_pos).T)
-            change = float(np.nanmax(d)) if np.isfinite(d).any() else 0.0
-            # the step the plain iteration takes (a relaxed step is omega times it)
-            change = max(change, abs(rigid_pos - prev_rigid) * model.drive.r_m) / prev_omega
-            if _TRACE is not None:
-                _TRACE.append((it, change, omega, len(keys), int((F > 0).sum())))
-            # pairs entering or leaving the GAP_MARGIN band carry no load: not part of the test
-            if change < tol:
-                break
-            # a contact toggling between passes (a linearisation that closes a pair the exact geometry
-            # opens) has no fixed point: the relaxed passes settle where it switches; the residual of the
-            # nonlinear contact law on the exact geometry is then reported (linearisation_mm)
-            settled = settled + 1 if (omega < 1.0 and change * prev_omega < 0.25 * tol) else 0
-            if settled >= 3:
-                relaxed = True
-                break
-            if it >= 5 and change > 0.95 * last_change:  # a cycle, not a slow contraction
-                omega = max(omega * 0.5, 1.0 / 16.0)
-            last_change = change
-        prev_pos, prev_rigid, prev_omega = pos, rigid_pos, omega_used
     else:
         raise ContactSolveError(f"load state at {torque_nm:g} N m: tooth positions still moving after {_MAX_LINEARISATIONS} re-linearisations")
     # the reported state is the last contact solution itself (not a relaxed mixture): its forces, points and
@@ -385,7 +437,8 @@ def solve_load(model: ElasticModel, torque_nm: float, cam_offset_um: float = 0.0
     F_ball, Ft = F[:Z], F[Z:]
     model.bearing.check(F_ball)
     t0 = time.perf_counter()
-    keys2, gaps2 = _geometry(model, loads, rigid)
+    pairs2 = pairs.copy()
+    keys2, gaps2, exact2 = pairs2.report(*_poses(model, loads, rigid), rigid)
     t_geo += time.perf_counter() - t0
     psi, law_loads = _merge_loads(tab.angles, loads)
     laws = [LoadedLaw(centre, model.section_law(i), model.ring, psi, law_loads, model.scales[i], tuple(rigid))
@@ -396,11 +449,15 @@ def solve_load(model: ElasticModel, torque_nm: float, cam_offset_um: float = 0.0
         width = model.widths[sec_t]
         appr_t = model.teeth.bending(point, normal, width) * Ft + model.teeth.hertz(Ft, width)
         # a pair that left the GAP_MARGIN band on the final poses is open by at least that much
-        exact = np.full(n_keys, GAP_MARGIN)
-        exact[keys2] = gaps2
-        gap_t = exact[keys]
+        final = np.full(n_keys, GAP_MARGIN)
+        final[keys2] = gaps2
+        gap_t = final[keys]
+        is_exact = np.zeros(n_keys, dtype=bool)
+        is_exact[keys2] = exact2
+        exact_t = is_exact[keys]
     else:
         appr_t = gap_t = np.zeros(0)
+        exact_t = np.zeros(0, dtype=bool)
     cb, sb = np.cos(model.bearing.psi), np.sin(model.bearing.psi)
     w_nom, v_nom = tab.centre_ball
     wb = (tab.influence[3 * tab.z_g :: 3] @ loads.ravel()) + rigid[0] * cb + rigid[1] * sb - rigid[2] * v_nom
@@ -422,6 +479,7 @@ def solve_load(model: ElasticModel, torque_nm: float, cam_offset_um: float = 0.0
         "phi": np.concatenate([model.bearing.psi, tab.angles[tooth_t]]),
         "force": F_all,
         "gap": np.concatenate([gap_b, gap_t]),
+        "gap_exact": np.concatenate([np.ones(Z, dtype=bool), exact_t]),
         "approach": np.concatenate([appr_b, appr_t]),
         "point": np.concatenate([ball_pt, point if n_t else empty2]),
         "normal": np.concatenate([-np.stack([cb, sb], axis=-1), normal if n_t else empty2]),
@@ -433,10 +491,67 @@ def solve_load(model: ElasticModel, torque_nm: float, cam_offset_um: float = 0.0
         "min_gap_plus_approach_mm": float(g_all.min()) if g_all.size else 0.0,
         "iterations": it + 1,
         "pivots": pivots,
-        "position_change_mm": change if prev_pos is not None and it else 0.0,
+        "position_change_mm": change,
         "settled_by_relaxation": relaxed,
     }
-    return LoadState(model, float(torque_nm), e, laws, rigid, contacts, residuals, {"geometry": t_geo, "solver": t_sol})
+    return LoadState(model, float(torque_nm), e, laws, rigid, contacts, residuals, {"geometry": t_geo, "solver": t_sol}, pairs2)
+
+
+def _origins(model: ElasticModel, loads: np.ndarray, rigid) -> np.ndarray:
+    """Neutral-line origins ``(S z_g, 2)`` of every tooth of every section (flattened as in :func:`_poses`)."""
+    w, v, _, _ = _rim(model, loads, rigid)
+    phi = model.tables.angles[: model.tables.z_g]
+    c, sn = np.cos(phi), np.sin(phi)
+    r = model.drive.r_m + w
+    return np.stack([r * c - v * sn, r * sn + v * c], axis=-1).reshape(-1, 2)
+
+
+class _Anderson:
+    """Anderson acceleration of the re-linearisation (type II, Walker & Ni 2011) on the ring loads and rim motion.
+
+    The next linearisation point is the affine combination of the last
+    solutions that best cancels their residuals (solution minus
+    linearisation point), so it balances the torque as each of them does.
+    Forces weigh in N, couples per ``_LEVER`` mm, motions times ``_KREF``
+    N/mm (a contact stiffness): the least-squares metric only. The history is
+    dropped when a step does not lower the residual (a change of contact set).
+    """
+
+    def __init__(self, r_m: float, depth: int):
+        self.r_m, self.depth = r_m, depth
+        self.reset()
+
+    def reset(self):
+        self.X, self.G, self.last = [], [], np.inf
+
+    def _vec(self, loads, rigid):
+        return np.concatenate([loads[:, :2].ravel(), loads[:, 2] / _LEVER,
+                               _KREF * np.array([rigid[0], rigid[1], rigid[2] * self.r_m])])
+
+    def step(self, loads, rigid, loads_new, rigid_new, change):
+        if self.depth == 0:
+            return loads_new, np.array(rigid_new, dtype=float)
+        if change > self.last or change > ANDERSON_START:
+            self.reset()
+            if change > ANDERSON_START:
+                return loads_new, np.array(rigid_new, dtype=float)
+        self.last = change
+        self.X.append(self._vec(loads, rigid))
+        self.G.append(self._vec(loads_new, rigid_new))
+        self.X, self.G = self.X[-(self.depth + 1):], self.G[-(self.depth + 1):]
+        if len(self.X) < 2:
+            return loads_new, np.array(rigid_new, dtype=float)
+        R = [g - x for g, x in zip(self.G, self.X)]
+        dR = np.stack([R[i + 1] - R[i] for i in range(len(R) - 1)], axis=1)
+        dG = np.stack([self.G[i + 1] - self.G[i] for i in range(len(R) - 1)], axis=1)
+        gamma, *_ = np.linalg.lstsq(dR, R[-1], rcond=1e-10)
+        y = self.G[-1] - dG @ gamma
+        n = len(loads)
+        out = np.empty_like(loads)
+        out[:, 0], out[:, 1] = y[: 2 * n].reshape(n, 2).T
+        out[:, 2] = y[2 * n: 3 * n] * _LEVER
+        r = y[3 * n:] / _KREF
+        return out, np.array([r[0], r[1], r[2] / self.r_m])
 
 
 def _loads_on_table(tab, psi, loads) -> np.ndarray:
