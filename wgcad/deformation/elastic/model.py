@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from math import pi
 
 import numpy as np
@@ -60,6 +60,8 @@ class ElasticModel:
     torque_sign: float
     ei_parts: dict
     tables: RingTables
+    #: results reused between load states of this model (the tooth pairs measured at the nominal state)
+    cache: dict = field(default_factory=dict, repr=False, compare=False)
 
     def section_law(self, i: int):
         return self.drive.law_at(float(self.zs[i])) if self.drive.coned else self.drive.law

@@ -366,7 +366,16 @@ def solve_load(model: ElasticModel, torque_nm: float, cam_offset_um: float = 0.0
     settled, relaxed = 0, False
     change = 0.0
     # a warm start's pairs were measured at exactly its state: the first pass measures only what moves
-    pairs = warm.pairs.copy() if warm is not None and warm.pairs is not None and warm.pairs.model is model else _Pairs(model)
+    if warm is not None and warm.pairs is not None and warm.pairs.model is model:
+        pairs = warm.pairs.copy()
+    else:
+        # a cold start's first pass is the nominal state: its pairs are measured once per model
+        if "nominal_pairs" not in model.cache:
+            nominal = _Pairs(model)
+            rot0, shift0, origin0, el0, cand0 = _poses(model, np.zeros((n_ang, 3)), np.zeros(3))
+            nominal.update(rot0, shift0, origin0, el0, cand0, np.zeros(3), full=True)
+            model.cache["nominal_pairs"] = nominal
+        pairs = model.cache["nominal_pairs"].copy()
     for it in range(_MAX_LINEARISATIONS):
         t0 = time.perf_counter()
         rot, shift, origin, el, cand = _poses(model, loads, rigid)
