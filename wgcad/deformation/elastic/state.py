@@ -15,7 +15,7 @@ from .loaded import LoadedLaw
 from .model import ElasticModel
 from .solve import ContactSolveError, solve_contact_qp
 from .tables import Compliance
-from .teeth import flank_contacts
+from .teeth import pair_contacts
 
 __all__ = ["LoadState", "solve_load", "POSITION_TOL", "RADIAL_MARGIN", "GAP_MARGIN"]
 
@@ -39,6 +39,8 @@ REFRESH_MARGIN = 5e-4
 #: (the approach error it leaves is below 1e-5 mm for the balls and teeth of D1).
 FORCE_FLOOR = 1e-2
 _MAX_LINEARISATIONS = 100
+#: Smallest relaxation of a cycling re-linearisation: its steps shrink to this share of the plain step.
+_OMEGA_MIN = 1.0 / 64.0
 #: Solutions the re-linearisation's Anderson acceleration combines (0: plain fixed-point iteration).
 ANDERSON_DEPTH = 3
 #: The acceleration starts once the teeth move less than this per pass, mm: before, contact sets change.
@@ -192,44 +194,45 @@ class _Pairs:
         """Measure again the pairs of teeth ``cand`` (flat tooth indices) that need it; return the keys within GAP_MARGIN."""
         m = self.model
         sec, tooth = np.divmod(cand, m.tables.z_g)
-        keys = np.stack([2 * cand, 2 * cand + 1], axis=1)  # (k, 2): lower, upper
-        fU = (m.scales[sec][:, None] * el[:, tooth].T)  # (k, 3)
-        need = np.ones(len(cand), dtype=bool)
-        if not full:
-            seen = self.have[keys].all(axis=1)
+        keys = np.stack([2 * cand, 2 * cand + 1], axis=1).ravel()  # lower, upper of each tooth
+        fU = np.repeat(m.scales[sec][:, None] * el[:, tooth].T, 2, axis=0)  # (2k, 3)
+        if full:
+            need = np.ones(len(keys), dtype=bool)
+        else:
+            seen = self.have[keys]
+            need = ~seen
             k0 = keys[seen]
-            move = self._move(k0[:, 0], rot, origin)
-            lin = np.minimum(self.linear_gap(k0[:, 0], fU[seen], rigid), self.linear_gap(k0[:, 1], fU[seen], rigid))
+            move = self._move(k0, rot, origin)
+            lin = self.linear_gap(k0, fU[seen], rigid)
             # a tooth that has not moved (a warm start's first pass) keeps its exact measurement
             need[seen] = (lin < 2.0 * move + REFRESH_MARGIN) & (move > 1e-9)
-        self._measure(np.nonzero(need)[0], cand, keys, fU, rot, shift, origin, rigid)
-        flat = keys.ravel()
-        lin = self.linear_gap(flat, np.repeat(fU, 2, axis=0), rigid)
-        return flat[lin < GAP_MARGIN]
+        self._measure(np.nonzero(need)[0], keys, fU, rot, shift, origin, rigid)
+        lin = self.linear_gap(keys, fU, rigid)
+        return keys[lin < GAP_MARGIN]
 
-    def _measure(self, idx, cand, keys, fU, rot, shift, origin, rigid):
+    def _measure(self, idx, keys, fU, rot, shift, origin, rigid):
+        """Measure pairs ``keys[idx]`` on the exact geometry at the current poses."""
         if idx.size == 0:
             return
         m = self.model
         self.measured += idx.size
-        t = cand[idx]
-        geo = flank_contacts(m.scene, rot[t], shift[t])
+        k = keys[idx]
+        t = k // 2
+        lo, up, _ = m.scene.neighbours(shift[t], rot[t])
+        g = pair_contacts(m.scene, rot[t], shift[t], np.where(k % 2 == 0, lo, up))
         ph = m.tables.angles[t % m.tables.z_g]
         c, sn = np.cos(ph), np.sin(ph)
-        for fl, key in enumerate(("lower", "upper")):
-            g = geo[key]
-            k = keys[idx, fl]
-            n, p = g.normal, g.point
-            rel = p - origin[t]
-            b = np.stack([n[:, 0] * c + n[:, 1] * sn, -n[:, 0] * sn + n[:, 1] * c, rel[:, 0] * n[:, 1] - rel[:, 1] * n[:, 0]], axis=-1)
-            A = np.stack([n[:, 0], n[:, 1], p[:, 0] * n[:, 1] - p[:, 1] * n[:, 0]], axis=-1)
-            self.have[k] = True
-            self.gap[k] = g.gap
-            self.b[k], self.A[k], self.point[k], self.normal[k] = b, A, p, n
-            self.rigid_tooth[k] = g.rigid
-            self.q_geo[k] = g.gap + (b * fU[idx]).sum(axis=1) + A @ rigid
-            self.at_origin[k] = origin[t]
-            self.at_rot[k] = rot[t]
+        n, p = g.normal, g.point
+        rel = p - origin[t]
+        b = np.stack([n[:, 0] * c + n[:, 1] * sn, -n[:, 0] * sn + n[:, 1] * c, rel[:, 0] * n[:, 1] - rel[:, 1] * n[:, 0]], axis=-1)
+        A = np.stack([n[:, 0], n[:, 1], p[:, 0] * n[:, 1] - p[:, 1] * n[:, 0]], axis=-1)
+        self.have[k] = True
+        self.gap[k] = g.gap
+        self.b[k], self.A[k], self.point[k], self.normal[k] = b, A, p, n
+        self.rigid_tooth[k] = g.rigid
+        self.q_geo[k] = g.gap + (b * fU[idx]).sum(axis=1) + A @ rigid
+        self.at_origin[k] = origin[t]
+        self.at_rot[k] = rot[t]
 
     def report(self, rot, shift, origin, el, cand, rigid):
         """The pairs within GAP_MARGIN at a solved state and their gaps, exact wherever it can matter.
@@ -249,11 +252,10 @@ class _Pairs:
         self.update(rot, shift, origin, el, cand, rigid)
         m = self.model
         sec, tooth = np.divmod(cand, m.tables.z_g)
-        keys = np.stack([2 * cand, 2 * cand + 1], axis=1)
-        fU = (m.scales[sec][:, None] * el[:, tooth].T)
+        flat = np.stack([2 * cand, 2 * cand + 1], axis=1).ravel()
+        fU = np.repeat(m.scales[sec][:, None] * el[:, tooth].T, 2, axis=0)
         while True:
-            flat = keys.ravel()
-            lin = self.linear_gap(flat, np.repeat(fU, 2, axis=0), rigid)
+            lin = self.linear_gap(flat, fU, rigid)
             move = self._move(flat, rot, origin)
             exact = move <= 1e-9
             op = exact & (lin > 0.0)
@@ -261,8 +263,7 @@ class _Pairs:
             need = (~exact) & (lin - 2.0 * move < max(m0, REFRESH_MARGIN) + REFRESH_MARGIN)
             if not need.any():
                 break
-            tn = np.unique(np.nonzero(need)[0] // 2)
-            self._measure(tn, cand, keys, fU, rot, shift, origin, rigid)
+            self._measure(np.nonzero(need)[0], flat, fU, rot, shift, origin, rigid)
         band = lin < GAP_MARGIN
         return flat[band], np.where(exact, self.gap[flat], lin)[band], exact[band]
 
@@ -422,7 +423,7 @@ def solve_load(model: ElasticModel, torque_nm: float, cam_offset_um: float = 0.0
             relaxed = True
             break
         if it >= 5 and change > 0.95 * last_change:  # a cycle, not a slow contraction
-            omega = max(omega * 0.5, 1.0 / 16.0)
+            omega = max(omega * 0.5, _OMEGA_MIN)
             acc.reset()
         last_change = change
         if omega < 1.0:
