@@ -10,7 +10,7 @@ from wgcad.clearance.engine import Scene, clearance_at_poses
 from wgcad.clearance.scene import refine_min
 from wgcad.placement import pose_from_displacements, tooth_pose
 
-from .loaded import states_many
+from .loaded import displacements_many
 
 __all__ = ["passing_poses", "entry_gap", "entry_gaps"]
 
@@ -37,9 +37,9 @@ def _tip_excess(scene: Scene, law, phi):
 def _poses_many(scene: Scene, laws, phis):
     """:func:`passing_poses` of several laws at once (one ring-field evaluation per load state)."""
     out = []
-    for phi, st in zip(phis, states_many(laws, phis)):
+    for phi, (w, v, th) in zip(phis, displacements_many(laws, phis)):
         mat = phi * (scene.z_b - scene.z_g) / scene.z_b
-        out.append(pose_from_displacements(phi, st.w, st.v, st.theta, scene.drive.r_m, mat - phi))
+        out.append(pose_from_displacements(phi, w, v, th, scene.drive.r_m, mat - phi))
     return out
 
 

@@ -64,7 +64,11 @@ class ElasticModel:
     cache: dict = field(default_factory=dict, repr=False, compare=False)
 
     def section_law(self, i: int):
-        return self.drive.law_at(float(self.zs[i])) if self.drive.coned else self.drive.law
+        """Nominal law of section ``i`` (one object per section, so loaded states can share its evaluations)."""
+        key = ("section_law", i)
+        if key not in self.cache:
+            self.cache[key] = self.drive.law_at(float(self.zs[i])) if self.drive.coned else self.drive.law
+        return self.cache[key]
 
 
 def _coning(drive):
