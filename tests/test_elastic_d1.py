@@ -217,3 +217,16 @@ def test_entry_gap_of_the_nominal_law_matches_the_engine(model):
     for z, (g, phi) in zip(model.zs, ref):
         g2, phi2 = entry_gap(model.scene, model.drive.law_at(float(z)))
         assert abs(g2 - g) < 1e-9 and abs(phi2 - phi) < 1e-9
+
+
+def test_displacements_of_many_laws_at_once_are_their_states(sweep):
+    # the entry-gap search evaluates the laws of every section, wave and level together (shared ring fields
+    # and nominal states); the figures must be each law's own
+    from wgcad.deformation.elastic.loaded import displacements_many
+
+    laws = [law.shifted(p) for st in sweep["states"] for law in st.laws for p in (0.0, np.pi)]
+    phis = [np.linspace(-3.0, 3.0, 41) + 0.013 * k for k in range(len(laws))]
+    phis[1] = phis[0]  # shared angles too
+    for law, phi, (w, v, th) in zip(laws, phis, displacements_many(laws, phis)):
+        st = law.state(phi)
+        assert np.abs(st.w - w).max() < 1e-13 and np.abs(st.v - v).max() < 1e-13 and np.abs(st.theta - th).max() < 1e-15
