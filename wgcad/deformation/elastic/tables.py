@@ -92,11 +92,12 @@ class Compliance:
 
     def __init__(self, tables: RingTables, idx: np.ndarray, fb: np.ndarray, s: np.ndarray):
         self._K = tables.influence
+        m = len(idx)
         self._rows = (3 * idx[:, None] + np.arange(3)).ravel()  # (3 m,)
         self._fb = fb
         self._s = s
-        self._cache: dict[int, np.ndarray] = {}
-        m = len(idx)
+        self._D = np.empty((m, m))
+        self._have = np.zeros(m, dtype=bool)
         self.shape = (m, m)
         # D_jj = fb_j' C(0) fb_j: the 3x3 block at zero angle is the same for every angle
         c0 = self._K[:3, :3]
@@ -105,21 +106,17 @@ class Compliance:
     def cols(self, W: np.ndarray) -> np.ndarray:
         """``M[:, W]``, ``(m, len(W))``."""
         W = np.asarray(W, dtype=int)
-        new = [j for j in W.tolist() if j not in self._cache]
-        if new:
-            nw = np.asarray(new)
+        new = W[~self._have[W]]
+        if new.size:
             m = self.shape[0]
-            # the load side: 3 nonzeros per contact column
-            src = self._K[:, self._rows.reshape(m, 3)[nw]]  # (3 n, k, 3)
-            Z = np.einsum("rka,ka->rk", src, self._fb[nw])  # (3 n, k)
-            # the observer side: gather each contact's three rows
-            D = np.einsum("ja,jak->jk", self._fb, Z[self._rows].reshape(m, 3, len(nw)))
-            D[nw, np.arange(len(nw))] += self._s[nw]
-            for k, j in enumerate(new):
-                self._cache[j] = D[:, k]
-        if W.size == 0:
-            return np.zeros((self.shape[0], 0))
-        return np.stack([self._cache[j] for j in W.tolist()], axis=1)
+            # the influence matrix is symmetric (Maxwell-Betti), so a load's column is its row: contiguous
+            src = self._K[self._rows.reshape(m, 3)[new]]  # (k, 3, 3 n)
+            Z = np.einsum("kar,ka->kr", src, self._fb[new])  # (k, 3 n)
+            D = np.einsum("kja,ja->jk", Z[:, self._rows].reshape(len(new), m, 3), self._fb)
+            D[new, np.arange(len(new))] += self._s[new]
+            self._D[:, new] = D
+            self._have[new] = True
+        return self._D[:, W]
 
     def dense(self) -> np.ndarray:
         """The whole matrix (tests, small problems)."""
