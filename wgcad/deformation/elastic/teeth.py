@@ -35,31 +35,37 @@ class ContactGeometry:
     rigid: np.ndarray
 
 
-def _deepest(pts: np.ndarray, geoms: np.ndarray):
-    """Deepest vertex of each polygon ``pts[k]`` ``(K, N, 2)`` inside ``geoms[k]``, all pairs at once.
+def _deepest(pts: np.ndarray, template, rot: np.ndarray, shift: np.ndarray):
+    """Deepest vertex of each polygon ``pts[k]`` ``(K, N, 2)`` inside the copy ``R(rot[k]) template + shift[k]``.
 
-    Returns depth ``(K,)`` (0 where no vertex is inside), the vertex ``(K, 2)`` and
-    its nearest point on the boundary of ``geoms[k]`` ``(K, 2)``.
+    Worked in the template's frame against its one prepared polygon (as the
+    engine's ``Template.depth_of``). Returns depth ``(K,)`` (0 where no
+    vertex is inside), the vertex ``(K, 2)`` and its nearest point on the
+    copy's boundary ``(K, 2)``, both in the frame of ``pts``.
     """
     K, N, _ = pts.shape
     depth = np.zeros(K)
     vert = pts[:, 0].copy()
     near = pts[:, 0].copy()
-    ins = shapely.contains_xy(geoms[:, None], pts[..., 0], pts[..., 1])
+    c, s = np.cos(rot)[:, None], np.sin(rot)[:, None]
+    d = pts - shift[:, None, :]
+    qx, qy = c * d[..., 0] + s * d[..., 1], -s * d[..., 0] + c * d[..., 1]
+    ins = shapely.contains_xy(template.polygon, qx, qy)
     kk, ii = np.nonzero(ins)
     if kk.size == 0:
         return depth, vert, near
-    rings = shapely.get_exterior_ring(geoms)
-    d = shapely.distance(rings[kk], shapely.points(pts[kk, ii]))
+    dist = shapely.distance(template.ring, shapely.points(qx[kk, ii], qy[kk, ii]))
     full = np.full((K, N), -1.0)
-    full[kk, ii] = d
+    full[kk, ii] = dist
     best = np.argmax(full, axis=1)
     has = full[np.arange(K), best] > 0.0
     k = np.nonzero(has)[0]
     depth[k] = full[k, best[k]]
     vert[k] = pts[k, best[k]]
-    seg = shapely.get_coordinates(shapely.shortest_line(rings[k], shapely.points(vert[k]))).reshape(-1, 2, 2)
-    near[k] = seg[:, 0]
+    seg = shapely.get_coordinates(shapely.shortest_line(template.ring, shapely.points(qx[k, best[k]], qy[k, best[k]])))
+    nl = seg.reshape(-1, 2, 2)[:, 0]
+    ck, sk = c[k, 0], s[k, 0]
+    near[k] = np.stack([ck * nl[:, 0] - sk * nl[:, 1], sk * nl[:, 0] + ck * nl[:, 1]], axis=-1) + shift[k]
     return depth, vert, near
 
 
@@ -91,11 +97,13 @@ def _smooth_normals(local: np.ndarray, rot: np.ndarray, shift: np.ndarray, p: np
     c, s = np.cos(rot), np.sin(rot)
     d = p - shift
     q = np.stack([c * d[:, 0] + s * d[:, 1], -s * d[:, 0] + c * d[:, 1]], axis=-1)
-    t = np.clip(((q[:, None, :] - a) * ab).sum(axis=-1) / L2, 0.0, 1.0)
-    r = a + t[..., None] * ab - q[:, None, :]
-    e = np.argmin((r * r).sum(axis=-1), axis=1)
+    # the nearest edge and the place on it: GEOS projects the points onto the template's ring
+    L = np.sqrt(L2)
+    cum = np.concatenate([[0.0], np.cumsum(L)])
+    sl = shapely.line_locate_point(shapely.linearrings(local), shapely.points(q))
     N = len(local)
-    te = t[np.arange(len(q)), e][:, None]
+    e = np.clip(np.searchsorted(cum, sl, side="right") - 1, 0, N - 1)
+    te = np.clip((sl - cum[e]) / L[e], 0.0, 1.0)[:, None]
     n = (1.0 - te) * vn[e] + te * vn[(e + 1) % N]
     n /= np.hypot(n[:, 0], n[:, 1])[:, None]
     return np.stack([c * n[:, 0] - s * n[:, 1], s * n[:, 0] + c * n[:, 1]], axis=-1), kink_edge[e]
@@ -144,8 +152,8 @@ def pair_contacts(scene: Scene, rot: np.ndarray, shift: np.ndarray, rigid: np.nd
     over = np.nonzero(gap == 0.0)[0]
     if over.size:
         # the vertex that sets the engine's depth: of the flexspline inside the rigid tooth, or the reverse
-        d_f, v_f, q_f = _deepest(pts[over], rg[over])
-        d_r, v_r, q_r = _deepest(scene.rigid_pts[idx[over]], geoms[over])
+        d_f, v_f, q_f = _deepest(pts[over], scene.rigid, scene.rigid_rot[idx[over]], scene.rigid_shift[idx[over]])
+        d_r, v_r, q_r = _deepest(scene.rigid_pts[idx[over]], scene.flex, rot[over], shift[over])
         gap[over] = -np.maximum(d_f, d_r)
         flex_side = d_f >= d_r
         point[over] = np.where(flex_side[:, None], v_f, q_r)
