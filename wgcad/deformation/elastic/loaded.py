@@ -10,7 +10,7 @@ import numpy as np
 from ..laws import Law, RimState
 from .ring import Ring
 
-__all__ = ["LoadedLaw", "states_many", "displacements_many"]
+__all__ = ["LoadedLaw", "displacements_many"]
 
 
 @dataclass(frozen=True)
@@ -106,34 +106,6 @@ class LoadedLaw(Law):
             theta=nom.theta + el["theta"] + rot,
             dtheta=nom.dtheta + el["dtheta"],
         )
-
-
-def states_many(laws, phis) -> list[RimState]:
-    """``[law.state(phi) for law, phi in zip(laws, phis)]`` with one ring-field evaluation per distinct load set.
-
-    The sections and waves of one load state share their loads (only the
-    coning scale and the phase differ), so their elastic fields come from one
-    call of :meth:`Ring.field` over all their angles.
-    """
-    out = [None] * len(laws)
-    groups: dict = {}
-    for k, law in enumerate(laws):
-        if isinstance(law, LoadedLaw):
-            groups.setdefault((id(law.ring), law.psi.tobytes(), law.loads.tobytes()), []).append(k)
-        else:
-            out[k] = law.state(phis[k])
-    for ks in groups.values():
-        law0 = laws[ks[0]]
-        ps = [np.asarray(phis[k], dtype=float) + laws[k].phase for k in ks]
-        f = law0.ring.field(np.concatenate([p.ravel() for p in ps]), law0.psi, law0.loads)
-        at = 0
-        for k, p in zip(ks, ps):
-            n = p.size
-            el = {key: laws[k].scale * v[at:at + n].reshape(p.shape) for key, v in f.items()}
-            at += n
-            phi = np.asarray(phis[k], dtype=float)
-            out[k] = laws[k]._combine(phi, laws[k].section.state(p), el)
-    return out
 
 
 def _unique_eval(fn, arrays):

@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import time
 from dataclasses import dataclass, field
-from math import pi
 
 import numpy as np
 
@@ -15,7 +14,7 @@ from .loaded import LoadedLaw
 from .model import ElasticModel
 from .solve import ContactSolveError, solve_contact_qp
 from .tables import Compliance
-from .teeth import pair_contacts
+from .pairs import GAP_MARGIN, MeasuredPairs
 
 __all__ = ["LoadState", "solve_load", "POSITION_TOL", "RADIAL_MARGIN", "GAP_MARGIN"]
 
@@ -27,15 +26,6 @@ POSITION_TOL = 2e-4
 #: Teeth whose tips stay this far inside the rigid tip circle are left out, mm:
 #: the rim moves by tens of um under rated load; 0.2 mm is four times more.
 RADIAL_MARGIN = 0.2
-#: Flank pairs farther apart than this are left out of the contact problem, mm
-#: (checked again at every re-linearisation on the loaded geometry, so a pair
-#: enters as soon as the rim brings it this close).
-GAP_MARGIN = 0.1
-#: A pair is measured again when its linearised gap is below twice its tooth's motion since the last
-#: measurement plus this, mm (0.5 um). The margin absorbs what the Lipschitz bound leaves out: the
-#: linearisation turns the tooth by theta to first order (its second-order error, lever * dtheta^2 / 2,
-#: stays below 0.01 um for the milliradians of a load state) and round-off.
-REFRESH_MARGIN = 5e-4
 #: Contact forces below this are floored when the Hertz secants are taken, N
 #: (the approach error it leaves is below 1e-5 mm for the balls and teeth of D1).
 FORCE_FLOOR = 1e-2
@@ -147,137 +137,15 @@ def _poses(model: ElasticModel, loads: np.ndarray, rigid):
     return rot, shift, origin, el, cand
 
 
-class _Pairs:
-    """The linearised contacts of every tooth pair (key ``(section z_g + tooth) 2 + flank``), kept between passes.
-
-    A pair is measured again on the exact geometry (the clearance engine)
-    when it is new, or when it could be closing: its linearised gap is less
-    than twice the largest distance any point of its tooth has moved since it
-    was measured, plus REFRESH_MARGIN. Gaps and their linearisations are both
-    1-Lipschitz in the tooth's motion, so a pair that is not measured again
-    is open on the exact geometry too: it carries no force and the contact
-    solution is the one full re-measurement gives (the same iterates).
-    """
-
-    def __init__(self, model: ElasticModel):
-        z_g = model.tables.z_g
-        n = len(model.zs) * z_g * 2
-        self.model = model
-        self.have = np.zeros(n, dtype=bool)
-        self.q_geo = np.zeros(n)  # gap + f b.U + A.rigid at the measurement: the constant part of the linear gap
-        self.gap = np.zeros(n)
-        self.b = np.zeros((n, 3))
-        self.A = np.zeros((n, 3))
-        self.point = np.zeros((n, 2))
-        self.normal = np.zeros((n, 2))
-        self.rigid_tooth = np.zeros(n, dtype=int)
-        self.at_origin = np.zeros((n, 2))
-        self.at_rot = np.zeros(n)
-        loc = model.scene.flex_local - np.array([model.drive.r_m, 0.0])
-        self.lever = float(np.hypot(loc[:, 0], loc[:, 1]).max())
-        self.measured = 0
-
-    def copy(self) -> "_Pairs":
-        new = object.__new__(_Pairs)
-        new.__dict__.update({k: (v.copy() if isinstance(v, np.ndarray) else v) for k, v in self.__dict__.items()})
-        return new
-
-    def linear_gap(self, keys, fU, rigid):
-        """Linearised gap of pairs ``keys`` at the current state (``fU``: scaled elastic ``w, v, theta`` at each pair's tooth)."""
-        return self.q_geo[keys] - (self.b[keys] * fU).sum(axis=1) - self.A[keys] @ rigid
-
-    def _move(self, keys, rot, origin):
-        """Largest motion of any point of each pair's tooth since the pair was measured, mm."""
-        t = keys // 2
-        return np.hypot(*(origin[t] - self.at_origin[keys]).T) + np.abs(rot[t] - self.at_rot[keys]) * self.lever
-
-    def update(self, rot, shift, origin, el, cand, rigid, full: bool = False):
-        """Measure again the pairs of teeth ``cand`` (flat tooth indices) that need it; return the keys within GAP_MARGIN."""
-        m = self.model
-        sec, tooth = np.divmod(cand, m.tables.z_g)
-        keys = np.stack([2 * cand, 2 * cand + 1], axis=1).ravel()  # lower, upper of each tooth
-        fU = np.repeat(m.scales[sec][:, None] * el[:, tooth].T, 2, axis=0)  # (2k, 3)
-        if full:
-            need = np.ones(len(keys), dtype=bool)
-        else:
-            seen = self.have[keys]
-            need = ~seen
-            k0 = keys[seen]
-            move = self._move(k0, rot, origin)
-            lin = self.linear_gap(k0, fU[seen], rigid)
-            # a tooth that has not moved (a warm start's first pass) keeps its exact measurement
-            need[seen] = (lin < 2.0 * move + REFRESH_MARGIN) & (move > 1e-9)
-        self._measure(np.nonzero(need)[0], keys, fU, rot, shift, origin, rigid)
-        lin = self.linear_gap(keys, fU, rigid)
-        return keys[lin < GAP_MARGIN]
-
-    def _measure(self, idx, keys, fU, rot, shift, origin, rigid):
-        """Measure pairs ``keys[idx]`` on the exact geometry at the current poses."""
-        if idx.size == 0:
-            return
-        m = self.model
-        self.measured += idx.size
-        k = keys[idx]
-        t = k // 2
-        lo, up, _ = m.scene.neighbours(shift[t], rot[t])
-        g = pair_contacts(m.scene, rot[t], shift[t], np.where(k % 2 == 0, lo, up))
-        ph = m.tables.angles[t % m.tables.z_g]
-        c, sn = np.cos(ph), np.sin(ph)
-        n, p = g.normal, g.point
-        rel = p - origin[t]
-        b = np.stack([n[:, 0] * c + n[:, 1] * sn, -n[:, 0] * sn + n[:, 1] * c, rel[:, 0] * n[:, 1] - rel[:, 1] * n[:, 0]], axis=-1)
-        A = np.stack([n[:, 0], n[:, 1], p[:, 0] * n[:, 1] - p[:, 1] * n[:, 0]], axis=-1)
-        self.have[k] = True
-        self.gap[k] = g.gap
-        self.b[k], self.A[k], self.point[k], self.normal[k] = b, A, p, n
-        self.rigid_tooth[k] = g.rigid
-        self.q_geo[k] = g.gap + (b * fU[idx]).sum(axis=1) + A @ rigid
-        self.at_origin[k] = origin[t]
-        self.at_rot[k] = rot[t]
-
-    def report(self, rot, shift, origin, el, cand, rigid):
-        """The pairs within GAP_MARGIN at a solved state and their gaps, exact wherever it can matter.
-
-        Measured on the exact geometry: every pair that could be closing (as
-        in :meth:`update`) and then every pair whose linearised gap, less
-        twice its tooth's motion since measured, is below the smallest exact
-        open gap (it could be the smallest clearance). The others are open by
-        more than that and report the linearised gap (``exact`` False).
-
-        Returns
-        -------
-        keys : (k,) int
-        gap : (k,) float, mm
-        exact : (k,) bool
-        """
-        self.update(rot, shift, origin, el, cand, rigid)
-        m = self.model
-        sec, tooth = np.divmod(cand, m.tables.z_g)
-        flat = np.stack([2 * cand, 2 * cand + 1], axis=1).ravel()
-        fU = np.repeat(m.scales[sec][:, None] * el[:, tooth].T, 2, axis=0)
-        while True:
-            lin = self.linear_gap(flat, fU, rigid)
-            move = self._move(flat, rot, origin)
-            exact = move <= 1e-9
-            op = exact & (lin > 0.0)
-            m0 = float(lin[op].min()) if op.any() else np.inf
-            need = (~exact) & (lin - 2.0 * move < max(m0, REFRESH_MARGIN) + REFRESH_MARGIN)
-            if not need.any():
-                break
-            self._measure(np.nonzero(need)[0], flat, fU, rot, shift, origin, rigid)
-        band = lin < GAP_MARGIN
-        return flat[band], np.where(exact, self.gap[flat], lin)[band], exact[band]
-
-
 def _geometry(model: ElasticModel, loads: np.ndarray, rigid):
     """Every tooth pair within GAP_MARGIN measured on the exact geometry at the state ``(loads, rigid)``: keys, gaps, pairs."""
     rot, shift, origin, el, cand = _poses(model, loads, rigid)
-    pairs = _Pairs(model)
+    pairs = MeasuredPairs(model)
     keys = pairs.update(rot, shift, origin, el, cand, rigid, full=True) if cand.size else np.zeros(0, dtype=int)
     return keys, pairs.gap[keys], pairs
 
 
-def _assemble(model: ElasticModel, pairs: _Pairs, keys, el, rigid, e, F_prev_ball, F_prev_teeth):
+def _assemble(model: ElasticModel, pairs: MeasuredPairs, keys, el, rigid, e, F_prev_ball, F_prev_teeth):
     """Vectors of the linearised contact problem (balls first, then the tooth pairs ``keys``): angle index, b, f, A, q, s."""
     br = model.bearing
     tab = model.tables
@@ -373,7 +241,7 @@ def solve_load(model: ElasticModel, torque_nm: float, cam_offset_um: float = 0.0
     else:
         # a cold start's first pass is the nominal state: its pairs are measured once per model
         if "nominal_pairs" not in model.cache:
-            nominal = _Pairs(model)
+            nominal = MeasuredPairs(model)
             rot0, shift0, origin0, el0, cand0 = _poses(model, np.zeros((n_ang, 3)), np.zeros(3))
             nominal.update(rot0, shift0, origin0, el0, cand0, np.zeros(3), full=True)
             model.cache["nominal_pairs"] = nominal
