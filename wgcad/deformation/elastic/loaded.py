@@ -10,7 +10,7 @@ import numpy as np
 from ..laws import Law, RimState
 from .ring import Ring
 
-__all__ = ["LoadedLaw"]
+__all__ = ["LoadedLaw", "displacements_many"]
 
 
 @dataclass(frozen=True)
@@ -87,8 +87,11 @@ class LoadedLaw(Law):
 
     def _state(self, phi: np.ndarray) -> RimState:
         p = phi + self.phase
-        nom = self.section.state(p)
-        el = self.elastic(p)
+        return self._combine(phi, self.section.state(p), self.elastic(p))
+
+    def _combine(self, phi, nom: RimState, el: dict) -> RimState:
+        """The loaded state from the nominal one and the (scaled) elastic field at ``phi + phase``."""
+        p = phi + self.phase
         dx, dy, rot = self.rigid
         c, s = np.cos(p), np.sin(p)
         w_t = dx * c + dy * s
@@ -104,3 +107,65 @@ class LoadedLaw(Law):
             dtheta=nom.dtheta + el["dtheta"],
         )
 
+
+def _unique_eval(fn, arrays):
+    """``[fn(a) for a in arrays]`` for a function of a 1-D array that acts pointwise: one call on the distinct arrays joined."""
+    uniq: dict = {}
+    for a in arrays:
+        uniq.setdefault(a.tobytes(), a)
+    keys = list(uniq)
+    joined = np.concatenate([uniq[k] for k in keys])
+    res = fn(joined)
+    out, at = {}, 0
+    for k in keys:
+        n = uniq[k].size
+        out[k] = tuple(r[at:at + n] for r in res)
+        at += n
+    return [out[a.tobytes()] for a in arrays]
+
+
+def displacements_many(laws, phis) -> list[tuple]:
+    """``w, v, theta`` of each law at its angles ``phis[k]`` (1-D), evaluated together.
+
+    The sections and waves of a load state share their loads and the
+    sections their angles, the levels of a sweep share the nominal section
+    laws: each distinct ring field and nominal state is evaluated once, over
+    all the angles that need it. The figures are those of ``law.state``.
+    """
+    out = [None] * len(laws)
+    loaded = [k for k, law in enumerate(laws) if isinstance(law, LoadedLaw)]
+    for k, law in enumerate(laws):
+        if k not in loaded:
+            st = law.state(phis[k])
+            out[k] = (st.w, st.v, st.theta)
+    ps = {k: np.asarray(phis[k], dtype=float).ravel() + laws[k].phase for k in loaded}
+    el, nom = {}, {}
+    groups: dict = {}
+    for k in loaded:
+        law = laws[k]
+        groups.setdefault((id(law.ring), law.psi.tobytes(), law.loads.tobytes()), []).append(k)
+    for ks in groups.values():
+        law0 = laws[ks[0]]
+        res = _unique_eval(lambda p: law0.ring.displacements(p, law0.psi, law0.loads), [ps[k] for k in ks])
+        el.update(zip(ks, res))
+    sec: dict = {}
+    for k in loaded:
+        sec.setdefault(id(laws[k].section), []).append(k)
+    for ks in sec.values():
+        section = laws[ks[0]].section
+
+        def nominal(p, section=section):
+            st = section.state(p)
+            return st.w, st.v, st.theta
+
+        nom.update(zip(ks, _unique_eval(nominal, [ps[k] for k in ks])))
+    for k in loaded:
+        law = laws[k]
+        p = ps[k]
+        (nw, nv, nth), (ew, ev, eth) = nom[k], el[k]
+        dx, dy, rot = law.rigid
+        c, s = np.cos(p), np.sin(p)
+        out[k] = (nw + law.scale * ew + dx * c + dy * s - rot * nv,
+                  nv + law.scale * ev - dx * s + dy * c + rot * (law.r_m + nw),
+                  nth + law.scale * eth + rot)
+    return out

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from math import pi
 
 import numpy as np
@@ -13,6 +13,7 @@ from wgcad.errors import DesignError
 
 from .bearing import FlexibleBearing, ball_contact
 from .ring import Ring
+from .tables import RingTables, ring_tables
 from .teeth import ToothCompliance
 
 __all__ = ["ElasticModel", "build_model"]
@@ -43,6 +44,8 @@ class ElasticModel:
         +1 when the load torque on the flexspline is counter-clockwise (working flank ``upper``).
     ei_parts : dict
         The bending-stiffness contributions, N mm^2 (reported).
+    tables : RingTables
+        The ring's influence and the nominal rim at the tooth and ball angles (what every solver pass reads).
     """
 
     drive: object
@@ -56,9 +59,16 @@ class ElasticModel:
     cup_stiffness: float
     torque_sign: float
     ei_parts: dict
+    tables: RingTables
+    #: results reused between load states of this model (the tooth pairs measured at the nominal state)
+    cache: dict = field(default_factory=dict, repr=False, compare=False)
 
     def section_law(self, i: int):
-        return self.drive.law_at(float(self.zs[i])) if self.drive.coned else self.drive.law
+        """Nominal law of section ``i`` (one object per section, so loaded states can share its evaluations)."""
+        key = ("section_law", i)
+        if key not in self.cache:
+            self.cache[key] = self.drive.law_at(float(self.zs[i])) if self.drive.coned else self.drive.law
+        return self.cache[key]
 
 
 def _coning(drive):
@@ -138,5 +148,7 @@ def build_model(drive, sections: int = 3) -> ElasticModel:
     teeth = ToothCompliance(E, mat.poisson, 0.5 * pi * d.drive.module, flex.r_f, drive.rigid.r_f)
     r_c = drive.flex_rim_radius + 0.5 * t_cup
     k_cup = G * 2.0 * pi * r_c**3 * t_cup / cup_len if cup_len > 0 else float("inf")
+    laws = [drive.law_at(float(z)) if drive.coned else drive.law for z in zs]
+    tables = ring_tables(ring, d.drive.z_flex, psi, laws, drive.law)
     return ElasticModel(drive, scene, ring, bearing, teeth, zs, widths, np.asarray(f_of(zs), dtype=float),
-                        float(k_cup), 1.0 if scene.working == "upper" else -1.0, parts)
+                        float(k_cup), 1.0 if scene.working == "upper" else -1.0, parts, tables)

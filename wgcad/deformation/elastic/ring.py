@@ -177,6 +177,19 @@ class Ring:
             out[..., 2, j] = (v + d2) / self.r  # theta = (v + v'')/r
         return out
 
+    def displacements(self, phi, psi, loads):
+        """``w, v, theta`` at ``phi`` due to generalized loads at ``psi`` (:meth:`field` without the derivatives), three (K,) arrays."""
+        phi = np.atleast_1d(np.asarray(phi, dtype=float))
+        psi = np.atleast_1d(np.asarray(psi, dtype=float))
+        loads = np.asarray(loads, dtype=float).reshape(len(psi), 3)
+        x = phi[:, None] - psi[None, :]
+        d = [np.zeros(len(phi)) for _ in range(3)]
+        for j, vf in enumerate(self._vfields(x, 0)):
+            for i in range(3):
+                d[i] += vf[i] @ loads[:, j]
+        v, v1, v2 = d
+        return -v1, v, (v + v2) / self.r
+
     def field(self, phi, psi, loads):
         """Neutral-line state at ``phi`` due to generalized loads at ``psi``.
 

@@ -44,17 +44,35 @@ class QPSolution:
     equilibrium: float
 
 
+class _Dense:
+    """A dense matrix seen through the column interface the solver uses (``cols``, ``diag``)."""
+
+    def __init__(self, M):
+        self.M = np.asarray(M, dtype=float)
+        self.diag = np.diag(self.M)
+        self.shape = self.M.shape
+
+    def cols(self, W):
+        return self.M[:, W]
+
+
+def _gap(M, q, A, F, a, W):
+    """``q + M F - A a`` for ``F`` supported on ``W``."""
+    return q + M.cols(W) @ F[W] - A @ a
+
+
 def _kkt(M, q, A, f, W):
     """Solve the equality-constrained system on the active set ``W``; least-norm multipliers when rank-deficient."""
     m, r = A.shape
     F = np.zeros(m)
     if W.size == 0:
         return F, np.zeros(r)
-    Mw = M[np.ix_(W, W)]
+    Mw = M.cols(W)[W]
     Aw = A[W]
-    cf = cho_factor(Mw)
-    y_q = cho_solve(cf, q[W])
-    y_A = cho_solve(cf, Aw)
+    # inputs are finite by construction (geometry and compliances checked where they are made)
+    cf = cho_factor(Mw, check_finite=False)
+    y = cho_solve(cf, np.column_stack([q[W], Aw]), check_finite=False)
+    y_q, y_A = y[:, 0], y[:, 1:]
     S = Aw.T @ y_A
     rhs = f + Aw.T @ y_q
     # S = A_W' M_WW^-1 A_W: singular when the active contacts cannot hold a rigid-body motion
@@ -75,7 +93,8 @@ def solve_contact_qp(M, q, A, f, active=None, tol_gap: float = 1e-12, max_iter: 
 
     Parameters
     ----------
-    M : (m, m) float
+    M : (m, m) float, or an object with ``cols(W)`` (the columns ``M[:, W]``), ``diag`` and ``shape``
+        (a compliance built column by column, :class:`~wgcad.deformation.elastic.tables.Compliance`).
     q : (m,) float
     A : (m, r) float
     f : (r,) float
@@ -90,24 +109,24 @@ def solve_contact_qp(M, q, A, f, active=None, tol_gap: float = 1e-12, max_iter: 
         No convergence in ``max_iter`` pivots, or the equalities cannot be met
         by any set of contacts (e.g. a torque and no tooth that can carry it).
     """
-    M = np.asarray(M, dtype=float)
+    M = M if hasattr(M, "cols") else _Dense(M)
     q = np.asarray(q, dtype=float)
     A = np.asarray(A, dtype=float)
     f = np.asarray(f, dtype=float)
     m = len(q)
     act = (q < 0.0) if active is None else np.asarray(active, dtype=bool).copy()
-    tol_F = tol_gap / max(float(np.abs(np.diag(M)).max()) if m else 1.0, 1e-300)
+    tol_F = tol_gap / max(float(np.abs(M.diag).max()) if m else 1.0, 1e-300)
     best, p_left = m + 1, 3
     for it in range(max_iter):
         W = np.nonzero(act)[0]
         F, a = _kkt(M, q, A, f, W)
-        gap = q + M @ F - A @ a
+        gap = _gap(M, q, A, F, a, W)
         bad_F = act & (F < -tol_F)
         bad_g = ~act & (gap < -tol_gap)
         n_bad = int(bad_F.sum() + bad_g.sum())
         if n_bad == 0:
             F = np.where(act, np.maximum(F, 0.0), 0.0)
-            gap = q + M @ F - A @ a
+            gap = _gap(M, q, A, F, a, W)
             return _finish(M, q, A, f, F, a, gap, it, tol_gap)
         if n_bad < best:
             best, p_left = n_bad, 3

@@ -4,17 +4,17 @@ from __future__ import annotations
 
 import time
 from dataclasses import dataclass, field
-from math import pi
 
 import numpy as np
 
 from wgcad.errors import DesignError
-from wgcad.placement import tooth_pose, transform
+from wgcad.placement import pose_from_displacements, transform
 
 from .loaded import LoadedLaw
 from .model import ElasticModel
 from .solve import ContactSolveError, solve_contact_qp
-from .teeth import flank_contacts
+from .tables import Compliance
+from .pairs import GAP_MARGIN, MeasuredPairs
 
 __all__ = ["LoadState", "solve_load", "POSITION_TOL", "RADIAL_MARGIN", "GAP_MARGIN"]
 
@@ -26,14 +26,18 @@ POSITION_TOL = 2e-4
 #: Teeth whose tips stay this far inside the rigid tip circle are left out, mm:
 #: the rim moves by tens of um under rated load; 0.2 mm is four times more.
 RADIAL_MARGIN = 0.2
-#: Flank pairs farther apart than this are left out of the contact problem, mm
-#: (checked again at every re-linearisation on the loaded geometry, so a pair
-#: enters as soon as the rim brings it this close).
-GAP_MARGIN = 0.1
 #: Contact forces below this are floored when the Hertz secants are taken, N
 #: (the approach error it leaves is below 1e-5 mm for the balls and teeth of D1).
 FORCE_FLOOR = 1e-2
 _MAX_LINEARISATIONS = 100
+#: Smallest relaxation of a cycling re-linearisation: its steps shrink to this share of the plain step.
+_OMEGA_MIN = 1.0 / 64.0
+#: Solutions the re-linearisation's Anderson acceleration combines (0: plain fixed-point iteration).
+ANDERSON_DEPTH = 3
+#: The acceleration starts once the teeth move less than this per pass, mm: before, contact sets change.
+ANDERSON_START = 0.02
+_LEVER = 2.0  # mm, a tooth's lever: weighs ring couples against forces in the acceleration's metric
+_KREF = 1e5  # N/mm, a contact stiffness: weighs rim motions against forces there
 _TRACE = None  # a list to record (pass, change, relaxation, pairs, loaded contacts) while debugging
 
 
@@ -52,7 +56,9 @@ class LoadState:
         Rim translation ``dx, dy`` (mm) and rotation (rad, counter-clockwise) relative to the rigid gear.
     contacts : dict of arrays
         ``kind`` (0 ball, 1 tooth), ``section``, ``tooth``, ``flank`` (0 lower, 1 upper, -1 ball),
-        ``phi`` (rad), ``force`` (N), ``gap`` (exact geometric gap at the solution, mm),
+        ``phi`` (rad), ``force`` (N), ``gap`` (geometric gap at the solution, mm: exact, from the
+        clearance engine, for every pair that carries load or could hold the smallest clearance, ``gap_exact``;
+        the others are open wider and report their linearised gap),
         ``approach`` (contact compliance's share, mm), ``point`` (K, 2).
     residuals : dict
         ``equilibrium`` (relative), ``complementarity`` (relative), ``linearisation_mm``
@@ -69,6 +75,8 @@ class LoadState:
     contacts: dict
     residuals: dict
     timing: dict = field(default_factory=dict)
+    #: the tooth pairs measured on the exact geometry at this state (a warm start's first pass reuses them)
+    pairs: object = field(default=None, repr=False, compare=False)
 
     @property
     def mesh_wind_up(self) -> float:
@@ -90,72 +98,76 @@ def _cam_offset(e_um: float, e_deg: float) -> np.ndarray:
     return np.array([e * np.cos(a), e * np.sin(a)])
 
 
-def _tooth_candidates(model: ElasticModel, law, phi):
-    """Poses of teeth at ``phi`` and the mask of those whose tips reach within RADIAL_MARGIN of the rigid tips."""
-    rot, shift = tooth_pose(law, phi, model.drive.r_m)
+def _rim(model: ElasticModel, loads: np.ndarray, rigid) -> tuple:
+    """``w, v, theta`` ``(S, z_g)`` of every section at the tooth angles, and the elastic field ``(3, z_g)`` (centre scale).
+
+    The formula of :class:`LoadedLaw` (nominal law + scaled ring field +
+    rigid-body motion) on the model's tables: the same numbers, without the
+    kernel evaluations.
+    """
+    tab = model.tables
+    el = tab.tooth_field(loads)
+    phi = tab.angles[: tab.z_g]
+    c, sn = np.cos(phi), np.sin(phi)
+    dx, dy, rot = (float(x) for x in rigid)
+    nom = tab.nominal
+    f = model.scales[:, None]
+    w = nom[:, 0] + f * el[0] + (dx * c + dy * sn) - rot * nom[:, 1]
+    v = nom[:, 1] + f * el[1] + (-dx * sn + dy * c) + rot * (model.drive.r_m + nom[:, 0])
+    th = nom[:, 2] + f * el[2] + rot
+    return w, v, th, el
+
+
+def _poses(model: ElasticModel, loads: np.ndarray, rigid):
+    """Poses of every tooth of every section (flattened ``section * z_g + tooth``), their neutral-line origins and
+    the elastic field, plus the indices of the teeth whose tips reach within RADIAL_MARGIN of the rigid tips."""
+    d = model.drive
+    z_g = model.tables.z_g
+    S = len(model.zs)
+    w, v, th, el = _rim(model, loads, rigid)
+    phi = np.broadcast_to(model.tables.angles[:z_g], (S, z_g))
+    rot, shift = pose_from_displacements(phi, w, v, th, d.r_m)
+    rot, shift = rot.ravel(), shift.reshape(-1, 2)
+    c, sn = np.cos(phi).ravel(), np.sin(phi).ravel()
+    w, v = w.ravel(), v.ravel()
+    origin = np.stack([(d.r_m + w) * c - v * sn, (d.r_m + w) * sn + v * c], axis=-1)
     tips = transform(model.scene.flex_tip_local, rot, shift)
     R = np.hypot(tips[..., 0], tips[..., 1]).max(axis=1)
-    return rot, shift, R >= model.scene.r_tip_b - RADIAL_MARGIN
+    cand = np.nonzero(R >= model.scene.r_tip_b - RADIAL_MARGIN)[0]
+    return rot, shift, origin, el, cand
 
 
-def _geometry(model: ElasticModel, laws, psi, loads, rigid):
-    """Tooth contacts of the current state, linearised: arrays for every pair within GAP_MARGIN."""
-    d = model.drive
-    z_g = d.design.drive.z_flex
-    phi_all = 2.0 * pi * np.arange(z_g) / z_g
-    phi_all = np.where(phi_all > pi, phi_all - 2.0 * pi, phi_all)
-    rows = []
-    for s, law in enumerate(laws):
-        rot, shift, cand = _tooth_candidates(model, law, phi_all)
-        idx = np.nonzero(cand)[0]
-        if idx.size == 0:
-            continue
-        geo = flank_contacts(model.scene, rot[idx], shift[idx])
-        st = law.state(phi_all[idx])
-        c, sn = np.cos(phi_all[idx]), np.sin(phi_all[idx])
-        o = np.stack([(d.r_m + st.w) * c - st.v * sn, (d.r_m + st.w) * sn + st.v * c], axis=-1)
-        for fl, key in enumerate(("lower", "upper")):
-            g = geo[key]
-            keep = g.gap < GAP_MARGIN
-            if not keep.any():
-                continue
-            rows.append(dict(section=np.full(keep.sum(), s), tooth=idx[keep], flank=np.full(keep.sum(), fl),
-                             phi=phi_all[idx][keep], gap=g.gap[keep], point=g.point[keep], normal=g.normal[keep],
-                             origin=o[keep], rigid_tooth=g.rigid[keep]))
-    if not rows:
-        return None
-    return {k: np.concatenate([r[k] for r in rows]) for k in rows[0]}
+def _geometry(model: ElasticModel, loads: np.ndarray, rigid):
+    """Every tooth pair within GAP_MARGIN measured on the exact geometry at the state ``(loads, rigid)``: keys, gaps, pairs."""
+    rot, shift, origin, el, cand = _poses(model, loads, rigid)
+    pairs = MeasuredPairs(model)
+    keys = pairs.update(rot, shift, origin, el, cand, rigid, full=True) if cand.size else np.zeros(0, dtype=int)
+    return keys, pairs.gap[keys], pairs
 
 
-def _assemble(model: ElasticModel, geo, psi, loads, rigid, e, F_prev_ball, F_prev_teeth, laws):
-    """Vectors and matrices of the linearised contact problem (balls first, then teeth)."""
-    ring, br = model.ring, model.bearing
+def _assemble(model: ElasticModel, pairs: MeasuredPairs, keys, el, rigid, e, F_prev_ball, F_prev_teeth):
+    """Vectors of the linearised contact problem (balls first, then the tooth pairs ``keys``): angle index, b, f, A, q, s."""
+    br = model.bearing
+    tab = model.tables
     Z = len(br.psi)
     # balls: b = (-1, 0, 0) at psi_i, A = (-cos, -sin, v_nom), q = clearance - e . e_r (exact: linear in the state)
-    centre = laws[0].centre
-    v_nom = centre.state(br.psi).v
+    v_nom = tab.centre_ball[1]
     cb, sb = np.cos(br.psi), np.sin(br.psi)
-    phi_b = br.psi
+    idx_b = tab.z_g + np.arange(Z)
     b_b = np.tile([-1.0, 0.0, 0.0], (Z, 1))
     A_b = np.stack([-cb, -sb, v_nom], axis=-1)
     o_b, s_b = br.tangent(F_prev_ball, FORCE_FLOOR)
     q_b = br.clearance - (e[0] * cb + e[1] * sb) + o_b
-    if geo is None:
-        return phi_b, b_b, np.ones(Z), A_b, q_b, s_b
-    n, p, o, phi = geo["normal"], geo["point"], geo["origin"], geo["phi"]
-    c, sn = np.cos(phi), np.sin(phi)
-    rel = p - o
-    b_t = np.stack([n[:, 0] * c + n[:, 1] * sn, -n[:, 0] * sn + n[:, 1] * c, rel[:, 0] * n[:, 1] - rel[:, 1] * n[:, 0]], axis=-1)
-    f_t = model.scales[geo["section"]]
-    A_t = np.stack([n[:, 0], n[:, 1], p[:, 0] * n[:, 1] - p[:, 1] * n[:, 0]], axis=-1)
-    U = ring.field(phi, psi, loads)
-    Uv = np.stack([U["w"], U["v"], U["theta"]], axis=-1)
-    width = model.widths[geo["section"]]
+    if len(keys) == 0:
+        return idx_b, b_b, np.ones(Z), A_b, q_b, s_b
+    sec, tooth = np.divmod(keys // 2, tab.z_g)
+    f_t = model.scales[sec]
+    width = model.widths[sec]
     o_t, s_t = model.teeth.tangent(F_prev_teeth, width, FORCE_FLOOR)
-    s_t = s_t + model.teeth.bending(p, n, width)
-    q_t = geo["gap"] + f_t * (b_t * Uv).sum(axis=1) + A_t @ rigid + o_t
-    return (np.concatenate([phi_b, phi]), np.concatenate([b_b, b_t]), np.concatenate([np.ones(Z), f_t]),
-            np.concatenate([A_b, A_t]), np.concatenate([q_b, q_t]), np.concatenate([s_b, s_t]))
+    s_t = s_t + model.teeth.bending(pairs.point[keys], pairs.normal[keys], width)
+    q_t = pairs.q_geo[keys] + o_t
+    return (np.concatenate([idx_b, tooth]), np.concatenate([b_b, pairs.b[keys]]), np.concatenate([np.ones(Z), f_t]),
+            np.concatenate([A_b, pairs.A[keys]]), np.concatenate([q_b, q_t]), np.concatenate([s_b, s_t]))
 
 
 def _merge_loads(phi, loads):
@@ -167,14 +179,11 @@ def _merge_loads(phi, loads):
     return u, out
 
 
-def _compliance(ring, phi, b, f):
-    """``D_jl = f_j f_l b_j' C(phi_j - phi_l) b_l`` through the distinct contact angles."""
-    u, inv = np.unique(np.round(phi, 15), return_inverse=True)
-    K = ring.block(u[:, None] - u[None, :])  # (n, n, 3, 3)
-    fb = b * f[:, None]
-    # contract the source side first (3 nonzeros per contact), then gather the observer side
-    T = np.einsum("ulab,lb->ula", K[:, inv], fb)  # (n, m, 3)
-    return np.einsum("ja,jla->jl", fb, T[inv])
+def _dense_loads(n: int, idx, F, f, b) -> np.ndarray:
+    """Generalized loads ``(n, 3)`` on the ring at the table's angles from contact forces ``F`` (N)."""
+    out = np.zeros((n, 3))
+    np.add.at(out, idx, -(F * f)[:, None] * b)
+    return out
 
 
 def solve_load(model: ElasticModel, torque_nm: float, cam_offset_um: float = 0.0, cam_offset_deg: float = 0.0,
@@ -207,44 +216,51 @@ def solve_load(model: ElasticModel, torque_nm: float, cam_offset_um: float = 0.0
     e = _cam_offset(cam_offset_um, cam_offset_deg)
     M_rim = model.torque_sign * 1e3 * torque_nm
     f_ext = np.array([0.0, 0.0, M_rim])
+    tab = model.tables
+    n_ang = len(tab.angles)
     Z = len(model.bearing.psi)
-    psi = np.zeros(0)
-    loads = np.zeros((0, 3))
+    n_keys = len(model.zs) * tab.z_g * 2
+    loads = np.zeros((n_ang, 3))
     rigid = np.zeros(3)
     F_ball = np.zeros(Z)
-    prev_active = {}
-    F_teeth_prev = {}
+    prev_active = np.zeros(n_keys, dtype=bool)
+    F_teeth_prev = np.zeros(n_keys)
     if warm is not None:
-        psi, loads, rigid = warm.laws[0].psi.copy(), warm.laws[0].loads.copy(), np.array(warm.rigid)
+        loads, rigid = _loads_on_table(tab, warm.laws[0].psi, warm.laws[0].loads), np.array(warm.rigid)
         F_ball = warm.contacts["force"][warm.contacts["kind"] == 0].copy()
     centre = model.drive.law
     t_geo = t_sol = 0.0
-    prev_pos = None
     pivots = 0
-    omega, last_change, prev_omega = 1.0, np.inf, 1.0
+    omega, last_change = 1.0, np.inf
+    acc = _Anderson(model.drive.r_m, ANDERSON_DEPTH)
     settled, relaxed = 0, False
+    change = 0.0
+    # a warm start's pairs were measured at exactly its state: the first pass measures only what moves
+    if warm is not None and warm.pairs is not None and warm.pairs.model is model:
+        pairs = warm.pairs.copy()
+    else:
+        # a cold start's first pass is the nominal state: its pairs are measured once per model
+        if "nominal_pairs" not in model.cache:
+            nominal = MeasuredPairs(model)
+            rot0, shift0, origin0, el0, cand0 = _poses(model, np.zeros((n_ang, 3)), np.zeros(3))
+            nominal.update(rot0, shift0, origin0, el0, cand0, np.zeros(3), full=True)
+            model.cache["nominal_pairs"] = nominal
+        pairs = model.cache["nominal_pairs"].copy()
     for it in range(_MAX_LINEARISATIONS):
         t0 = time.perf_counter()
-        laws = [LoadedLaw(centre, model.section_law(i), model.ring, psi, loads, model.scales[i], tuple(rigid))
-                for i in range(len(model.zs))]
-        geo = _geometry(model, laws, psi, loads, rigid)
-        if geo is None and torque_nm > 0:
+        rot, shift, origin, el, cand = _poses(model, loads, rigid)
+        if cand.size == 0 and torque_nm > 0:
             raise DesignError("generator.w0_coef", "the flexspline teeth never reach the rigid teeth (no tooth tip within "
                               f"{RADIAL_MARGIN:g} mm of the rigid tip circle): no torque can be carried")
-        keys = [] if geo is None else list(zip(geo["section"].tolist(), geo["tooth"].tolist(), geo["flank"].tolist()))
-        F_t_prev = np.array([F_teeth_prev.get(k, 0.0) for k in keys])
-        # tooth positions (the carried poses of the engaging teeth) for the convergence test
-        pos = {} if geo is None else {k: o for k, o in zip(keys, geo["origin"])}
-        rigid_pos = float(rigid[2])
+        keys = pairs.update(rot, shift, origin, el, cand, rigid) if cand.size else np.zeros(0, dtype=int)
         t1 = time.perf_counter()
-        phi_c, b, f, A, q, s = _assemble(model, geo, psi, loads, rigid, e, F_ball, F_t_prev, laws)
-        M = _compliance(model.ring, phi_c, b, f)
-        M[np.diag_indices_from(M)] += s
-        active = np.concatenate([F_ball > 0, np.array([prev_active.get(k, False) for k in keys], dtype=bool)])
+        idx, b, f, A, q, s_c = _assemble(model, pairs, keys, el, rigid, e, F_ball, F_teeth_prev[keys])
+        M = Compliance(tab, idx, b * f[:, None], s_c)
+        active = np.concatenate([F_ball > 0, prev_active[keys]])
         try:
             sol = solve_contact_qp(M, q, A, f_ext, active=active if it else None)
         except ContactSolveError as exc:
-            if torque_nm > 0 and geo is not None and "balance" in str(exc):
+            if torque_nm > 0 and len(keys) and "balance" in str(exc):
                 raise DesignError("generator.w0_coef", f"no set of tooth contacts can carry {torque_nm:g} N m: the teeth never meet "
                                   "on the working flanks") from None
             raise
@@ -252,70 +268,78 @@ def solve_load(model: ElasticModel, torque_nm: float, cam_offset_um: float = 0.0
         t_sol += time.perf_counter() - t1
         t_geo += t1 - t0
         F = sol.F
-        last = (geo, keys, F, sol, phi_c, b, f, A)
-        omega_used = omega
+        last = (keys, F, sol, idx, b, f, pairs.point[keys], pairs.normal[keys])
         # under-relaxed update once the plain iteration stops contracting: the exact gaps are piecewise
         # smooth in the poses (polygon vertices), which can leave a 2-cycle of sub-micrometre amplitude
-        psi_new, loads_new = _merge_loads(phi_c, -(F * f)[:, None] * b)
-        F_t_new = {k: float(x) for k, x in zip(keys, F[Z:])}
+        loads_new = _dense_loads(n_ang, idx, F, f, b)
+        F_t_new = np.zeros(n_keys)
+        F_t_new[keys] = F[Z:]
+        # convergence: the largest move of an engaging tooth from the linearisation's poses to the solution's
+        # (the fixed-point residual itself, from the tables: no engine call)
+        o_new = _origins(model, loads_new, sol.a)
+        k2 = keys // 2
+        d = np.hypot(*(o_new[k2] - origin[k2]).T)
+        change = max(float(d.max()) if d.size else 0.0, abs(float(sol.a[2] - rigid[2])) * model.drive.r_m)
+        if _TRACE is not None:
+            _TRACE.append((it, change, omega, len(keys), int((F > 0).sum())))
+        if change < tol:
+            break
+        # a contact toggling between passes (a linearisation that closes a pair the exact geometry
+        # opens) has no fixed point: the relaxed passes settle where it switches; the residual of the
+        # nonlinear contact law on the exact geometry is then reported (linearisation_mm)
+        settled = settled + 1 if (omega < 1.0 and change * omega < 0.25 * tol) else 0
+        if settled >= 3:
+            relaxed = True
+            break
+        if it >= 5 and change > 0.95 * last_change:  # a cycle, not a slow contraction
+            omega = max(omega * 0.5, _OMEGA_MIN)
+            acc.reset()
+        last_change = change
         if omega < 1.0:
-            psi, loads = _merge_loads(np.concatenate([psi, psi_new]), np.concatenate([(1 - omega) * loads, omega * loads_new]))
+            loads = (1 - omega) * loads + omega * loads_new
             rigid = (1 - omega) * rigid + omega * sol.a
             F_ball = (1 - omega) * F_ball + omega * F[:Z]
-            F_teeth_prev = {k: (1 - omega) * F_teeth_prev.get(k, 0.0) + omega * F_t_new.get(k, 0.0) for k in set(F_t_new) | set(F_teeth_prev)}
+            F_teeth_prev = (1 - omega) * F_teeth_prev + omega * F_t_new
         else:
-            psi, loads, rigid = psi_new, loads_new, sol.a.copy()
+            loads, rigid = acc.step(loads, rigid, loads_new, sol.a, change)
             F_ball = F[:Z].copy()
             F_teeth_prev = F_t_new
-        prev_active = {k: bool(x > 0) for k, x in zip(keys, F[Z:])}
-        # convergence: largest move of an engaging tooth between two passes
-        if prev_pos is not None:
-            common = [k for k in pos if k in prev_pos]
-            change = max((float(np.hypot(*(pos[k] - prev_pos[k]))) for k in common), default=0.0)
-            # the step the plain iteration takes (a relaxed step is omega times it)
-            change = max(change, abs(rigid_pos - prev_rigid) * model.drive.r_m) / prev_omega
-            if _TRACE is not None:
-                _TRACE.append((it, change, omega, len(pos), int((F > 0).sum())))
-            # pairs entering or leaving the GAP_MARGIN band carry no load: not part of the test
-            if change < tol:
-                break
-            # a contact toggling between passes (a linearisation that closes a pair the exact geometry
-            # opens) has no fixed point: the relaxed passes settle where it switches; the residual of the
-            # nonlinear contact law on the exact geometry is then reported (linearisation_mm)
-            settled = settled + 1 if (omega < 1.0 and change * prev_omega < 0.25 * tol) else 0
-            if settled >= 3:
-                relaxed = True
-                break
-            if it >= 5 and change > 0.95 * last_change:  # a cycle, not a slow contraction
-                omega = max(omega * 0.5, 1.0 / 16.0)
-            last_change = change
-        prev_pos, prev_rigid, prev_omega = pos, rigid_pos, omega_used
+        prev_active = np.zeros(n_keys, dtype=bool)
+        prev_active[keys] = F[Z:] > 0
     else:
         raise ContactSolveError(f"load state at {torque_nm:g} N m: tooth positions still moving after {_MAX_LINEARISATIONS} re-linearisations")
     # the reported state is the last contact solution itself (not a relaxed mixture): its forces, points and
     # normals are in equilibrium to round-off; the exact gaps are then measured on the final poses
-    geo, keys, F, sol, phi_c, b, f, A = last
-    psi, loads = _merge_loads(phi_c, -(F * f)[:, None] * b)
+    keys, F, sol, idx, b, f, point, normal = last
+    loads = _dense_loads(n_ang, idx, F, f, b)
     rigid = sol.a.copy()
     F_ball, Ft = F[:Z], F[Z:]
     model.bearing.check(F_ball)
     t0 = time.perf_counter()
-    laws = [LoadedLaw(centre, model.section_law(i), model.ring, psi, loads, model.scales[i], tuple(rigid))
-            for i in range(len(model.zs))]
-    geo2 = _geometry(model, laws, psi, loads, rigid)
+    pairs2 = pairs.copy()
+    keys2, gaps2, exact2 = pairs2.report(*_poses(model, loads, rigid), rigid)
     t_geo += time.perf_counter() - t0
+    psi, law_loads = _merge_loads(tab.angles, loads)
+    laws = [LoadedLaw(centre, model.section_law(i), model.ring, psi, law_loads, model.scales[i], tuple(rigid))
+            for i in range(len(model.zs))]
     n_t = len(keys)
-    exact = {} if geo2 is None else dict(zip(zip(geo2["section"].tolist(), geo2["tooth"].tolist(), geo2["flank"].tolist()), geo2["gap"]))
+    sec_t, tooth_t = np.divmod(keys // 2, tab.z_g)
     if n_t:
-        width = model.widths[geo["section"]]
-        appr_t = model.teeth.bending(geo["point"], geo["normal"], width) * Ft + model.teeth.hertz(Ft, width)
+        width = model.widths[sec_t]
+        appr_t = model.teeth.bending(point, normal, width) * Ft + model.teeth.hertz(Ft, width)
         # a pair that left the GAP_MARGIN band on the final poses is open by at least that much
-        gap_t = np.array([exact.get(k, GAP_MARGIN) for k in keys])
+        final = np.full(n_keys, GAP_MARGIN)
+        final[keys2] = gaps2
+        gap_t = final[keys]
+        is_exact = np.zeros(n_keys, dtype=bool)
+        is_exact[keys2] = exact2
+        exact_t = is_exact[keys]
     else:
         appr_t = gap_t = np.zeros(0)
+        exact_t = np.zeros(0, dtype=bool)
     cb, sb = np.cos(model.bearing.psi), np.sin(model.bearing.psi)
-    v_nom = centre.state(model.bearing.psi)
-    wb = model.ring.field(model.bearing.psi, psi, loads)["w"] + rigid[0] * cb + rigid[1] * sb - rigid[2] * v_nom.v
+    w_nom, v_nom = tab.centre_ball
+    wb = (tab.influence[3 * tab.z_g :: 3] @ loads.ravel()) + rigid[0] * cb + rigid[1] * sb - rigid[2] * v_nom
     gap_b = model.bearing.clearance - (e[0] * cb + e[1] * sb) + wb
     appr_b = model.bearing.approach(F_ball)
     # exact complementarity of the nonlinear contacts: gap + approach >= 0, F >= 0, F (gap + approach) = 0
@@ -323,20 +347,21 @@ def solve_load(model: ElasticModel, torque_nm: float, cam_offset_um: float = 0.0
     F_all = np.concatenate([F_ball, Ft])
     loaded = F_all > 0
     lin = float(np.abs(g_all[loaded]).max()) if loaded.any() else 0.0
-    r_b = centre.r_m + v_nom.w
-    ball_pt = np.stack([r_b * cb - v_nom.v * sb, r_b * sb + v_nom.v * cb], axis=-1)
+    r_b = centre.r_m + w_nom
+    ball_pt = np.stack([r_b * cb - v_nom * sb, r_b * sb + v_nom * cb], axis=-1)
     empty2 = np.zeros((0, 2))
     contacts = {
         "kind": np.concatenate([np.zeros(Z, int), np.ones(n_t, int)]),
-        "section": np.concatenate([np.zeros(Z, int), geo["section"] if n_t else np.zeros(0, int)]),
-        "tooth": np.concatenate([np.full(Z, -1), geo["tooth"] if n_t else np.zeros(0, int)]),
-        "flank": np.concatenate([np.full(Z, -1), geo["flank"] if n_t else np.zeros(0, int)]),
-        "phi": np.concatenate([model.bearing.psi, geo["phi"] if n_t else np.zeros(0)]),
+        "section": np.concatenate([np.zeros(Z, int), sec_t]),
+        "tooth": np.concatenate([np.full(Z, -1), tooth_t]),
+        "flank": np.concatenate([np.full(Z, -1), keys % 2]),
+        "phi": np.concatenate([model.bearing.psi, tab.angles[tooth_t]]),
         "force": F_all,
         "gap": np.concatenate([gap_b, gap_t]),
+        "gap_exact": np.concatenate([np.ones(Z, dtype=bool), exact_t]),
         "approach": np.concatenate([appr_b, appr_t]),
-        "point": np.concatenate([ball_pt, geo["point"] if n_t else empty2]),
-        "normal": np.concatenate([-np.stack([cb, sb], axis=-1), geo["normal"] if n_t else empty2]),
+        "point": np.concatenate([ball_pt, point if n_t else empty2]),
+        "normal": np.concatenate([-np.stack([cb, sb], axis=-1), normal if n_t else empty2]),
     }
     residuals = {
         "equilibrium": sol.equilibrium,
@@ -345,7 +370,75 @@ def solve_load(model: ElasticModel, torque_nm: float, cam_offset_um: float = 0.0
         "min_gap_plus_approach_mm": float(g_all.min()) if g_all.size else 0.0,
         "iterations": it + 1,
         "pivots": pivots,
-        "position_change_mm": change if prev_pos is not None and it else 0.0,
+        "position_change_mm": change,
         "settled_by_relaxation": relaxed,
     }
-    return LoadState(model, float(torque_nm), e, laws, rigid, contacts, residuals, {"geometry": t_geo, "solver": t_sol})
+    return LoadState(model, float(torque_nm), e, laws, rigid, contacts, residuals, {"geometry": t_geo, "solver": t_sol}, pairs2)
+
+
+def _origins(model: ElasticModel, loads: np.ndarray, rigid) -> np.ndarray:
+    """Neutral-line origins ``(S z_g, 2)`` of every tooth of every section (flattened as in :func:`_poses`)."""
+    w, v, _, _ = _rim(model, loads, rigid)
+    phi = model.tables.angles[: model.tables.z_g]
+    c, sn = np.cos(phi), np.sin(phi)
+    r = model.drive.r_m + w
+    return np.stack([r * c - v * sn, r * sn + v * c], axis=-1).reshape(-1, 2)
+
+
+class _Anderson:
+    """Anderson acceleration of the re-linearisation (type II, Walker & Ni 2011) on the ring loads and rim motion.
+
+    The next linearisation point is the affine combination of the last
+    solutions that best cancels their residuals (solution minus
+    linearisation point), so it balances the torque as each of them does.
+    Forces weigh in N, couples per ``_LEVER`` mm, motions times ``_KREF``
+    N/mm (a contact stiffness): the least-squares metric only. The history is
+    dropped when a step does not lower the residual (a change of contact set).
+    """
+
+    def __init__(self, r_m: float, depth: int):
+        self.r_m, self.depth = r_m, depth
+        self.reset()
+
+    def reset(self):
+        self.X, self.G, self.last = [], [], np.inf
+
+    def _vec(self, loads, rigid):
+        return np.concatenate([loads[:, :2].ravel(), loads[:, 2] / _LEVER,
+                               _KREF * np.array([rigid[0], rigid[1], rigid[2] * self.r_m])])
+
+    def step(self, loads, rigid, loads_new, rigid_new, change):
+        if self.depth == 0:
+            return loads_new, np.array(rigid_new, dtype=float)
+        if change > self.last or change > ANDERSON_START:
+            self.reset()
+            if change > ANDERSON_START:
+                return loads_new, np.array(rigid_new, dtype=float)
+        self.last = change
+        self.X.append(self._vec(loads, rigid))
+        self.G.append(self._vec(loads_new, rigid_new))
+        self.X, self.G = self.X[-(self.depth + 1):], self.G[-(self.depth + 1):]
+        if len(self.X) < 2:
+            return loads_new, np.array(rigid_new, dtype=float)
+        R = [g - x for g, x in zip(self.G, self.X)]
+        dR = np.stack([R[i + 1] - R[i] for i in range(len(R) - 1)], axis=1)
+        dG = np.stack([self.G[i + 1] - self.G[i] for i in range(len(R) - 1)], axis=1)
+        gamma, *_ = np.linalg.lstsq(dR, R[-1], rcond=1e-10)
+        y = self.G[-1] - dG @ gamma
+        n = len(loads)
+        out = np.empty_like(loads)
+        out[:, 0], out[:, 1] = y[: 2 * n].reshape(n, 2).T
+        out[:, 2] = y[2 * n: 3 * n] * _LEVER
+        r = y[3 * n:] / _KREF
+        return out, np.array([r[0], r[1], r[2] / self.r_m])
+
+
+def _loads_on_table(tab, psi, loads) -> np.ndarray:
+    """Generalized loads at angles ``psi`` put on the table's angles (a warm start from a solved state)."""
+    out = np.zeros((len(tab.angles), 3))
+    where = {}
+    for i, a in enumerate(np.round(tab.angles, 15).tolist()):
+        where.setdefault(a, i)
+    for a, l in zip(np.round(psi, 15).tolist(), loads):
+        out[where[a]] += l
+    return out

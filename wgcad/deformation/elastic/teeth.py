@@ -6,10 +6,10 @@ from dataclasses import dataclass
 import numpy as np
 import shapely
 
-from wgcad.clearance.engine import Scene, clearance_at_poses
+from wgcad.clearance.engine import Scene
 from wgcad.placement import transform
 
-__all__ = ["ContactGeometry", "flank_contacts", "ToothCompliance"]
+__all__ = ["ContactGeometry", "flank_contacts", "pair_contacts", "ToothCompliance"]
 
 
 @dataclass(frozen=True)
@@ -35,66 +35,85 @@ class ContactGeometry:
     rigid: np.ndarray
 
 
-def _deepest(pts: np.ndarray, geoms: np.ndarray):
-    """Deepest vertex of each polygon ``pts[k]`` ``(K, N, 2)`` inside ``geoms[k]``, all pairs at once.
+def _deepest(pts: np.ndarray, template, rot: np.ndarray, shift: np.ndarray):
+    """Deepest vertex of each polygon ``pts[k]`` ``(K, N, 2)`` inside the copy ``R(rot[k]) template + shift[k]``.
 
-    Returns depth ``(K,)`` (0 where no vertex is inside), the vertex ``(K, 2)`` and
-    its nearest point on the boundary of ``geoms[k]`` ``(K, 2)``.
+    Worked in the template's frame against its one prepared polygon (as the
+    engine's ``Template.depth_of``). Returns depth ``(K,)`` (0 where no
+    vertex is inside), the vertex ``(K, 2)`` and its nearest point on the
+    copy's boundary ``(K, 2)``, both in the frame of ``pts``.
     """
     K, N, _ = pts.shape
     depth = np.zeros(K)
     vert = pts[:, 0].copy()
     near = pts[:, 0].copy()
-    ins = shapely.contains_xy(geoms[:, None], pts[..., 0], pts[..., 1])
+    c, s = np.cos(rot)[:, None], np.sin(rot)[:, None]
+    d = pts - shift[:, None, :]
+    qx, qy = c * d[..., 0] + s * d[..., 1], -s * d[..., 0] + c * d[..., 1]
+    ins = shapely.contains_xy(template.polygon, qx, qy)
     kk, ii = np.nonzero(ins)
     if kk.size == 0:
         return depth, vert, near
-    rings = shapely.get_exterior_ring(geoms)
-    d = shapely.distance(rings[kk], shapely.points(pts[kk, ii]))
+    dist = shapely.distance(template.ring, shapely.points(qx[kk, ii], qy[kk, ii]))
     full = np.full((K, N), -1.0)
-    full[kk, ii] = d
+    full[kk, ii] = dist
     best = np.argmax(full, axis=1)
     has = full[np.arange(K), best] > 0.0
     k = np.nonzero(has)[0]
     depth[k] = full[k, best[k]]
     vert[k] = pts[k, best[k]]
-    seg = shapely.get_coordinates(shapely.shortest_line(rings[k], shapely.points(vert[k]))).reshape(-1, 2, 2)
-    near[k] = seg[:, 0]
+    seg = shapely.get_coordinates(shapely.shortest_line(template.ring, shapely.points(qx[k, best[k]], qy[k, best[k]])))
+    nl = seg.reshape(-1, 2, 2)[:, 0]
+    ck, sk = c[k, 0], s[k, 0]
+    near[k] = np.stack([ck * nl[:, 0] - sk * nl[:, 1], sk * nl[:, 0] + ck * nl[:, 1]], axis=-1) + shift[k]
     return depth, vert, near
 
 
-def _smooth_normals(outlines: np.ndarray, p: np.ndarray) -> np.ndarray:
-    """Outward normals of counter-clockwise outlines ``(K, N, 2)`` at points ``p`` ``(K, 2)`` on them.
+def _smooth_normals(local: np.ndarray, rot: np.ndarray, shift: np.ndarray, p: np.ndarray):
+    """Outward normals of copies ``R(rot) local + shift`` of one counter-clockwise outline at points ``p`` ``(K, 2)`` on them.
 
     Vertex normals (the mean of the two edge normals) interpolated along the
     nearest edge: a normal field that is continuous along the outline, so the
     contact direction does not jump from edge to edge of the polygon (which
     would leave the re-linearisation cycling by a fraction of a micrometre).
+    Worked in the outline's own frame (one template for every copy).
+
+    Returns
+    -------
+    normal : (K, 2) float
+    kink : (K,) float
+        How sharp the outline turns at the ends of that edge, rad (0: straight, pi/2: a right-angled corner).
     """
-    a = outlines
-    b = np.roll(outlines, -1, axis=1)
+    a = local
+    b = np.roll(local, -1, axis=0)
     ab = b - a
     L2 = np.maximum((ab * ab).sum(axis=-1), 1e-300)
-    t = np.clip(((p[:, None, :] - a) * ab).sum(axis=-1) / L2, 0.0, 1.0)
-    d2 = ((a + t[..., None] * ab - p[:, None, :]) ** 2).sum(axis=-1)
-    e = np.argmin(d2, axis=1)
-    en = np.stack([ab[..., 1], -ab[..., 0]], axis=-1) / np.sqrt(L2)[..., None]  # edge i: vertex i -> i+1
-    vn = en + np.roll(en, 1, axis=1)  # vertex i: edges i-1 and i
-    vn /= np.hypot(vn[..., 0], vn[..., 1])[..., None]
-    k = np.arange(len(p))
-    N = outlines.shape[1]
-    te = t[k, e][:, None]
-    n = (1.0 - te) * vn[k, e] + te * vn[k, (e + 1) % N]
-    # how sharp the outline turns at the ends of that edge (0: straight, pi/2: a right-angled corner)
-    cosang = lambda i: np.clip((en[k, (i - 1) % N] * en[k, i]).sum(axis=-1), -1.0, 1.0)  # noqa: E731
-    kink = np.maximum(np.arccos(cosang(e)), np.arccos(cosang((e + 1) % N)))
-    return n / np.hypot(n[:, 0], n[:, 1])[:, None], kink
+    en = np.stack([ab[:, 1], -ab[:, 0]], axis=-1) / np.sqrt(L2)[:, None]  # edge i: vertex i -> i+1
+    vn = en + np.roll(en, 1, axis=0)  # vertex i: edges i-1 and i
+    vn /= np.hypot(vn[:, 0], vn[:, 1])[:, None]
+    turn = np.arccos(np.clip((np.roll(en, 1, axis=0) * en).sum(axis=-1), -1.0, 1.0))  # at vertex i
+    kink_edge = np.maximum(turn, np.roll(turn, -1))
+    # the points in the template's frame
+    c, s = np.cos(rot), np.sin(rot)
+    d = p - shift
+    q = np.stack([c * d[:, 0] + s * d[:, 1], -s * d[:, 0] + c * d[:, 1]], axis=-1)
+    # the nearest edge and the place on it: GEOS projects the points onto the template's ring
+    L = np.sqrt(L2)
+    cum = np.concatenate([[0.0], np.cumsum(L)])
+    sl = shapely.line_locate_point(shapely.linearrings(local), shapely.points(q))
+    N = len(local)
+    e = np.clip(np.searchsorted(cum, sl, side="right") - 1, 0, N - 1)
+    te = np.clip((sl - cum[e]) / L[e], 0.0, 1.0)[:, None]
+    n = (1.0 - te) * vn[e] + te * vn[(e + 1) % N]
+    n /= np.hypot(n[:, 0], n[:, 1])[:, None]
+    return np.stack([c * n[:, 0] - s * n[:, 1], s * n[:, 0] + c * n[:, 1]], axis=-1), kink_edge[e]
 
 
 def flank_contacts(scene: Scene, rot: np.ndarray, shift: np.ndarray) -> dict[str, ContactGeometry]:
     """Contacts of flexspline teeth at poses ``(rot, shift)`` with their lower and upper rigid neighbours.
 
-    The gaps are the engine's (:func:`wgcad.clearance.engine.clearance_at_poses`);
+    The gaps are the engine's (:func:`wgcad.clearance.engine.clearance_at_poses`, the same
+    definition computed here from the shortest segments and deepest vertices it also needs);
     the point and normal come from the shortest segment between the outlines
     when apart, and from the deepest vertex and its nearest point on the other
     outline when overlapping (the vertex that sets the engine's depth): the
@@ -111,41 +130,46 @@ def flank_contacts(scene: Scene, rot: np.ndarray, shift: np.ndarray) -> dict[str
     """
     rot = np.atleast_1d(np.asarray(rot, dtype=float))
     shift = np.atleast_2d(np.asarray(shift, dtype=float))
-    res = clearance_at_poses(scene, rot, shift, third=False)
+    K = len(rot)
+    lo, up, _ = scene.neighbours(shift, rot)
+    # both neighbours in one batch: pairs 0..K-1 with the lower rigid tooth, K..2K-1 with the upper
+    g = pair_contacts(scene, np.concatenate([rot, rot]), np.concatenate([shift, shift]), np.concatenate([lo, up]))
+    return {key: ContactGeometry(g.gap[sl], g.point[sl], g.normal[sl], g.rigid[sl])
+            for key, sl in (("lower", slice(0, K)), ("upper", slice(K, 2 * K)))}
+
+
+def pair_contacts(scene: Scene, rot: np.ndarray, shift: np.ndarray, rigid: np.ndarray) -> ContactGeometry:
+    """:func:`flank_contacts` of flexspline teeth at poses ``(rot, shift)`` against given rigid teeth ``rigid`` ``(K,)``."""
+    idx = np.asarray(rigid)
     pts = transform(scene.flex_local, rot, shift)
     geoms = shapely.polygons(pts)
-    out = {}
-    for key, idx in (("lower", res["lo"]), ("upper", res["up"])):
-        gap = np.asarray(res[key], dtype=float)
-        rg = scene.rigid_geoms[idx]
-        point = np.empty((len(rot), 2))
-        other = np.empty((len(rot), 2))
-        apart = np.nonzero(gap > 0.0)[0]
-        if apart.size:
-            seg = shapely.get_coordinates(shapely.shortest_line(geoms[apart], rg[apart])).reshape(-1, 2, 2)
-            point[apart] = seg[:, 0]
-            other[apart] = seg[:, 1]
-        over = np.nonzero(gap <= 0.0)[0]
-        if over.size:
-            # the vertex that sets the engine's depth: of the flexspline inside the rigid tooth, or the reverse
-            d_f, v_f, q_f = _deepest(pts[over], rg[over])
-            d_r, v_r, q_r = _deepest(scene.rigid_pts[idx[over]], geoms[over])
-            flex_side = d_f >= d_r
-            point[over] = np.where(flex_side[:, None], v_f, q_r)
-            other[over] = np.where(flex_side[:, None], q_f, v_r)
-            touch = np.nonzero(np.maximum(d_f, d_r) <= 0.0)[0]
-            if touch.size:  # touching without a vertex inside
-                k = over[touch]
-                seg = shapely.get_coordinates(shapely.shortest_line(shapely.get_exterior_ring(geoms[k]),
-                                                                    shapely.get_exterior_ring(rg[k]))).reshape(-1, 2, 2)
-                point[k], other[k] = seg[:, 0], seg[:, 1]
-        # the contact normal is the normal of the smoother outline there: a tip corner pressing on a
-        # flank acts along the flank's normal (vertex normals interpolated, so it does not jump)
-        n_f, kink_f = _smooth_normals(pts, point)
-        n_r, kink_r = _smooth_normals(scene.rigid_pts[idx], other)
-        normal = np.where((kink_r < kink_f)[:, None], -n_r, n_f)
-        out[key] = ContactGeometry(gap, point, normal, np.asarray(idx))
-    return out
+    rg = scene.rigid_geoms[idx]
+    # the engine's signed clearance (wgcad.clearance.distance.signed_clearance): the distance when apart,
+    # minus the depth of the deepest vertex of either polygon inside the other when overlapping
+    seg = shapely.get_coordinates(shapely.shortest_line(geoms, rg)).reshape(-1, 2, 2)
+    point, other = seg[:, 0].copy(), seg[:, 1].copy()
+    gap = np.hypot(*(other - point).T)
+    over = np.nonzero(gap == 0.0)[0]
+    if over.size:
+        # the vertex that sets the engine's depth: of the flexspline inside the rigid tooth, or the reverse
+        d_f, v_f, q_f = _deepest(pts[over], scene.rigid, scene.rigid_rot[idx[over]], scene.rigid_shift[idx[over]])
+        d_r, v_r, q_r = _deepest(scene.rigid_pts[idx[over]], scene.flex, rot[over], shift[over])
+        gap[over] = -np.maximum(d_f, d_r)
+        flex_side = d_f >= d_r
+        point[over] = np.where(flex_side[:, None], v_f, q_r)
+        other[over] = np.where(flex_side[:, None], q_f, v_r)
+        touch = np.nonzero(np.maximum(d_f, d_r) <= 0.0)[0]
+        if touch.size:  # touching without a vertex inside
+            k = over[touch]
+            seg = shapely.get_coordinates(shapely.shortest_line(shapely.get_exterior_ring(geoms[k]),
+                                                                shapely.get_exterior_ring(rg[k]))).reshape(-1, 2, 2)
+            point[k], other[k] = seg[:, 0], seg[:, 1]
+    # the contact normal is the normal of the smoother outline there: a tip corner pressing on a
+    # flank acts along the flank's normal (vertex normals interpolated, so it does not jump)
+    n_f, kink_f = _smooth_normals(scene.flex_local, rot, shift, point)
+    n_r, kink_r = _smooth_normals(scene.rigid.local, scene.rigid_rot[idx], scene.rigid_shift[idx], other)
+    normal = np.where((kink_r < kink_f)[:, None], -n_r, n_f)
+    return ContactGeometry(gap, point, normal, idx)
 
 
 @dataclass(frozen=True)

@@ -1,0 +1,59 @@
+"""Ring tables of the elastic model (wgcad.deformation.elastic.tables): the same numbers as the closed-form ring."""
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from wgcad.deformation.elastic import build_model
+from wgcad.deformation.elastic.tables import Compliance
+from wgcad.design import load_design
+from wgcad.drive import build_drive
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+@pytest.fixture(scope="module")
+def model():
+    return build_model(build_drive(load_design(ROOT / "templates" / "d1_involute.toml")), 3)
+
+
+def test_influence_is_the_ring_block_and_symmetric(model):
+    tab = model.tables
+    rng = np.random.default_rng(1)
+    n = len(tab.angles)
+    for i, j in rng.integers(0, n, size=(20, 2)):
+        blk = model.ring.block(np.array(tab.angles[i] - tab.angles[j]))
+        assert np.array_equal(tab.influence[3 * i:3 * i + 3, 3 * j:3 * j + 3], blk)
+    # Maxwell-Betti: the compliance solver reads a load's column as its row
+    assert np.abs(tab.influence - tab.influence.T).max() < 1e-12 * np.abs(tab.influence).max()
+
+
+def test_tooth_field_is_the_ring_field(model):
+    tab = model.tables
+    rng = np.random.default_rng(2)
+    loads = np.zeros((len(tab.angles), 3))
+    pick = rng.choice(len(tab.angles), 30, replace=False)
+    loads[pick] = rng.normal(size=(30, 3)) * [1e3, 1e3, 1e3]
+    el = tab.tooth_field(loads)
+    f = model.ring.field(tab.angles[: tab.z_g], tab.angles[pick], loads[pick])
+    for row, key in enumerate(("w", "v", "theta")):
+        assert np.abs(el[row] - f[key]).max() < 1e-12 * max(np.abs(f[key]).max(), 1e-30)
+
+
+def test_compliance_columns_are_the_dense_product(model):
+    tab = model.tables
+    rng = np.random.default_rng(3)
+    m = 40
+    idx = rng.integers(0, len(tab.angles), m)
+    fb = rng.normal(size=(m, 3))
+    s = rng.random(m) * 1e-4
+    B = np.zeros((m, tab.influence.shape[0]))
+    for j in range(m):
+        B[j, 3 * idx[j]:3 * idx[j] + 3] = fb[j]
+    ref = B @ tab.influence @ B.T + np.diag(s)
+    C = Compliance(tab, idx, fb, s)
+    scale = np.abs(ref).max()
+    assert np.abs(C.cols(np.array([5, 2, 5, 39])) - ref[:, [5, 2, 5, 39]]).max() < 1e-12 * scale
+    assert np.abs(C.dense() - ref).max() < 1e-12 * scale
+    assert np.abs(C.diag - np.diag(ref)).max() < 1e-12 * scale
