@@ -6,6 +6,12 @@ import argparse
 import os
 import sys
 
+# The solvers' matrices are small (a few hundred rows): BLAS threads cost more than they save and,
+# on a busy machine, thrash (benchmarks/elastic.py measured 3.2 ms against 0.05 ms per Cholesky
+# factorisation, a 13-level torque sweep 2.7x slower). Set before numpy loads; a user's own setting wins.
+for _var in ("OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
+    os.environ.setdefault(_var, "1")
+
 from .. import __version__
 from ..errors import WgcadError
 from . import audit, generate, ke, kinematics, parts, sector
