@@ -244,7 +244,7 @@ def register(sub) -> None:
     a.add_argument("--no-culling", action="store_true", help="also evaluate teeth radially clear of all rigid material, and the third-nearest rigid tooth everywhere")
     a.add_argument("--no-refine", action="store_true",
                    help="report the figures of the sampled outlines (within 2 chord tolerances of the true curves) instead of "
-                        "refining them on the exact tooth curves: ~20x faster, not exact")
+                        "refining them on the exact tooth curves: about 5x faster, not exact")
     a.add_argument("--no-bound", action="store_true", help="evaluate every sample (no branch and bound on the Lipschitz lower bound)")
     a.add_argument("--progress", action="store_true", help="progress bar (fraction, ETA) on stderr even when it is not a terminal or with --quiet; "
                    "by default it is drawn only on a terminal")
