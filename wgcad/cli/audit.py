@@ -90,8 +90,11 @@ def cmd_audit(args) -> int:
     res["source"] = drive.design.source
     from .common import not_modelled
 
-    res["not_checked"] = not_modelled(drive.design, "this audit")
-    if args.engine in ("fcl", "both"):
+    imperfect = bool(res["settings"].get("imperfections"))
+    res["not_checked"] = not_modelled(drive.design, "this audit", imperfections=imperfect)
+    if imperfect:
+        res["not_checked"] += _imperfect_not_checked(args)
+    if args.engine in ("fcl", "both") and not imperfect:
         bar.set(work_end, "3D check (fcl)")
         from ..clearance.fcl3d import verify_worst
 
@@ -151,6 +154,16 @@ def cmd_audit(args) -> int:
     if drifts:
         return EXIT_INTERFERENCE
     return EXIT_INTERFERENCE if res["interference"] else EXIT_OK
+
+
+def _imperfect_not_checked(args) -> list[str]:
+    """What the audit of an imperfect drive (wgcad.clearance.imperfect) leaves to the perfect drive, said in the summary."""
+    notes = ["entry gap and pinch with [imperfections]: not computed (run the audit without the table for the perfect drive's)"]
+    if args.engine in ("fcl", "both"):
+        notes.append("--engine fcl/both with [imperfections]: the 3D check places perfect parts, so it was not run")
+    if args.plot:
+        notes.append("--plot with [imperfections]: the pictures show the perfect drive")
+    return notes
 
 
 def _audit_pngs(drive, result):
