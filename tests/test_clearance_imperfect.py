@@ -71,7 +71,7 @@ def test_error_bound_holds_for_every_point(d1, seed):
             Pi = transform(scene.flex_local, ri, si_)
             Pp = transform(scene.flex_local, rp, sp)
             lo, up, th = scene.neighbours(sp, rp)
-            bound = eb.bound(k[:, None], np.array([[phi_h]]), si)[:, 0]
+            bound = eb.bound(k, np.array([phi_h]))[si, :, 0]
             for j in (lo, up, th):
                 # the imperfect point taken into the imperfect rigid tooth's frame, then out through the perfect one's
                 d = rb_rot[j] - scene.rigid_rot[j]

@@ -47,6 +47,8 @@ _SEED = 256
 #: candidates above this many are first sorted out on polygons 8 times finer (as the engine does)
 _FINE_ABOVE = 48
 _FINE = 8
+#: candidates refined in one call (the 16 lowest first above that)
+_ONE_CALL = 48
 
 
 def chunk_angles(z_g: int, sections: int, chunk_samples: int = CHUNK_SAMPLES) -> int:
@@ -141,7 +143,7 @@ class PerfectBound:
     at least that high. Its size does not depend on the sweep.
     """
 
-    def __init__(self, scene: Scene, z, settings, band: float):
+    def __init__(self, scene: Scene, z, settings):
         from .search import _SectionSearch
 
         half = pi / scene.n_w
@@ -151,7 +153,7 @@ class PerfectBound:
         self.grid = np.linspace(0.0, half, n)
         self.search = _SectionSearch(scene, self.grid, z, settings)
         self.search.prepare_bound()
-        self.z, self.band, self.half = z, band, half
+        self.z, self.half = z, half
 
     @property
     def lower(self) -> np.ndarray:
@@ -171,17 +173,32 @@ class PerfectBound:
 GRID_LOSS = 0.5e-3
 
 
-def _perfect_bounds(scene: Scene, sections: list, settings, band: float):
-    """The perfect drive's bounds of every section, searched together (the best of any prunes all)."""
-    from .search import _evaluate
+class _Perfect:
+    """The perfect drive's bounds of every section (:class:`PerfectBound`), searched together: the best of any prunes all."""
 
-    pb = [PerfectBound(scene, z, settings, band) for z in sections]
-    res = [p.search for p in pb]
-    best = _evaluate(scene, res, [r.coarse() for r in res], sections)
-    for stride in (64, 16, 4, 1):
-        best = _evaluate(scene, res, [r.candidates(stride, best + band) for r in res], sections)
-    _evaluate(scene, res, [r.culled_needed(best + band) for r in res], sections)
-    return pb, int(sum(r.evaluated.sum() for r in res))
+    def __init__(self, scene: Scene, sections: list, settings):
+        from .search import _evaluate
+
+        self._evaluate = _evaluate
+        self.scene, self.sections = scene, sections
+        self.pb = [PerfectBound(scene, z, settings) for z in sections]
+        self.res = [p.search for p in self.pb]
+        self.best = _evaluate(scene, self.res, [r.coarse() for r in self.res], sections)
+        self.band = -np.inf
+
+    def extend(self, band: float) -> None:
+        """Evaluate every grid point whose bound lies below ``best + band``; the others keep bounds at least that high."""
+        if band <= self.band:
+            return
+        ev, sc, res, zs = self._evaluate, self.scene, self.res, self.sections
+        for stride in (64, 16, 4, 1):
+            self.best = ev(sc, res, [r.candidates(stride, self.best + band) for r in res], zs)
+        self.best = ev(sc, res, [r.culled_needed(self.best + band) for r in res], zs)
+        self.band = band
+
+    @property
+    def evaluated(self) -> int:
+        return int(sum(r.evaluated.sum() for r in self.res))
 
 
 class ErrorBound:
@@ -242,26 +259,37 @@ class ErrorBound:
                + abs(imp.rigid_ecc) + 0.5 * imp.rigid_runout)
         self.second = self.a_b * amp
 
-    def bound(self, k, phi_h, si) -> np.ndarray:
-        """Largest relative displacement (mm) of tooth ``k`` (Kk, 1) at generator angles ``phi_h`` (1, B) in section ``si``."""
+    def bound(self, k, phi_h) -> np.ndarray:
+        """Largest relative displacement (mm) of teeth ``k`` (Kk,) at generator angles ``phi_h`` (B,), every section, ``(S, Kk, B)``."""
         imp = self.imp
+        k = np.asarray(k)
+        phi_h = np.asarray(phi_h, dtype=float)
         da, dr = flex_deviations(imp, k, self.z_g, self.r_g)
-        mat = 2.0 * pi * k / self.z_g + phi_h / self.u
-        dev = self.a_b * np.sin(mat - imp.rigid_install + imp.rigid_runout_phase)
-        E = self.cz[si] * cam_offset(imp, phi_h, phi_h / self.u)
+        da, dr = da[:, None], dr[:, None]
+        # mat = A_k + B_h: its sines and cosines from the two factors' (outer products, no trigonometry on K x B)
+        A, Bh = 2.0 * pi * k / self.z_g, phi_h / self.u
+        ca, sa, cb, sb = np.cos(A)[:, None], np.sin(A)[:, None], np.cos(Bh)[None, :], np.sin(Bh)[None, :]
+        c, s = ca * cb - sa * sb, sa * cb + ca * sb
+        p = imp.rigid_runout_phase - imp.rigid_install
+        dev = self.a_b * (s * np.cos(p) + c * np.sin(p))  # a_b sin(mat + p)
+        E = cam_offset(imp, phi_h, phi_h / self.u)  # (B, 2)
         tan = da * self.r_m - dev * self.r_b
-        c, s = np.cos(mat), np.sin(mat)
-        vx = -tan * s + dr * c + E[..., 0] - self.T[0]
-        vy = tan * c + dr * s + E[..., 1] - self.T[1]
-        rem = (np.abs(da) * self.k_gain[si] + np.abs(dr) * self.rho_gain[si] + np.abs(dev) * self.dev_gain[si]
-               + self.fixed[si] + self.second)
-        return np.hypot(vx, vy) + rem
+        bx = -tan * s + dr * c - self.T[0]
+        by = tan * c + dr * s - self.T[1]
+        ada, adr, adev = np.abs(da), np.abs(dr), np.abs(dev)
+        out = np.empty((len(self.cz), len(k), len(phi_h)))
+        for si, cz in enumerate(self.cz):
+            rem = ada * self.k_gain[si] + adr * self.rho_gain[si] + adev * self.dev_gain[si] + (self.fixed[si] + self.second)
+            out[si] = np.hypot(bx + cz * E[None, :, 0], by + cz * E[None, :, 1]) + rem
+        return out
 
-    def largest(self, sections: list, angles: np.ndarray) -> float:
-        """The largest :meth:`bound` over the teeth and angles (mm)."""
-        k = np.arange(self.z_g)[:, None]
-        return max(float(self.bound(k, angles[None, :: max(1, len(angles) // 720)], si).max())
-                   for si in range(len(sections)))
+    def largest(self, angles: np.ndarray) -> float:
+        """The largest :meth:`bound` over the teeth and (up to 90 of the) angles, mm.
+
+        Only the width of the perfect drive's search rests on it, not a
+        bound's validity, so a subsample of the angles is enough.
+        """
+        return float(self.bound(np.arange(self.z_g), angles[:: max(1, len(angles) // 90)]).max())
 
 
 def _evaluate_poses(scene, rot, shift) -> np.ndarray:
@@ -274,12 +302,12 @@ def _evaluate_poses(scene, rot, shift) -> np.ndarray:
 
 def _chunk_bounds(pb, eb, angles, a0, a1, z_g, S):
     """Lower bounds of the imperfect clearance of samples (section, tooth, angle) of angles ``a0:a1``, ``(S, z_g, B)``."""
-    ph = angles[a0:a1][None, :]
+    ph = angles[a0:a1]
     k = np.arange(z_g)[:, None]
-    phi = 2.0 * pi * k / z_g + ph / eb.u - ph
-    out = np.empty((S, z_g, ph.shape[1]))
+    phi = 2.0 * pi * k / z_g + ph[None, :] * (1.0 / eb.u - 1.0)
+    out = -eb.bound(np.arange(z_g), ph)
     for si in range(S):
-        out[si] = pb[si].at(phi) - eb.bound(k, ph, si)
+        out[si] += pb[si].at(phi)
     return out
 
 
@@ -359,8 +387,12 @@ def audit_imperfect(drive, settings, imp: Imperfections, progress=None, chunk_sa
     eb = ErrorBound(scene, imp, sections)
     # the widest the errors can move a tooth against its rigid teeth: the imperfect minimum is within
     # that of the perfect one, so the perfect bounds are needed up to twice that above it
-    e_max = eb.largest(sections, angles)
-    pb, n_perfect = _perfect_bounds(scene, sections, settings, 2.0 * e_max + margin)
+    e_max = eb.largest(angles)
+    # the perfect drive's bounds, first as far as a perfect audit needs them; then as far as the sweep
+    # needs them: a grid point whose bound is above (imperfect best + margin + e_max) prunes every sample
+    perfect = _Perfect(scene, sections, settings)
+    perfect.extend(margin)
+    pb = perfect.pb
     if progress is not None:
         progress(300, 1000, "clearance")
     best = np.inf
@@ -409,6 +441,8 @@ def audit_imperfect(drive, settings, imp: Imperfections, progress=None, chunk_sa
             sel.append((s_, k_, b_ + a0))
             at += len(L)
         run(*(np.concatenate(x) for x in zip(*sel)))
+        # the seeds' best is the imperfect minimum's upper bound; it is within e_max of the perfect one
+        perfect.extend(min(best + margin + e_max - perfect.best, 2.0 * e_max + margin))
         done = set(zip(*(np.concatenate(x).tolist() for x in zip(*sel))))
         for a0 in range(0, A, B):
             a1 = min(A, a0 + B)
@@ -455,7 +489,10 @@ def audit_imperfect(drive, settings, imp: Imperfections, progress=None, chunk_sa
         while at < len(cand_v):
             if cand_v[at] - ref.chord_gap >= exact_best:
                 break
-            live = np.nonzero(cand_v[at:] - ref.chord_gap < exact_best)[0] + at if at else np.arange(min(16, len(cand_v)))
+            # a refinement's cost is mostly per call: a few candidates go in one call, many in two
+            # (the 16 lowest set the bar for the rest)
+            first = len(cand_v) if len(cand_v) <= _ONE_CALL else 16
+            live = np.nonzero(cand_v[at:] - ref.chord_gap < exact_best)[0] + at if at else np.arange(first)
             if live.size == 0:
                 break
             rot, shift = _poses_of(drive, imp, angles, cand_a[live], cand_k[live], cand_s[live], sections)
@@ -526,7 +563,7 @@ def audit_imperfect(drive, settings, imp: Imperfections, progress=None, chunk_sa
         "rigid_pitch_radius_mm": drive.rigid.r,
     }
     counts = {"samples": int(A * z_g * S), "unique_tooth_angles": int(A * z_g), "sections": S, "evaluated": int(n_ev),
-              "culled": int(n_pruned), "perfect_evaluated": int(n_perfect), "refined": int(n_refined), "fine_polygon": int(n_fine), "chunks": -(-A // B)}
+              "culled": int(n_pruned), "perfect_evaluated": perfect.evaluated, "refined": int(n_refined), "fine_polygon": int(n_fine), "chunks": -(-A // B)}
     entry = {"tooth_angle_deg": None, "section_z_mm": None, "side": "entry (+phi)" if scene.entry_sign > 0 else "entry (-phi)",
              "pinch_um": None, "pinch_tooth_angle_deg": None, "pinch_section_z_mm": None, "pinch_location": None,
              "tip_to_tip_risk": False,
