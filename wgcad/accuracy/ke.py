@@ -41,7 +41,7 @@ from ..clearance.distance import Template
 from ..errors import DesignError
 from ..kinematics import gear_ratios
 from ..placement import tooth_pose, transform
-from .contact import Contact, closing_rotation
+from .contact import closing_rotation
 from .imperfect import (Imperfections, cam_offset, coning_factor, flex_deviations, flex_poses,
                         rigid_deviations, rigid_poses, rigid_translation)
 
@@ -156,7 +156,8 @@ def contact_table(drive, imp: Imperfections, n_per_mesh: int = DEFAULT_N, sectio
         for side in (1, -1):
             j = (lo + (1 if side > 0 else 0)) % z_b
             rb = (j + 0.5) * gamma_b
-            con = _closing_lattice(flex, rot[idx], shift[idx], rigid, rb, side, reach_pitches * 2 * pi / z_g, idx)
+            con = closing_rotation(flex, rot[idx], shift[idx], rigid, rb, np.zeros((len(idx), 2)), side,
+                                   reach_pitches * 2 * pi / z_g)
             good = con.ok & (np.hypot(con.nt[:, 0], con.nt[:, 1]) * drive.rigid.r <= NT_MAX)
             k = np.nonzero(good)[0]
             t = side * con.delta[k]
@@ -178,53 +179,6 @@ def contact_table(drive, imp: Imperfections, n_per_mesh: int = DEFAULT_N, sectio
         tab.sides[side] = {key: np.concatenate([p[key] for p in parts[side]]) for key in parts[side][0]}
         _refine(tab, side, imp, flex, rigid, reach_pitches * 2 * pi / z_g)
     return tab
-
-
-#: lattice points solved from rest before the others start from their interpolated closing rotations
-_WARM_EVERY = 8
-
-
-def _closing_lattice(flex, rot, shift, rigid, rb, side, reach, m):
-    """:func:`closing_rotation` of the rigid teeth ``rb`` of lattice points ``m`` (sorted), warm-started.
-
-    Every ``_WARM_EVERY``-th point is solved from rest; the others start
-    from the closing rotation interpolated between their solved neighbours
-    (the rotation is smooth along the lattice except where the facing rigid
-    tooth changes): Newton's method then needs a step or two instead of five
-    or six. Where the neighbours are missing or farther than that on the
-    lattice, they start from rest. The same convergence test ends both, so
-    the figures agree to it (tests/test_ke.py).
-    """
-    K = len(rot)
-    zero = np.zeros((K, 2))
-    if not _WARM_EVERY or K < 4 * _WARM_EVERY:
-        return closing_rotation(flex, rot, shift, rigid, rb, zero, side, reach)
-    first = np.arange(0, K, _WARM_EVERY)
-    rest = np.setdiff1d(np.arange(K), first)
-    c1 = closing_rotation(flex, rot[first], shift[first], rigid, rb[first], zero[first], side, reach)
-    # only between neighbours apart at rest (closing rotation > 0): an overlapping pair is turned back
-    # first, and from a warm start that search can end at another contact than from rest
-    use = c1.ok & (c1.delta > 0.0)
-    mf, ok = m[first][use], c1.delta[use]
-    start = np.zeros(rest.size)
-    if mf.size >= 2:
-        pos = np.clip(np.searchsorted(mf, m[rest]), 1, mf.size - 1)
-        near = (m[rest] - mf[pos - 1] <= _WARM_EVERY) & (mf[pos] - m[rest] <= _WARM_EVERY) & (mf[pos - 1] <= m[rest])
-        start = np.where(near, np.interp(m[rest], mf, ok), 0.0)
-    warm = start > 0.0
-    c2 = closing_rotation(flex, rot[rest], shift[rest], rigid, rb[rest], zero[rest], side, reach, start=start)
-    # a warm-started pair that turned out to overlap at its start went through the same turning back:
-    # solved again from rest, so that every figure is the one from rest
-    again = np.nonzero(warm & ~(c2.ok & (c2.delta > 0.0)))[0]
-    if again.size:
-        c3 = closing_rotation(flex, rot[rest][again], shift[rest][again], rigid, rb[rest][again], zero[again], side, reach)
-        for a in ("delta", "p", "q", "nt", "ok"):
-            getattr(c2, a)[again] = getattr(c3, a)
-    out = [np.empty((K,) + np.shape(getattr(c1, a))[1:], dtype=getattr(c1, a).dtype) for a in ("delta", "p", "q", "nt", "ok")]
-    for arr, a in zip(out, ("delta", "p", "q", "nt", "ok")):
-        arr[first] = getattr(c1, a)
-        arr[rest] = getattr(c2, a)
-    return Contact(*out)
 
 
 #: translation (mm) of the rigid tooth for the finite-difference sensitivities: 0.1 um, where the
@@ -250,8 +204,6 @@ def _refine(tab: ContactTable, side: int, imp: Imperfections, flex, rigid, reach
     for ax in (0, 1):
         dv = np.zeros((e.size, 2))
         dv[:, ax] = _FD_H
-        # from rest, as the table's own rotations: started at the unperturbed rotation, a pair whose
-        # start lands within the gap tolerance stops there at once and its difference reads 0
         cp = closing_rotation(flex, S["rot"][e], S["shift"][e], rigid, rb, dv, side, reach)
         cm = closing_rotation(flex, S["rot"][e], S["shift"][e], rigid, rb, -dv, side, reach)
         nt[:, ax] = (cp.delta - cm.delta) / (2 * _FD_H)
