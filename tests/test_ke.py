@@ -202,3 +202,21 @@ def test_contact_normals_do_not_depend_on_the_search_path():
                          (158450, 1, a.delta_w)):
         ref = K.closing_direct(drive, imp, a.phi_h[i], side * tab.side_w, sections=[None])
         assert abs(arr[i] - ref) * AS < 1.0, (i, arr[i] * AS, ref * AS)
+
+
+def test_deep_overlaps_are_flagged_where_the_linear_model_fails():
+    # Validity range of the linear error model (ke.DEEP_OVERLAP): on D2 with its [S4] errors the open end
+    # (z = 0) interferes so deeply that every first contact turns back by > 600'' to separate, and there
+    # the table's closing rotations are hundreds of arcsec off the direct computation; mid-face (z = 16)
+    # no first contact is that deep and they agree within 2'' (measured 1.8'' at most, 250 samples).
+    drive = build_drive(load_design(TEMPLATES / "d2_imperfect.toml"))
+    imp = Imperfections.from_spec(drive.design.imperfections)
+    worst = {}
+    for z in (0.0, 16.0):
+        tab = K.contact_table(drive, imp, 8, sections=[z])
+        res = K.kinematic_error(drive, imp, table=tab, samples=8 * 202 * 4)
+        errs = [abs(res.delta_n[i] - K.closing_direct(drive, imp, res.phi_h[i], -tab.side_w, sections=[z])) * AS
+                for i in (101, 1733, 2900, 5631 % len(res.ke), 6001)]
+        worst[z] = (res.deep_overlap_fraction, max(errs))
+    assert worst[0.0][0] == 1.0 and worst[0.0][1] > 100.0
+    assert worst[16.0][0] == 0.0 and worst[16.0][1] < 2.0

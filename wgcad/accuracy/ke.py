@@ -46,7 +46,7 @@ from .imperfect import (Imperfections, cam_offset, coning_factor, flex_deviation
                         rigid_deviations, rigid_poses, rigid_translation)
 
 __all__ = ["ContactTable", "contact_table", "KEResult", "kinematic_error", "install_angle_scan",
-           "optimize_install_angle", "closing_direct", "spectrum", "expected_orders", "DEFAULT_N"]
+           "optimize_install_angle", "closing_direct", "spectrum", "expected_orders", "DEFAULT_N", "DEEP_OVERLAP"]
 
 #: generator angles per mesh period (2 pi / z_b); benchmarks/ke.py measures the error of
 #: 16 against 160: it is what keeps the full D2 revolution (323 200 angles) within seconds
@@ -325,6 +325,15 @@ def _side_arrays(tab, side, imp, lanes, i, lever):
     return base, X, Y
 
 
+#: closing rotation (rad, negative: turning back) of the first contact's perfect pair beyond which the linear
+#: model is not trusted: 300 arcsec. Measured on D2 against the direct computation (exact poses, fresh
+#: contact search; 250 samples, each section alone, [S4] errors and 0.3 of them): first contacts whose pair
+#: is apart were within 0.5''; turning back by up to 300'' within 1.8''; by more than 600'' (the open end
+#: with the full [S4] errors) up to 650'' off, median 38''. The separating feature of so deep an overlap
+#: changes with the errors. 300..600'' were not met.
+DEEP_OVERLAP = 300.0 / 206264.80624709636
+
+
 def _theta(tab, dw, dn):
     lm = dw + dn
     return tab.side_w * (dw - 0.5 * np.minimum(lm, 0.0)), lm
@@ -343,6 +352,10 @@ class KEResult:
     turns: float
     engagement: str
     u: float
+    #: fraction of the samples whose first contact (either side) is a pair that, perfect, overlaps so deeply
+    #: that it must turn back by more than :data:`DEEP_OVERLAP` to separate: there the linear model can
+    #: be off by hundreds of arcseconds (the separating feature changes with the errors)
+    deep_overlap_fraction: float = 0.0
 
     @property
     def flex_turns_per_record(self) -> float:
@@ -377,15 +390,20 @@ def kinematic_error(drive, imp: Imperfections, n_per_mesh: int = DEFAULT_N, sect
     I = _record(tab) if samples is None else int(samples)
     lw, ln = _lanes(tab, tab.side_w, imp), _lanes(tab, -tab.side_w, imp)
     dw, dn = np.empty(I), np.empty(I)
+    deep = np.zeros(I, dtype=bool)
     for a in range(0, I, _CHUNK):
         i = np.arange(a, min(I, a + _CHUNK))
-        dw[a : a + len(i)] = _side_arrays(tab, tab.side_w, imp, lw, i, None)[0].min(axis=1)
-        dn[a : a + len(i)] = _side_arrays(tab, -tab.side_w, imp, ln, i, None)[0].min(axis=1)
+        for side, lanes, out in ((tab.side_w, lw, dw), (-tab.side_w, ln, dn)):
+            base = _side_arrays(tab, side, imp, lanes, i, None)[0]
+            first = np.argmin(base, axis=1)
+            out[a : a + len(i)] = base[np.arange(len(i)), first]
+            e = lanes[i % tab.N, first]
+            deep[a : a + len(i)] |= (e >= 0) & (tab.sides[side]["g"][np.maximum(e, 0)] < -DEEP_OVERLAP)
     theta, lm = _theta(tab, dw, dn)
     phi_h = tab.sigma * np.arange(I) * 2 * pi / (tab.z_b * tab.N)
     eng = "single-flank (backlash)" if lm.min() >= 0 else "double-flank (interference)" if lm.max() < 0 else "mixed"
     return KEResult(phi_h, dw, dn, lm, -(theta - theta[0]), tab.N, I / (tab.N * tab.z_b), eng,
-                    abs(gear_ratios(tab.z_g, tab.z_b)["u_hg"]))
+                    abs(gear_ratios(tab.z_g, tab.z_b)["u_hg"]), float(deep.mean()) if I else 0.0)
 
 
 def install_angle_scan(tab: ContactTable, imp: Imperfections, angles, lever: str = "rigid") -> np.ndarray:
