@@ -227,8 +227,9 @@ def _geometry(tab: ContactTable, side: int, i: np.ndarray, e: np.ndarray) -> dic
     # the table frame turned to the actual one by whole rigid pitches: (m' + sigma i) / N, with m'
     # the lattice index of the folded tooth angle (docs/models.md 7: phi z_g / z_b + phi_h)
     sb = (((m + M // 2) % M - M // 2) + tab.sigma * i) // N
-    rho = (2 * pi / z_b) * sb
-    cr, sr = np.cos(rho), np.sin(rho)
+    # rho = 2 pi sb / z_b: its cosine and sine looked up per whole rigid pitch (no trigonometry per sample)
+    ang = (2 * pi / z_b) * np.arange(z_b)
+    cr, sr = np.cos(ang)[sb % z_b], np.sin(ang)[sb % z_b]
     ntx, nty = S["nt"][e, 0], S["nt"][e, 1]
     return {"k": k, "sb": sb, "nx": cr * ntx - sr * nty, "ny": sr * ntx + cr * nty}
 
@@ -242,10 +243,12 @@ def _terms(tab: ContactTable, side: int, imp: Imperfections, i: np.ndarray, e: n
     if which == "rigid":
         T = rigid_translation(imp)
         j = (S["j"][e] + geo["sb"]) % z_b
-        return T[0] * nx + T[1] * ny + rigid_deviations(imp, j, z_b, tab.r_b) * S["a_beta"][e]
+        # per-tooth values looked up (the same formula at the same whole tooth numbers): no sine per sample
+        return T[0] * nx + T[1] * ny + rigid_deviations(imp, np.arange(z_b), z_b, tab.r_b)[j] * S["a_beta"][e]
     if which == "flex":
-        da, dr = flex_deviations(imp, geo["k"], z_g, tab.r_g)
-        return -da * S["a_phi"][e] - dr * S["a_rho"][e]
+        da, dr = flex_deviations(imp, np.arange(z_g), z_g, tab.r_g)
+        k = geo["k"]
+        return -da[k] * S["a_phi"][e] - dr[k] * S["a_rho"][e]
     phi_h = tab.sigma * i * (2 * pi / (z_b * tab.N))
     E = cam_offset(imp, phi_h, phi_h / gear_ratios(z_g, z_b)["u_hg"], parts=("flex", "fixed"))
     return -S["c"][e] * (E[..., 0] * nx + E[..., 1] * ny)
@@ -273,6 +276,9 @@ def _lanes(tab: ContactTable, side: int, imp: Imperfections, slack: float = 1.05
     phi = _fold(2 * pi * S["m"] / M)
     zone = np.where(np.abs(phi) <= 0.5 * pi, 0, 1)  # 0: the zone around +x, 1: around -x (two waves)
     cls = (-tab.sigma * np.arange(N)) % N  # lattice class of sample residue r
+    mf = (S["m"] + M // 2) % M - M // 2  # folded lattice index
+    cq = np.round(S["c"] * 1e6).astype(int)
+    group = np.unique(np.stack([zone, cq], 1), axis=0, return_inverse=True)[1].ravel()  # (zone, section) of each contact
     out = []
     for r in range(N):
         e = np.nonzero(S["m"] % N == cls[r])[0]
@@ -280,10 +286,10 @@ def _lanes(tab: ContactTable, side: int, imp: Imperfections, slack: float = 1.05
             out.append(e)
             continue
         keep = S["g"][e] - B[e] <= np.min(S["g"][e] + B[e])
-        for key in np.unique(np.stack([zone[e], np.round(S["c"][e] * 1e6).astype(int)], 1), axis=0):
-            grp = e[(zone[e] == key[0]) & (np.round(S["c"][e] * 1e6).astype(int) == key[1])]
+        for gk in np.unique(group[e]):
+            sel = group[e] == gk
+            grp = e[sel]
             es = grp[np.argmin(S["g"][grp])]
-            mf = (S["m"] + M // 2) % M - M // 2  # folded lattice index
             dk = np.abs(mf[grp] - mf[es]) // N  # teeth apart (same class: a whole number)
             dj = np.abs(((S["j"][grp] - S["j"][es] + (mf[grp] - mf[es]) // N) + z_b // 2) % z_b - z_b // 2)
             dnt = np.hypot(*(S["nt"][grp] - S["nt"][es]).T)
@@ -292,7 +298,7 @@ def _lanes(tab: ContactTable, side: int, imp: Imperfections, slack: float = 1.05
                  + A_a * (np.abs(S["a_phi"][grp] - S["a_phi"][es]) + np.abs(S["a_phi"][es]) * 2 * pi * dk / z_g)
                  + imp.flex_ecc * (np.abs(S["a_rho"][grp] - S["a_rho"][es]) + np.abs(S["a_rho"][es]) * 2 * pi * dk / z_g))
             far = S["g"][grp] - S["g"][es] > slack * D + 1e-12
-            keep[np.isin(e, grp[far])] = False
+            keep[np.nonzero(sel)[0][far]] = False
         out.append(e[keep])
     C = max(len(x) for x in out)
     lanes = np.full((N, max(C, 1)), -1, dtype=int)
