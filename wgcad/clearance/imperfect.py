@@ -47,6 +47,8 @@ _SEED = 256
 #: candidates above this many are first sorted out on polygons 8 times finer (as the engine does)
 _FINE_ABOVE = 48
 _FINE = 8
+#: candidates measured at once on the finer polygons
+_FINE_BATCH = 256
 #: candidates refined in one call (the 16 lowest first above that)
 _ONE_CALL = 48
 
@@ -429,7 +431,7 @@ def audit_imperfect(drive, settings, imp: Imperfections, progress=None, chunk_sa
             a1 = min(A, a0 + B)
             L = _chunk_bounds(pb, eb, angles, a0, a1, z_g, S).ravel()
             m = min(_SEED, L.size)
-            idx = np.argpartition(L, m - 1)[:m]
+            idx = np.argpartition(L, m - 1)[:m].copy()  # a copy: the view would keep the chunk's whole array alive
             seed.append((L[idx], idx, a0, a1))
         allL = np.concatenate([x[0] for x in seed])
         top = np.argsort(allL, kind="stable")[:_SEED]
@@ -478,7 +480,10 @@ def audit_imperfect(drive, settings, imp: Imperfections, progress=None, chunk_sa
             fine_drive = build_drive(drive.design, tol=drive.tol / _FINE)
             ref = ImperfectScene.from_scene(Scene(fine_drive), imp)
             rot, shift = _poses_of(drive, imp, angles, cand_a, cand_k, cand_s, sections)
-            cand_v = clearance_at_poses(ref, rot, shift)["min"]
+            # in batches: a candidate on the finer polygons holds ~18 kB while measured, and their number
+            # grows with the sampling density (2900 at 0.05 deg on D1 [S4])
+            cand_v = np.concatenate([clearance_at_poses(ref, rot[a : a + _FINE_BATCH], shift[a : a + _FINE_BATCH])["min"]
+                                     for a in range(0, len(rot), _FINE_BATCH)])
             n_fine = len(cand_v)
             o = np.argsort(cand_v, kind="stable")
             cand_v, cand_a, cand_k, cand_s = cand_v[o], cand_a[o], cand_k[o], cand_s[o]
