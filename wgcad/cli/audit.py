@@ -232,7 +232,9 @@ def register(sub) -> None:
         description=textwrap.fill("Signed clearance of every flexspline tooth against its rigid neighbours over a full generator "
                     "revolution (and several sections when coned): the worst spot, entry gap and pinch, backlash. "
                     "Prints a summary; --json - puts the JSON on standard output and the summary on standard error "
-                    "(--quiet drops it), so the audit can be piped.", width=79),
+                    "(--quiet drops it), so the audit can be piped. A design's [imperfections] are honoured: every tooth is "
+                    "posed with its run-out, eccentricity and cam offset (the mesh-period, wave and mirror shortcuts do not "
+                    "hold then, and the entry gap and pinch are not computed).", width=79),
         epilog=EPILOG, formatter_class=argparse.RawDescriptionHelpFormatter)
     a.add_argument("design", help="design file (TOML), e.g. templates/d1_involute.toml")
     grp = a.add_mutually_exclusive_group()
