@@ -157,3 +157,17 @@ def test_audit_cli_honours_imperfections(tmp_path, capsys):
     assert any("entry gap" in n for n in res["not_checked"])
     text_out = capsys.readouterr().out
     assert "imperfect parts" in text_out and "NOT CHECKED: entry gap" in text_out
+
+
+def test_fixed_flexspline_keeps_the_perfect_audit_and_says_so(tmp_path):
+    # the imperfect poses take the rigid gear as the housing's member: with a fixed flexspline the
+    # audit stays on perfect parts and the summary says why
+    text = (TEMPLATES / "d1_involute.toml").read_text() + "\n[imperfections]\n"
+    text = edit_toml(edit_toml(text, "imperfections", "rigid_runout_um", "20.0"), "drive", "fixed", '"flexspline"')
+    p = tmp_path / "d1_fixed_flex.toml"
+    p.write_text(text)
+    out = tmp_path / "a.json"
+    main(["audit", str(p), "--step-deg", "4", "--json", str(out), "--quiet", "--no-refine"])
+    res = json.loads(out.read_text())
+    assert "imperfections" not in res["settings"]
+    assert any("uses perfect parts (imperfect parts are modelled with a fixed rigid gear only)" in n for n in res["not_checked"])

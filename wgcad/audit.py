@@ -67,7 +67,9 @@ def run_audit(design_path, rs: RunSettings, progress=None):
     # judged before any large allocation: outlines, sample arrays and evaluation batches
     run = {"angles": n, "sections": rs.sections, "use_period": rs.use_period, "use_waves": rs.use_waves,
            "use_mirror": rs.use_mirror, "bound": rs.bound, "exports": False}
-    imperfect = design.imperfections.any
+    # the imperfect poses (docs/models.md 6.2) take the rigid gear as the fixed member (the housing's
+    # frame); with a fixed flexspline the audit stays on perfect parts and says so (cli.common.not_modelled)
+    imperfect = design.imperfections.any and design.drive.fixed == "rigid"
     if imperfect:
         # imperfect parts: the sweep is held one chunk of generator angles at a time
         # (wgcad.clearance.imperfect), whatever its length

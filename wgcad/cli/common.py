@@ -185,5 +185,6 @@ def not_modelled(design, command: str, imperfections: bool = False) -> list[str]
         notes.append(f"[sectors]: {command} uses the plain rigid gear of drive.z_rigid = {design.drive.z_rigid} teeth; "
                      "`wgcad sector` builds and audits the sectored gear")
     if design.imperfections.any and not imperfections:
-        notes.append(f"[imperfections]: {command} uses perfect parts; `wgcad ke` computes the imperfect drive's kinematic error")
+        why = " (imperfect parts are modelled with a fixed rigid gear only)" if design.drive.fixed != "rigid" else ""
+        notes.append(f"[imperfections]: {command} uses perfect parts{why}; `wgcad ke` computes the imperfect drive's kinematic error")
     return notes
