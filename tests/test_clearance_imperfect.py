@@ -148,13 +148,15 @@ def test_audit_cli_honours_imperfections(tmp_path, capsys):
     p = tmp_path / "d1_imp.toml"
     p.write_text(text)
     out = tmp_path / "a.json"
-    rc = main(["audit", str(p), "--step-deg", "2", "--json", str(out), "--no-refine"])
+    rc = main(["audit", str(p), "--step-deg", "2", "--json", str(out), "--no-refine", "--plot", str(tmp_path / "pic")])
     assert rc == 1  # D1 interferes
     res = json.loads(out.read_text())
     assert res["settings"]["imperfections"] is True
     assert res["settings"]["mesh_period"] is False
     assert not any("uses perfect parts" in n for n in res["not_checked"])
     assert any("entry gap" in n for n in res["not_checked"])
+    for suffix in ("profile", "vs_angle", "tightest"):
+        assert (tmp_path / f"pic_{suffix}.png").stat().st_size > 10_000
     text_out = capsys.readouterr().out
     assert "imperfect parts" in text_out and "NOT CHECKED: entry gap" in text_out
 
