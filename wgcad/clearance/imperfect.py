@@ -2,22 +2,23 @@
 
 Run-out, eccentricities and a cam offset tied to a gear or the housing
 break the mesh period, the identical waves and the mirror symmetry
-(:func:`wgcad.accuracy.imperfect.shortcuts`): every sample must be looked
-at in its own right. What still saves work:
+(:func:`wgcad.accuracy.imperfect.shortcuts`): every sample has its own pose.
+What still saves work (docs/models.md 7, last paragraph):
 
-* **culling** (exact): a tooth whose tip arc stays inside the rigid tip
-  circle, taken about the rigid gear's own (eccentric) centre, is radially
-  separated from all rigid material by that gap; run-out turns rigid teeth
-  about that centre, which leaves the circle where it is;
-* **branch and bound along each tooth's track**: a tooth's clearance is
-  Lipschitz in the generator angle, with a speed bounded from the law's
-  derivatives and the errors' amplitudes (:func:`track_speed`); bounds are
-  carried only between samples of one tooth, one section, one unbroken run
-  of engaged samples, so nothing rests on a periodicity;
+* **the perfect twin**: a sample's clearance is at least the perfect
+  drive's ``c(phi)`` at its tooth angle less how far the errors move its
+  tooth against the rigid tooth it faces
+  (:mod:`wgcad.clearance.imperfect_bounds`); ``c(phi)`` is bounded by the
+  perfect engine's own culling and branch and bound, which the perfect
+  drive's symmetries still serve, on a fixed grid of tooth angles;
+* **lowest bounds first**: the samples with the lowest bounds anywhere set
+  the bar; then only samples whose bound is below the running minimum are
+  posed and measured, so nothing rests on a periodicity of the imperfect
+  drive;
 * **chunks**: the sweep is cut into blocks of generator angles; each block's
-  poses, bounds and figures are dropped once it is done, and only the
-  running minimum and the samples that can still hold it are kept, so the
-  memory does not grow with the sweep length.
+  bounds are dropped once it is done, and only the running minimum and the
+  samples that can still hold it are kept, so the memory does not grow with
+  the sweep length.
 """
 
 from __future__ import annotations
@@ -32,13 +33,14 @@ from .. import constants
 from ..accuracy.imperfect import (Imperfections, cam_offset, coning_factor, flex_deviations, rigid_poses,
                                   rigid_translation, shortcuts)
 from ..placement import pose_from_displacements, transform
+from .imperfect_bounds import ErrorBound, PerfectBound, PerfectBounds, chunk_bounds
 from .scene import Scene, clearance_at_poses, refine_min
 
 __all__ = ["ImperfectScene", "flex_poses_batch", "PerfectBound", "ErrorBound", "audit_imperfect", "chunk_angles", "CHUNK_SAMPLES"]
 
-#: samples (generator angles x teeth x sections) per chunk: ~100 bytes each are held while a
-#: chunk is searched (poses, radial bounds, figures, bounds), so 2**16 keep it near 7 MB, and
-#: the per-chunk overhead (a few array passes) stays well below the evaluations' cost
+#: samples (generator angles x teeth x sections) per chunk: a chunk's bounds and their temporaries
+#: (~10 arrays of 8 bytes a sample) hold ~5 MB at 2**16, and the per-chunk overhead (a few array
+#: passes) stays well below the evaluations' cost
 CHUNK_SAMPLES = 1 << 16
 #: polygons measured per call (as wgcad.clearance.search._CHUNK)
 _BATCH = 4096
@@ -85,12 +87,8 @@ class ImperfectScene(Scene):
     def neighbours(self, shift: np.ndarray, rot: np.ndarray):
         return Scene.neighbours(self, shift - self.center_b, rot)
 
-    def radial_gap(self, rot: np.ndarray, shift: np.ndarray) -> np.ndarray:
-        """Exact radial gap between the placed tip arcs and the rigid tip circle about its own centre, ``(K,)``."""
-        return self.tip_radial(rot, shift - self.center_b)
 
-
-def flex_poses_batch(drive, imp: Imperfections, phi_h: np.ndarray, k: np.ndarray, sections: list, state=None):
+def flex_poses_batch(drive, imp: Imperfections, phi_h: np.ndarray, k: np.ndarray, sections: list):
     """Poses of flexspline teeth ``k`` at generator angles ``phi_h`` in every section, as :func:`wgcad.accuracy.imperfect.flex_poses`.
 
     Parameters
@@ -134,183 +132,12 @@ def flex_poses_batch(drive, imp: Imperfections, phi_h: np.ndarray, k: np.ndarray
     return out
 
 
-class PerfectBound:
-    """Lower bounds of the perfect drive's clearance ``c(phi)`` of one section on a fixed grid of tooth angles (docs/models.md 7).
-
-    The grid covers one folded half-wave ``[0, pi / n_w]`` (the perfect drive
-    has identical, mirror-symmetric waves), spaced so that the Lipschitz
-    interpolation between grid points loses at most :data:`GRID_LOSS`. The
-    perfect engine's own culling and branch and bound fill it: points whose
-    bound lies below ``best + band`` are evaluated, the others keep a bound
-    at least that high. Its size does not depend on the sweep.
-    """
-
-    def __init__(self, scene: Scene, z, settings):
-        from .search import _SectionSearch
-
-        half = pi / scene.n_w
-        self.V = scene.speed_bound(np.linspace(-half, half, 4097), z)  # per rad of tooth angle, every phi
-        n = int(np.ceil(half * self.V / (2.0 * GRID_LOSS))) + 1
-        self.h = half / (n - 1)
-        self.grid = np.linspace(0.0, half, n)
-        self.search = _SectionSearch(scene, self.grid, z, settings)
-        self.search.prepare_bound()
-        self.z, self.half = z, half
-
-    @property
-    def lower(self) -> np.ndarray:
-        return self.search.lower
-
-    def at(self, phi: np.ndarray) -> np.ndarray:
-        """Lower bound of ``c`` at tooth angles ``phi`` (any), from the two grid points around each."""
-        key = np.abs((phi + self.half) % (2.0 * self.half) - self.half)
-        i0 = np.minimum((key / self.h).astype(int), len(self.grid) - 2)
-        lo = self.search.lower
-        d0 = key - self.grid[i0]
-        return np.maximum(lo[i0] - self.V * d0, lo[i0 + 1] - self.V * (self.h - d0))
-
-
-#: largest loss (mm) of the perfect bound from interpolating between its grid points: the grid
-#: holds ~6000 tooth angles per section for D1; a finer one costs more perfect evaluations
-GRID_LOSS = 0.5e-3
-
-
-class _Perfect:
-    """The perfect drive's bounds of every section (:class:`PerfectBound`), searched together: the best of any prunes all."""
-
-    def __init__(self, scene: Scene, sections: list, settings):
-        from .search import _evaluate
-
-        self._evaluate = _evaluate
-        self.scene, self.sections = scene, sections
-        self.pb = [PerfectBound(scene, z, settings) for z in sections]
-        self.res = [p.search for p in self.pb]
-        self.best = _evaluate(scene, self.res, [r.coarse() for r in self.res], sections)
-        self.band = -np.inf
-
-    def extend(self, band: float) -> None:
-        """Evaluate every grid point whose bound lies below ``best + band``; the others keep bounds at least that high."""
-        if band <= self.band:
-            return
-        ev, sc, res, zs = self._evaluate, self.scene, self.res, self.sections
-        for stride in (64, 16, 4, 1):
-            self.best = ev(sc, res, [r.candidates(stride, self.best + band) for r in res], zs)
-        self.best = ev(sc, res, [r.culled_needed(self.best + band) for r in res], zs)
-        self.band = band
-
-    @property
-    def evaluated(self) -> int:
-        return int(sum(r.evaluated.sum() for r in self.res))
-
-
-class ErrorBound:
-    """How far the errors move a flexspline tooth relative to the rigid teeth it faces, per sample, mm.
-
-    A sample's clearance differs from the perfect drive's at the same tooth
-    angle by at most the largest displacement of a point of the tooth in
-    the frame of the rigid tooth it is measured against (a signed distance,
-    and a penetration depth, move by no more than the bodies do). To first
-    order that displacement is one vector for the whole tooth
-    (docs/models.md 6.2), with ``t``, ``e`` the tangent and radius at the
-    tooth's material angle ``mat``:
-
-        (dalpha r_m - dev(mat) r_b) t + drho e + c E - T
-
-    (the flexspline's run-out and eccentricity along and across the rim,
-    the rigid tooth's run-out turn, the cam offset ``E`` scaled by coning,
-    the rigid gear's eccentric shift ``T``); errors of the same direction
-    cancel in it. What the vector leaves out is bounded term by term
-    (:meth:`remainder`): the rim's deformation and the tooth's turn under
-    ``dalpha``, the tooth's extent about its centre line, and the rigid
-    teeth within three pitches having run-out turns other than ``dev(mat)``.
-    """
-
-    def __init__(self, scene: Scene, imp: Imperfections, sections: list):
-        drive = scene.drive
-        self.imp, self.scene = imp, scene
-        self.z_g, self.z_b = scene.z_g, scene.z_b
-        self.r_m = r_m = drive.r_m
-        self.r_g, self.r_b = drive.flex.r, drive.rigid.r
-        self.u = scene.ratios["u_hg"]
-        self.T = rigid_translation(imp)
-        phi = np.linspace(-pi, pi, 8192, endpoint=False)
-        lever_f = float(np.hypot(scene.flex_local[:, 0] - r_m, scene.flex_local[:, 1]).max())
-        R_loc = np.hypot(scene.flex_local[:, 0], scene.flex_local[:, 1])
-        half_w = float(np.abs(scene.flex_local[:, 1]).max())
-        gamma_b = 2.0 * pi / scene.z_b
-        self.a_b = 0.5 * imp.rigid_runout / self.r_b  # largest run-out turn of a rigid tooth, rad
-        da_max = (0.5 * imp.flex_runout + abs(imp.flex_ecc)) / self.r_g
-        self.k_gain, self.rho_gain, self.dev_gain, self.fixed, self.cz = [], [], [], [], []
-        for z in sections:
-            st = scene.law(z).state(phi)
-            w_max, v_max = float(np.abs(st.w).max()), float(np.abs(st.v).max())
-            dth = float(np.abs(st.dtheta).max())
-            # 1 % on every maximum over the grid of rim angles (they vary by far less between its points)
-            self.k_gain.append(1.01 * (float(np.hypot(st.dw - st.v, st.w + st.dv).max()) + r_m * da_max
-                                       + (1.0 + dth) * lever_f))
-            self.rho_gain.append(1.01 * (float(np.abs(st.theta).max()) + da_max * (1.0 + dth)))
-            # a flexspline tooth point p: | |p| - r_b | and its angle from mat (tooth half-width, v, theta)
-            rad_spread = float(max(abs(R_loc.max() + w_max - self.r_b), abs(R_loc.min() - w_max - self.r_b)))
-            ang = half_w / R_loc.min() + v_max / r_m + float(np.abs(st.theta).max())
-            self.dev_gain.append(1.01 * (rad_spread + self.r_b * ang))
-            self.fixed.append(1.01 * self.a_b * 3.0 * gamma_b * (R_loc.max() + w_max))
-            self.cz.append(coning_factor(drive, z))
-        # second order: the rigid frame's own turn applied to the displacement (|dev| |Delta|), bounded
-        # with the largest displacement the amplitudes allow
-        amp = (0.5 * imp.flex_runout + 2 * abs(imp.flex_ecc) + abs(imp.cam_cam) + abs(imp.cam_flex) + abs(imp.cam_fixed)
-               + abs(imp.rigid_ecc) + 0.5 * imp.rigid_runout)
-        self.second = self.a_b * amp
-
-    def bound(self, k, phi_h) -> np.ndarray:
-        """Largest relative displacement (mm) of teeth ``k`` (Kk,) at generator angles ``phi_h`` (B,), every section, ``(S, Kk, B)``."""
-        imp = self.imp
-        k = np.asarray(k)
-        phi_h = np.asarray(phi_h, dtype=float)
-        da, dr = flex_deviations(imp, k, self.z_g, self.r_g)
-        da, dr = da[:, None], dr[:, None]
-        # mat = A_k + B_h: its sines and cosines from the two factors' (outer products, no trigonometry on K x B)
-        A, Bh = 2.0 * pi * k / self.z_g, phi_h / self.u
-        ca, sa, cb, sb = np.cos(A)[:, None], np.sin(A)[:, None], np.cos(Bh)[None, :], np.sin(Bh)[None, :]
-        c, s = ca * cb - sa * sb, sa * cb + ca * sb
-        p = imp.rigid_runout_phase - imp.rigid_install
-        dev = self.a_b * (s * np.cos(p) + c * np.sin(p))  # a_b sin(mat + p)
-        E = cam_offset(imp, phi_h, phi_h / self.u)  # (B, 2)
-        tan = da * self.r_m - dev * self.r_b
-        bx = -tan * s + dr * c - self.T[0]
-        by = tan * c + dr * s - self.T[1]
-        ada, adr, adev = np.abs(da), np.abs(dr), np.abs(dev)
-        out = np.empty((len(self.cz), len(k), len(phi_h)))
-        for si, cz in enumerate(self.cz):
-            rem = ada * self.k_gain[si] + adr * self.rho_gain[si] + adev * self.dev_gain[si] + (self.fixed[si] + self.second)
-            out[si] = np.hypot(bx + cz * E[None, :, 0], by + cz * E[None, :, 1]) + rem
-        return out
-
-    def largest(self, angles: np.ndarray) -> float:
-        """The largest :meth:`bound` over the teeth and (up to 90 of the) angles, mm.
-
-        Only the width of the perfect drive's search rests on it, not a
-        bound's validity, so a subsample of the angles is enough.
-        """
-        return float(self.bound(np.arange(self.z_g), angles[:: max(1, len(angles) // 90)]).max())
-
-
 def _evaluate_poses(scene, rot, shift) -> np.ndarray:
     vals = np.empty(len(rot))
     for a in range(0, len(rot), _BATCH):
         b = min(a + _BATCH, len(rot))
         vals[a:b] = clearance_at_poses(scene, rot[a:b], shift[a:b])["min"]
     return vals
-
-
-def _chunk_bounds(pb, eb, angles, a0, a1, z_g, S):
-    """Lower bounds of the imperfect clearance of samples (section, tooth, angle) of angles ``a0:a1``, ``(S, z_g, B)``."""
-    ph = angles[a0:a1]
-    k = np.arange(z_g)[:, None]
-    phi = 2.0 * pi * k / z_g + ph[None, :] * (1.0 / eb.u - 1.0)
-    out = -eb.bound(np.arange(z_g), ph)
-    for si in range(S):
-        out[si] += pb[si].at(phi)
-    return out
 
 
 def _classify(scene: Scene, rot: float, shift: np.ndarray, j: int) -> str:
@@ -392,7 +219,7 @@ def audit_imperfect(drive, settings, imp: Imperfections, progress=None, chunk_sa
     e_max = eb.largest(angles)
     # the perfect drive's bounds, first as far as a perfect audit needs them; then as far as the sweep
     # needs them: a grid point whose bound is above (imperfect best + margin + e_max) prunes every sample
-    perfect = _Perfect(scene, sections, settings)
+    perfect = PerfectBounds(scene, sections, settings)
     perfect.extend(margin)
     pb = perfect.pb
     if progress is not None:
@@ -429,7 +256,7 @@ def audit_imperfect(drive, settings, imp: Imperfections, progress=None, chunk_sa
         seed = []
         for a0 in range(0, A, B):
             a1 = min(A, a0 + B)
-            L = _chunk_bounds(pb, eb, angles, a0, a1, z_g, S).ravel()
+            L = chunk_bounds(pb, eb, angles, a0, a1, z_g, S).ravel()
             m = min(_SEED, L.size)
             idx = np.argpartition(L, m - 1)[:m].copy()  # a copy: the view would keep the chunk's whole array alive
             seed.append((L[idx], idx, a0, a1))
@@ -448,7 +275,7 @@ def audit_imperfect(drive, settings, imp: Imperfections, progress=None, chunk_sa
         done = set(zip(*(np.concatenate(x).tolist() for x in zip(*sel))))
         for a0 in range(0, A, B):
             a1 = min(A, a0 + B)
-            L = _chunk_bounds(pb, eb, angles, a0, a1, z_g, S).ravel()
+            L = chunk_bounds(pb, eb, angles, a0, a1, z_g, S).ravel()
             idx = np.nonzero(L < best + margin)[0]
             n_pruned += L.size - idx.size
             idx = idx[np.argsort(L[idx], kind="stable")]
