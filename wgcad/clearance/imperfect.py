@@ -61,13 +61,16 @@ def chunk_angles(z_g: int, sections: int, chunk_samples: int = CHUNK_SAMPLES) ->
 
 
 class ImperfectScene(Scene):
-    """A :class:`Scene` whose rigid teeth carry the rigid gear's run-out and eccentricity.
+    """A :class:`Scene` whose rigid teeth carry the rigid gear's run-out, in the frame of the rigid gear's own centre.
 
-    Built from a perfect scene (templates and exact curves are shared);
-    :meth:`neighbours` finds a tooth's rigid neighbours by its angle about
-    the rigid gear's own centre. Run-out turns a tooth by at most
-    ``F_b / (2 r_b)``, far below half a pitch, so the bracketing teeth stay
-    the bracketing teeth (and the third-nearest check covers the next one).
+    Built from a perfect scene (templates and exact curves are shared). The
+    rigid gear's eccentric shift ``T`` is taken out of the frame: the rigid
+    teeth stay about the origin (turned by their run-out) and flexspline
+    poses are given relative to the rigid centre (:meth:`relative`), so the
+    perfect scene's neighbour search and third-tooth bound, which measure
+    angles about the origin, hold as they are. Run-out turns a tooth by at
+    most ``F_b / (2 r_b)``, far below half a pitch, so the bracketing teeth
+    stay the bracketing teeth.
     """
 
     @classmethod
@@ -77,15 +80,16 @@ class ImperfectScene(Scene):
         new.imp = imp
         new.center_b = rigid_translation(imp)
         rot, shift = rigid_poses(scene.drive, imp)
-        new.rigid_rot, new.rigid_shift = rot, shift
-        new.rigid_pts = transform(scene.rigid.local, rot, shift)
+        new.rigid_rot, new.rigid_shift = rot, shift - new.center_b  # zero: the frame of the rigid centre
+        new.rigid_pts = transform(scene.rigid.local, rot, new.rigid_shift)
         new.rigid_pts.setflags(write=False)
         new.rigid_geoms = shapely.polygons(new.rigid_pts)
         shapely.prepare(new.rigid_geoms)
         return new
 
-    def neighbours(self, shift: np.ndarray, rot: np.ndarray):
-        return Scene.neighbours(self, shift - self.center_b, rot)
+    def relative(self, shift: np.ndarray) -> np.ndarray:
+        """Flexspline shifts (rigid-gear frame) in the frame of the rigid gear's own centre."""
+        return shift - self.center_b
 
 
 def flex_poses_batch(drive, imp: Imperfections, phi_h: np.ndarray, k: np.ndarray, sections: list):
@@ -169,14 +173,14 @@ def _classify(scene: Scene, rot: float, shift: np.ndarray, j: int) -> str:
 
 
 def _poses_of(drive, imp, angles, a_idx, k_idx, s_idx, sections):
-    """Poses of samples (angle index, tooth, section index), ``(K,)``, ``(K, 2)``."""
+    """Poses of samples (angle index, tooth, section index) relative to the rigid gear's centre (:class:`ImperfectScene`), ``(K,)``, ``(K, 2)``."""
     rot = np.empty(len(a_idx))
     shift = np.empty((len(a_idx), 2))
     for si, z in enumerate(sections):
         sel = np.nonzero(s_idx == si)[0]
         if sel.size:
             rot[sel], shift[sel] = flex_poses_batch(drive, imp, angles[a_idx[sel]], k_idx[sel], [z])[0]
-    return rot, shift
+    return rot, shift - rigid_translation(imp)
 
 
 def audit_imperfect(drive, settings, imp: Imperfections, progress=None, chunk_samples: int = CHUNK_SAMPLES):

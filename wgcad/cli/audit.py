@@ -213,6 +213,7 @@ def _audit_pngs(drive, result):
         imp = Imperfections.from_spec(drive.design.imperfections)
         scene = ImperfectScene.from_scene(scene, imp)
         rot, shift = flex_poses_batch(drive, imp, np.full(len(k), phi_h), k, [z])[0]
+        shift = scene.relative(shift)  # drawn in the frame of the rigid gear's own centre
     teeth = transform(scene.flex_local, rot, shift)
     lo, up, _ = scene.neighbours(shift, rot)
     rig_idx = np.unique(np.concatenate([lo, up]))
