@@ -220,3 +220,21 @@ def test_deep_overlaps_are_flagged_where_the_linear_model_fails():
         worst[z] = (res.deep_overlap_fraction, max(errs))
     assert worst[0.0][0] == 1.0 and worst[0.0][1] > 100.0
     assert worst[16.0][0] == 0.0 and worst[16.0][1] < 2.0
+
+
+def test_finite_differences_started_near_the_contact_equal_those_from_rest(monkeypatch):
+    # The FD sensitivities' solves start 1 um of gap before the unperturbed contact (ke._FD_START) rather
+    # than from rest. Both end at the same convergence test (1e-8 mm gap), so the sensitivities agree to
+    # the FD's own noise, 1e-10 rad / 1e-4 mm = 1e-6 rad/mm on |nt| ~ 1/80 per mm: 1e-4 relative, and the
+    # KE to ~0.1 mm x 1e-6 rad/mm = 1e-7 rad = 0.02 arcsec. D2 [S4], open end, 8 per mesh.
+    drive = build_drive(load_design(TEMPLATES / "d2_imperfect.toml"))
+    imp = Imperfections.from_spec(drive.design.imperfections)
+    near = K.contact_table(drive, imp, 8, sections=[0.0])
+    monkeypatch.setattr(K, "_FD_START", 0.0)
+    rest = K.contact_table(drive, imp, 8, sections=[0.0])
+    for side in (1, -1):
+        a, b = near.sides[side]["nt"], rest.sides[side]["nt"]
+        assert np.abs(a - b).max() <= 1e-4 * np.abs(b).max()
+    a = K.kinematic_error(drive, imp, table=near, samples=8 * 202 * 10)
+    b = K.kinematic_error(drive, imp, table=rest, samples=8 * 202 * 10)
+    assert np.abs(a.ke - b.ke).max() * AS < 0.02

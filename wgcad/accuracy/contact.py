@@ -65,7 +65,7 @@ def _turn(rot, shift, t):
 
 
 def closing_rotation(flex: Template, rot, shift, rigid: Template, rot_b, shift_b, side: float,
-                     reach: float) -> Contact:
+                     reach: float, start=None) -> Contact:
     """Rotation of the flexspline (about the axis, direction ``side``) that brings each tooth into contact with its rigid tooth.
 
     Newton's method on the gap (it falls at ``s (z x p) . n`` per radian),
@@ -85,6 +85,11 @@ def closing_rotation(flex: Template, rot, shift, rigid: Template, rot_b, shift_b
         Direction of rotation (+1 counter-clockwise).
     reach : float
         Largest rotation looked at, rad; pairs that need more get ``inf``.
+    start : (K,) float, optional
+        Rotations (rad, direction ``side``) to start from instead of 0. Only
+        a start where the pair is still apart (before its contact) is safe:
+        from an overlapping start the search turns back and can end at
+        another contact.
 
     Returns
     -------
@@ -111,7 +116,7 @@ def closing_rotation(flex: Template, rot, shift, rigid: Template, rot_b, shift_b
             d[over] = np.minimum(d[over], -1e-15)
         return d, line
 
-    t = np.zeros(K)
+    t = np.zeros(K) if start is None else np.array(np.broadcast_to(np.asarray(start, dtype=float), (K,)))
     lo_t = np.full(K, -np.inf)  # largest rotation known apart, and its gap
     lo_d = np.full(K, np.nan)
     hi_t = np.full(K, np.inf)  # smallest rotation known overlapping, and its (negative) gap
