@@ -185,3 +185,56 @@ def test_contact_ke_agrees_with_the_double_flank_formula_to_first_order(d2):
     # the flexspline turns back by dT / R; 3 % covers the contacts' spread about the zone's axis
     # (teeth within +-10 deg: the tangential direction there differs by cos 10 deg = 0.985)
     np.testing.assert_allclose(d1, -dT / R, atol=0.03 * np.abs(dT).max() / R)
+
+
+def test_contact_normals_do_not_depend_on_the_search_path():
+    # A contact's normal (hence its sensitivity nt) was read at the search's last iterate; where a corner
+    # meets the other outline that direction depends on the path the search took, and on D2 with its
+    # [S4] errors 11 % of the KE samples were 4 to 35 arcsec off the direct computation (exact poses,
+    # fresh contact search), among them these. It is now read at a fixed 10 nm gap (contact.BACKOFF).
+    # The linear model's own residual at the [S4] amplitudes (0.1 mm, second order) measured 0.55 arcsec
+    # at most over 60 random samples (centre section, 8 per mesh): 1 arcsec here.
+    drive = build_drive(load_design(TEMPLATES / "d2_imperfect.toml"))
+    imp = Imperfections.from_spec(drive.design.imperfections)
+    tab = K.contact_table(drive, imp, 8, sections=[None])
+    a = K.kinematic_error(drive, imp, table=tab)
+    for i, side, arr in ((59, 1, a.delta_w), (74, 1, a.delta_w), (82, 1, a.delta_w), (1041, -1, a.delta_n),
+                         (158450, 1, a.delta_w)):
+        ref = K.closing_direct(drive, imp, a.phi_h[i], side * tab.side_w, sections=[None])
+        assert abs(arr[i] - ref) * AS < 1.0, (i, arr[i] * AS, ref * AS)
+
+
+def test_deep_overlaps_are_flagged_where_the_linear_model_fails():
+    # Validity range of the linear error model (ke.DEEP_OVERLAP): on D2 with its [S4] errors the open end
+    # (z = 0) interferes so deeply that every first contact turns back by > 600'' to separate, and there
+    # the table's closing rotations are hundreds of arcsec off the direct computation; mid-face (z = 16)
+    # no first contact is that deep and they agree within 2'' (measured 1.8'' at most, 250 samples).
+    drive = build_drive(load_design(TEMPLATES / "d2_imperfect.toml"))
+    imp = Imperfections.from_spec(drive.design.imperfections)
+    worst = {}
+    for z in (0.0, 16.0):
+        tab = K.contact_table(drive, imp, 8, sections=[z])
+        res = K.kinematic_error(drive, imp, table=tab, samples=8 * 202 * 4)
+        errs = [abs(res.delta_n[i] - K.closing_direct(drive, imp, res.phi_h[i], -tab.side_w, sections=[z])) * AS
+                for i in (101, 1733, 2900, 5631 % len(res.ke), 6001)]
+        worst[z] = (res.deep_overlap_fraction, max(errs))
+    assert worst[0.0][0] == 1.0 and worst[0.0][1] > 100.0
+    assert worst[16.0][0] == 0.0 and worst[16.0][1] < 2.0
+
+
+def test_finite_differences_started_near_the_contact_equal_those_from_rest(monkeypatch):
+    # The FD sensitivities' solves start 1 um of gap before the unperturbed contact (ke._FD_START) rather
+    # than from rest. Both end at the same convergence test (1e-8 mm gap), so the sensitivities agree to
+    # the FD's own noise, 1e-10 rad / 1e-4 mm = 1e-6 rad/mm on |nt| ~ 1/80 per mm: 1e-4 relative, and the
+    # KE to ~0.1 mm x 1e-6 rad/mm = 1e-7 rad = 0.02 arcsec. D2 [S4], open end, 8 per mesh.
+    drive = build_drive(load_design(TEMPLATES / "d2_imperfect.toml"))
+    imp = Imperfections.from_spec(drive.design.imperfections)
+    near = K.contact_table(drive, imp, 8, sections=[0.0])
+    monkeypatch.setattr(K, "_FD_START", 0.0)
+    rest = K.contact_table(drive, imp, 8, sections=[0.0])
+    for side in (1, -1):
+        a, b = near.sides[side]["nt"], rest.sides[side]["nt"]
+        assert np.abs(a - b).max() <= 1e-4 * np.abs(b).max()
+    a = K.kinematic_error(drive, imp, table=near, samples=8 * 202 * 10)
+    b = K.kinematic_error(drive, imp, table=rest, samples=8 * 202 * 10)
+    assert np.abs(a.ke - b.ke).max() * AS < 0.02

@@ -67,6 +67,15 @@ def run_audit(design_path, rs: RunSettings, progress=None):
     # judged before any large allocation: outlines, sample arrays and evaluation batches
     run = {"angles": n, "sections": rs.sections, "use_period": rs.use_period, "use_waves": rs.use_waves,
            "use_mirror": rs.use_mirror, "bound": rs.bound, "exports": False}
+    # the imperfect poses (docs/models.md 6.2) take the rigid gear as the fixed member (the housing's
+    # frame); with a fixed flexspline the audit stays on perfect parts and says so (cli.common.not_modelled)
+    imperfect = design.imperfections.any and design.drive.fixed == "rigid"
+    if imperfect:
+        # imperfect parts: the sweep is held one chunk of generator angles at a time
+        # (wgcad.clearance.imperfect), whatever its length
+        from .clearance.imperfect import chunk_angles
+
+        run.update(angles=min(n, chunk_angles(design.drive.z_flex, rs.sections)), use_period=False)
     drive = build_drive(design, tol=rs.chord_tol_um * 1e-3, max_memory_mb=rs.max_memory_mb, run=run)
     angles = np.deg2rad(np.arange(n) * (360.0 / n))
     settings = AuditSettings(
@@ -80,4 +89,9 @@ def run_audit(design_path, rs: RunSettings, progress=None):
         interference_tol=rs.interference_tol_um * 1e-3,
         refine=rs.refine,
     )
+    if imperfect:
+        from .accuracy.imperfect import Imperfections
+        from .clearance.imperfect import audit_imperfect
+
+        return drive, audit_imperfect(drive, settings, Imperfections.from_spec(design.imperfections), progress=progress)
     return drive, audit(drive, settings, progress=progress)

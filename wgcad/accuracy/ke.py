@@ -46,7 +46,7 @@ from .imperfect import (Imperfections, cam_offset, coning_factor, flex_deviation
                         rigid_deviations, rigid_poses, rigid_translation)
 
 __all__ = ["ContactTable", "contact_table", "KEResult", "kinematic_error", "install_angle_scan",
-           "optimize_install_angle", "closing_direct", "spectrum", "expected_orders", "DEFAULT_N"]
+           "optimize_install_angle", "closing_direct", "spectrum", "expected_orders", "DEFAULT_N", "DEEP_OVERLAP"]
 
 #: generator angles per mesh period (2 pi / z_b); benchmarks/ke.py measures the error of
 #: 16 against 160: it is what keeps the full D2 revolution (323 200 angles) within seconds
@@ -181,6 +181,8 @@ def contact_table(drive, imp: Imperfections, n_per_mesh: int = DEFAULT_N, sectio
     return tab
 
 
+#: gap (mm) before the unperturbed contact where the finite-difference solves start (0: from rest)
+_FD_START = 1e-3
 #: translation (mm) of the rigid tooth for the finite-difference sensitivities: 0.1 um, where the
 #: closing rotation (converged to a 1e-8 mm gap) is known to 1e-4 of the difference
 _FD_H = 1e-4
@@ -201,11 +203,14 @@ def _refine(tab: ContactTable, side: int, imp: Imperfections, flex, rigid, reach
         return
     rb = (S["j"][e] + 0.5) * 2 * pi / tab.z_b
     nt = np.empty((e.size, 2))
+    # started 1 um of gap before the unperturbed contact (apart, ten times the perturbation): a Newton
+    # step or two to the perturbed one instead of five or six from rest
+    start = S["g"][e] - _FD_START * np.hypot(S["nt"][e, 0], S["nt"][e, 1]) if _FD_START else None
     for ax in (0, 1):
         dv = np.zeros((e.size, 2))
         dv[:, ax] = _FD_H
-        cp = closing_rotation(flex, S["rot"][e], S["shift"][e], rigid, rb, dv, side, reach)
-        cm = closing_rotation(flex, S["rot"][e], S["shift"][e], rigid, rb, -dv, side, reach)
+        cp = closing_rotation(flex, S["rot"][e], S["shift"][e], rigid, rb, dv, side, reach, start=start)
+        cm = closing_rotation(flex, S["rot"][e], S["shift"][e], rigid, rb, -dv, side, reach, start=start)
         nt[:, ax] = (cp.delta - cm.delta) / (2 * _FD_H)
     # a difference across a switch of the touching feature is no derivative: keep the nearest-point
     # normal's value there (within 50 % of it is a slide along one feature; the corner cases differ by ~10 %)
@@ -227,8 +232,9 @@ def _geometry(tab: ContactTable, side: int, i: np.ndarray, e: np.ndarray) -> dic
     # the table frame turned to the actual one by whole rigid pitches: (m' + sigma i) / N, with m'
     # the lattice index of the folded tooth angle (docs/models.md 7: phi z_g / z_b + phi_h)
     sb = (((m + M // 2) % M - M // 2) + tab.sigma * i) // N
-    rho = (2 * pi / z_b) * sb
-    cr, sr = np.cos(rho), np.sin(rho)
+    # rho = 2 pi sb / z_b: its cosine and sine looked up per whole rigid pitch (no trigonometry per sample)
+    ang = (2 * pi / z_b) * np.arange(z_b)
+    cr, sr = np.cos(ang)[sb % z_b], np.sin(ang)[sb % z_b]
     ntx, nty = S["nt"][e, 0], S["nt"][e, 1]
     return {"k": k, "sb": sb, "nx": cr * ntx - sr * nty, "ny": sr * ntx + cr * nty}
 
@@ -242,10 +248,12 @@ def _terms(tab: ContactTable, side: int, imp: Imperfections, i: np.ndarray, e: n
     if which == "rigid":
         T = rigid_translation(imp)
         j = (S["j"][e] + geo["sb"]) % z_b
-        return T[0] * nx + T[1] * ny + rigid_deviations(imp, j, z_b, tab.r_b) * S["a_beta"][e]
+        # per-tooth values looked up (the same formula at the same whole tooth numbers): no sine per sample
+        return T[0] * nx + T[1] * ny + rigid_deviations(imp, np.arange(z_b), z_b, tab.r_b)[j] * S["a_beta"][e]
     if which == "flex":
-        da, dr = flex_deviations(imp, geo["k"], z_g, tab.r_g)
-        return -da * S["a_phi"][e] - dr * S["a_rho"][e]
+        da, dr = flex_deviations(imp, np.arange(z_g), z_g, tab.r_g)
+        k = geo["k"]
+        return -da[k] * S["a_phi"][e] - dr[k] * S["a_rho"][e]
     phi_h = tab.sigma * i * (2 * pi / (z_b * tab.N))
     E = cam_offset(imp, phi_h, phi_h / gear_ratios(z_g, z_b)["u_hg"], parts=("flex", "fixed"))
     return -S["c"][e] * (E[..., 0] * nx + E[..., 1] * ny)
@@ -273,6 +281,9 @@ def _lanes(tab: ContactTable, side: int, imp: Imperfections, slack: float = 1.05
     phi = _fold(2 * pi * S["m"] / M)
     zone = np.where(np.abs(phi) <= 0.5 * pi, 0, 1)  # 0: the zone around +x, 1: around -x (two waves)
     cls = (-tab.sigma * np.arange(N)) % N  # lattice class of sample residue r
+    mf = (S["m"] + M // 2) % M - M // 2  # folded lattice index
+    cq = np.round(S["c"] * 1e6).astype(int)
+    group = np.unique(np.stack([zone, cq], 1), axis=0, return_inverse=True)[1].ravel()  # (zone, section) of each contact
     out = []
     for r in range(N):
         e = np.nonzero(S["m"] % N == cls[r])[0]
@@ -280,10 +291,10 @@ def _lanes(tab: ContactTable, side: int, imp: Imperfections, slack: float = 1.05
             out.append(e)
             continue
         keep = S["g"][e] - B[e] <= np.min(S["g"][e] + B[e])
-        for key in np.unique(np.stack([zone[e], np.round(S["c"][e] * 1e6).astype(int)], 1), axis=0):
-            grp = e[(zone[e] == key[0]) & (np.round(S["c"][e] * 1e6).astype(int) == key[1])]
+        for gk in np.unique(group[e]):
+            sel = group[e] == gk
+            grp = e[sel]
             es = grp[np.argmin(S["g"][grp])]
-            mf = (S["m"] + M // 2) % M - M // 2  # folded lattice index
             dk = np.abs(mf[grp] - mf[es]) // N  # teeth apart (same class: a whole number)
             dj = np.abs(((S["j"][grp] - S["j"][es] + (mf[grp] - mf[es]) // N) + z_b // 2) % z_b - z_b // 2)
             dnt = np.hypot(*(S["nt"][grp] - S["nt"][es]).T)
@@ -292,7 +303,7 @@ def _lanes(tab: ContactTable, side: int, imp: Imperfections, slack: float = 1.05
                  + A_a * (np.abs(S["a_phi"][grp] - S["a_phi"][es]) + np.abs(S["a_phi"][es]) * 2 * pi * dk / z_g)
                  + imp.flex_ecc * (np.abs(S["a_rho"][grp] - S["a_rho"][es]) + np.abs(S["a_rho"][es]) * 2 * pi * dk / z_g))
             far = S["g"][grp] - S["g"][es] > slack * D + 1e-12
-            keep[np.isin(e, grp[far])] = False
+            keep[np.nonzero(sel)[0][far]] = False
         out.append(e[keep])
     C = max(len(x) for x in out)
     lanes = np.full((N, max(C, 1)), -1, dtype=int)
@@ -325,6 +336,15 @@ def _side_arrays(tab, side, imp, lanes, i, lever):
     return base, X, Y
 
 
+#: closing rotation (rad, negative: turning back) of the first contact's perfect pair beyond which the linear
+#: model is not trusted: 300 arcsec. Measured on D2 against the direct computation (exact poses, fresh
+#: contact search; 250 samples, each section alone, [S4] errors and 0.3 of them): first contacts whose pair
+#: is apart were within 0.5''; turning back by up to 300'' within 1.8''; by more than 600'' (the open end
+#: with the full [S4] errors) up to 650'' off, median 38''. The separating feature of so deep an overlap
+#: changes with the errors. 300..600'' were not met.
+DEEP_OVERLAP = 300.0 / 206264.80624709636
+
+
 def _theta(tab, dw, dn):
     lm = dw + dn
     return tab.side_w * (dw - 0.5 * np.minimum(lm, 0.0)), lm
@@ -343,6 +363,10 @@ class KEResult:
     turns: float
     engagement: str
     u: float
+    #: fraction of the samples whose first contact (either side) is a pair that, perfect, overlaps so deeply
+    #: that it must turn back by more than :data:`DEEP_OVERLAP` to separate: there the linear model can
+    #: be off by hundreds of arcseconds (the separating feature changes with the errors)
+    deep_overlap_fraction: float = 0.0
 
     @property
     def flex_turns_per_record(self) -> float:
@@ -377,15 +401,20 @@ def kinematic_error(drive, imp: Imperfections, n_per_mesh: int = DEFAULT_N, sect
     I = _record(tab) if samples is None else int(samples)
     lw, ln = _lanes(tab, tab.side_w, imp), _lanes(tab, -tab.side_w, imp)
     dw, dn = np.empty(I), np.empty(I)
+    deep = np.zeros(I, dtype=bool)
     for a in range(0, I, _CHUNK):
         i = np.arange(a, min(I, a + _CHUNK))
-        dw[a : a + len(i)] = _side_arrays(tab, tab.side_w, imp, lw, i, None)[0].min(axis=1)
-        dn[a : a + len(i)] = _side_arrays(tab, -tab.side_w, imp, ln, i, None)[0].min(axis=1)
+        for side, lanes, out in ((tab.side_w, lw, dw), (-tab.side_w, ln, dn)):
+            base = _side_arrays(tab, side, imp, lanes, i, None)[0]
+            first = np.argmin(base, axis=1)
+            out[a : a + len(i)] = base[np.arange(len(i)), first]
+            e = lanes[i % tab.N, first]
+            deep[a : a + len(i)] |= (e >= 0) & (tab.sides[side]["g"][np.maximum(e, 0)] < -DEEP_OVERLAP)
     theta, lm = _theta(tab, dw, dn)
     phi_h = tab.sigma * np.arange(I) * 2 * pi / (tab.z_b * tab.N)
     eng = "single-flank (backlash)" if lm.min() >= 0 else "double-flank (interference)" if lm.max() < 0 else "mixed"
     return KEResult(phi_h, dw, dn, lm, -(theta - theta[0]), tab.N, I / (tab.N * tab.z_b), eng,
-                    abs(gear_ratios(tab.z_g, tab.z_b)["u_hg"]))
+                    abs(gear_ratios(tab.z_g, tab.z_b)["u_hg"]), float(deep.mean()) if I else 0.0)
 
 
 def install_angle_scan(tab: ContactTable, imp: Imperfections, angles, lever: str = "rigid") -> np.ndarray:

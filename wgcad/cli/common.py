@@ -175,12 +175,16 @@ def circle(radius: float, tol: float):
     return np.stack([radius * np.cos(t), radius * np.sin(t)], axis=1)
 
 
-def not_modelled(design, command: str) -> list[str]:
-    """What a design's optional tables ask for that ``command`` does not model: said in every summary, never silent."""
+def not_modelled(design, command: str, imperfections: bool = False) -> list[str]:
+    """What a design's optional tables ask for that ``command`` does not model: said in every summary, never silent.
+
+    ``imperfections``: the command models ``[imperfections]`` (the 2D audit does).
+    """
     notes = []
     if design.sectors.active:
         notes.append(f"[sectors]: {command} uses the plain rigid gear of drive.z_rigid = {design.drive.z_rigid} teeth; "
                      "`wgcad sector` builds and audits the sectored gear")
-    if design.imperfections.any:
-        notes.append(f"[imperfections]: {command} uses perfect parts; `wgcad ke` computes the imperfect drive's kinematic error")
+    if design.imperfections.any and not imperfections:
+        why = " (imperfect parts are modelled with a fixed rigid gear only)" if design.drive.fixed != "rigid" else ""
+        notes.append(f"[imperfections]: {command} uses perfect parts{why}; `wgcad ke` computes the imperfect drive's kinematic error")
     return notes

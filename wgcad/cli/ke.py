@@ -56,6 +56,11 @@ def cmd_ke(args) -> int:
     print(f"  engagement: {res.engagement}; lost motion {out['lost_motion_arcsec']['min']:.1f} .. {out['lost_motion_arcsec']['max']:.1f} arcsec")
     print(f"  largest KE (peak to peak): {out['ke_pp_arcsec']:.2f} arcsec; perfect parts: {out['intrinsic_ke_pp_arcsec']:.3f} arcsec")
     print(f"  strongest orders: " + ", ".join(f"{s['order']:g} ({s['amplitude_arcsec']:.2f}'')" for s in out["spectrum_top"][:4]))
+    out["deep_overlap_fraction"] = round(res.deep_overlap_fraction, 4)
+    if res.deep_overlap_fraction > 0:
+        print(f"  WARNING: at {100 * res.deep_overlap_fraction:.1f} % of the angles the first contact is a pair that overlaps "
+              f"so deeply (turning back > {K.DEEP_OVERLAP * _AS:.0f} arcsec to separate) that the linear error model does not "
+              "hold there: the KE can be off by hundreds of arcsec (docs/models.md 6.2); reduce the interference or use the elastic model")
     if res.lost_motion.min() < 0:
         print("  note: the teeth interfere (negative lost motion): the rigid-body position splits the interference; "
               "errors must stay well below the overlap for the linear model (docs/models.md 6.2) - under load use the elastic model")

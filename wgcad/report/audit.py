@@ -107,7 +107,13 @@ def audit_summary(name: str, res: dict) -> str:
     else:
         lines.append("  no interference")
     e = res["entry"]
-    if res["entry_gap_um"] is not None:
+    if st.get("imperfections"):
+        held = [k.replace("_", " ") for k, v in st["shortcuts_that_hold"].items() if v]
+        lines.append("  imperfect parts ([imperfections]): every tooth posed with its errors; shortcuts that still hold: "
+                     + (", ".join(held) if held else "none") + " (none used)")
+    if e.get("note"):
+        pass  # not computed (imperfect parts): the caller's NOT CHECKED lines say so
+    elif res["entry_gap_um"] is not None:
         sec = "" if e["section_z_mm"] is None else f", section z = {e['section_z_mm']:g} mm"
         lines.append(f"  entry gap: {res['entry_gap_um']:.3f} um at tooth angle {e['tooth_angle_deg']:+.3f} deg{sec} "
                      "(flexspline tip crossing the rigid tip circle)")
@@ -136,6 +142,11 @@ def audit_summary(name: str, res: dict) -> str:
     if st.get("face_ends_checked") is False:
         lines.append(f"  WARNING: coned flexspline, sections {st['sections_z_mm']} mm: the face ends were not checked")
     c = res["counts"]
-    lines.append(f"  computed {c['evaluated']} of {c['samples']} tooth samples on polygons, {c.get('refined', 0)} on the exact curves "
-                 f"({c['unique_tooth_angles']} distinct tooth angles, {c['culled']} culled by radius) in {res['elapsed_s']:.3f} s")
+    if "perfect_evaluated" in c:
+        lines.append(f"  computed {c['evaluated']} of {c['samples']} tooth samples on polygons, {c.get('refined', 0)} on the exact curves "
+                     f"({c['culled']} ruled out by the perfect drive's bounds less the errors' reach, {c['perfect_evaluated']} "
+                     f"perfect-drive tooth angles evaluated for them) in {res['elapsed_s']:.3f} s")
+    else:
+        lines.append(f"  computed {c['evaluated']} of {c['samples']} tooth samples on polygons, {c.get('refined', 0)} on the exact curves "
+                     f"({c['unique_tooth_angles']} distinct tooth angles, {c['culled']} culled by radius) in {res['elapsed_s']:.3f} s")
     return "\n".join(lines)

@@ -1,0 +1,196 @@
+"""The clearance audit of an imperfect drive (wgcad.clearance.imperfect, docs/models.md 5, 6.2, 7)."""
+
+import json
+import math
+
+import numpy as np
+import pytest
+
+from conftest import TEMPLATES, edit_toml
+from wgcad.accuracy.imperfect import Imperfections, flex_poses, rigid_poses
+from wgcad.audit import _sections
+from wgcad.cli import main
+from wgcad.clearance import imperfect as IM
+from wgcad.clearance.engine import audit
+from wgcad.clearance.scene import Scene
+from wgcad.clearance.search import AuditSettings
+from wgcad.constants import REFINE_TOL
+from wgcad.design import load_design
+from wgcad.drive import build_drive
+from wgcad.placement import transform
+
+#: D2's tolerances of [S4] (docs/models.md 9), and an eccentricity of each gear
+S4 = Imperfections(flex_runout=0.075, flex_runout_phase=math.radians(260), rigid_runout=0.075, cam_cam=0.08,
+                   cam_fixed=0.03, flex_ecc=0.01, flex_ecc_phase=1.0, rigid_ecc=0.012, rigid_ecc_phase=2.2,
+                   cam_flex=0.015, cam_flex_phase=0.3)
+
+
+@pytest.fixture(scope="module")
+def d1():
+    return build_drive(load_design(TEMPLATES / "d1_involute.toml"))
+
+
+def _settings(drive, step_deg, **kw):
+    n = int(round(360.0 / step_deg))
+    return AuditSettings(angles=np.deg2rad(np.arange(n) * (360.0 / n)), sections=_sections(drive, 3), **kw)
+
+
+def test_batch_poses_are_the_reference_poses(d1):
+    # the sweep's vectorised poses against wgcad.accuracy.imperfect.flex_poses (one angle at a time)
+    secs = [float(z) for z in _sections(d1, 3)]
+    for phi_h in (0.0, 0.7, 4.1):
+        k = np.arange(0, 200, 7)
+        got = IM.flex_poses_batch(d1, S4, np.full(k.size, phi_h), k, secs)
+        for (rot, shift), z in zip(got, secs):
+            r0, s0 = flex_poses(d1, S4, phi_h, teeth=k, z=z)
+            np.testing.assert_allclose(rot, r0, rtol=0, atol=1e-12)
+            np.testing.assert_allclose(shift, s0, rtol=0, atol=1e-12)
+
+
+@pytest.mark.parametrize("seed", [0, 1, 2])
+def test_error_bound_holds_for_every_point(d1, seed):
+    # The pruning rests on ErrorBound: the largest displacement of any point of a tooth relative to the
+    # rigid teeth it faces (lower, upper, third nearest) must never exceed it. Random errors up to the
+    # [S4] amplitudes and phases; every point of the tooth polygon, measured in the rigid tooth's frame.
+    rng = np.random.default_rng(seed)
+    imp = Imperfections(*(rng.uniform(0, 1) * getattr(S4, f) if not f.endswith(("phase", "install")) else rng.uniform(0, 2 * math.pi)
+                          for f in Imperfections.__dataclass_fields__))
+    scene = Scene(d1)
+    isc = IM.ImperfectScene.from_scene(scene, imp)
+    secs = [float(z) for z in _sections(d1, 3)]
+    eb = IM.ErrorBound(scene, imp, secs)
+    rb_rot, rb_shift = rigid_poses(d1, imp)
+    u = scene.ratios["u_hg"]
+    worst = 0.0
+    for phi_h in rng.uniform(0, 2 * math.pi, 6):
+        k = np.arange(200)
+        imp_poses = IM.flex_poses_batch(d1, imp, np.full(200, phi_h), k, secs)
+        per_poses = IM.flex_poses_batch(d1, Imperfections(), np.full(200, phi_h), k, secs)
+        for si in range(len(secs)):
+            (ri, si_), (rp, sp) = imp_poses[si], per_poses[si]
+            Pi = transform(scene.flex_local, ri, si_)
+            Pp = transform(scene.flex_local, rp, sp)
+            lo, up, th = scene.neighbours(sp, rp)
+            bound = eb.bound(k, np.array([phi_h]))[si, :, 0]
+            for j in (lo, up, th):
+                # the imperfect point taken into the imperfect rigid tooth's frame, then out through the perfect one's
+                d = rb_rot[j] - scene.rigid_rot[j]
+                c, s = np.cos(-d), np.sin(-d)
+                q = Pi - rb_shift[j][:, None, :]
+                back = np.stack([c[:, None] * q[..., 0] - s[:, None] * q[..., 1], s[:, None] * q[..., 0] + c[:, None] * q[..., 1]], -1)
+                disp = np.hypot(*(back - Pp).transpose(2, 0, 1)).max(axis=1)
+                assert np.all(disp <= bound), (float((disp - bound).max()), seed)
+                worst = max(worst, float((disp / bound).max()))
+    assert worst > 0.5  # the bound is not vacuous: it is within 2x of the real displacement somewhere
+
+
+def test_zero_imperfections_give_the_perfect_audit(d1):
+    st = _settings(d1, 2.0)
+    ref = audit(d1, st)
+    got = IM.audit_imperfect(d1, st, Imperfections())
+    # the same samples, posed by another route (unfolded generator angles): equal to rounding
+    assert abs(got.min_clearance - ref.min_clearance) <= 1e-9
+    assert abs(got.raw["min_clearance_polygon"] - ref.raw["min_clearance_polygon"]) <= 1e-9
+    assert abs(abs(got.worst["tooth_angle_deg"]) - ref.worst["tooth_angle_deg"]) <= 1e-6
+    assert got.worst["section_z_mm"] == ref.worst["section_z_mm"]
+    assert got.interference == ref.interference
+
+
+def test_rigid_eccentricity_deepens_by_its_amplitude(d1):
+    # Hand computation: the rigid gear shifted by e moves every flexspline tooth by -e relative to it, so no
+    # clearance can fall by more than e (a signed distance moves no more than the bodies do); shifted
+    # against the deepest spot's separating direction n*, that spot's penetration grows by exactly e
+    # (first order; e = 2 um is far below the overlap's 58 um and the tooth's size). So the audit's
+    # minimum must be c* - e. n* is found here by turning a 1 um translation of the perfect worst tooth
+    # round in 0.5 deg steps on the exact curves (the polygons' separating direction is a few degrees
+    # off: 12 nm of the 2 um). Tolerance: both figures' refinement (REFINE_TOL each) and the scan's
+    # step, e (1 - cos 0.25 deg) = 0.02 nm.
+    st = _settings(d1, 2.0)
+    ref = audit(d1, st)
+    scene = Scene(d1)
+    z = ref.worst["section_z_mm"]
+    # the worst sample itself, where it is (its zone: the mirror and the other wave's spots move the other way)
+    rot, shift = flex_poses(d1, Imperfections(), math.radians(ref.worst["generator_angle_deg"]),
+                            teeth=[ref.worst["tooth"]], z=z)
+    det = IM.clearance_at_poses(scene, rot, shift)
+    side = min(("lower", "upper"), key=lambda s: det[s][0])
+    j = det["lo"] if side == "lower" else det["up"]
+    th = np.radians(np.arange(0.0, 360.0, 0.5))
+    t = 1e-3 * np.stack([np.cos(th), np.sin(th)], -1)
+    vals = scene.exact_to(np.full(th.size, rot[0]), shift + t, np.full(th.size, j[0]))[0]  # on the exact curves
+    deeper = th[int(np.argmin(vals))]  # the flexspline tooth moving this way goes deepest
+    e = 2e-3
+    # the rigid gear moves the other way: its eccentricity's phase is deeper + pi
+    imp = Imperfections(rigid_ecc=e, rigid_ecc_phase=float(deeper + math.pi))
+    got = IM.audit_imperfect(d1, st, imp)
+    assert got.min_clearance == pytest.approx(ref.min_clearance - e, abs=2 * REFINE_TOL + e * (1 - math.cos(math.radians(0.25))))
+
+
+def test_chunks_and_bounds_change_nothing(d1):
+    # one chunk per 5 generator angles against one chunk for the sweep, and the branch and bound against
+    # every sample evaluated: the same minimum, the same spot (D2's [S4] errors on D1, coarse sweep)
+    st = _settings(d1, 4.0, refine=False)
+    a = IM.audit_imperfect(d1, st, S4, chunk_samples=200 * 3 * 5)
+    b = IM.audit_imperfect(d1, st, S4, chunk_samples=10**9)
+    brute = IM.audit_imperfect(d1, _settings(d1, 4.0, refine=False, bound=False), S4)
+    assert a.counts["chunks"] == 18 and b.counts["chunks"] == 1
+    assert brute.counts["evaluated"] == brute.counts["samples"]
+    for r in (b, brute):
+        assert r.min_clearance == a.min_clearance
+        assert r.worst == a.worst
+    assert a.counts["evaluated"] < 0.2 * brute.counts["evaluated"]
+
+
+def test_audit_cli_honours_imperfections(tmp_path, capsys):
+    text = (TEMPLATES / "d1_involute.toml").read_text() + "\n[imperfections]\n"
+    for key, val in (("rigid_runout_um", "20.0"), ("cam_offset_fixed_um", "10.0")):
+        text = edit_toml(text, "imperfections", key, val)
+    p = tmp_path / "d1_imp.toml"
+    p.write_text(text)
+    out = tmp_path / "a.json"
+    rc = main(["audit", str(p), "--step-deg", "2", "--json", str(out), "--no-refine", "--plot", str(tmp_path / "pic")])
+    assert rc == 1  # D1 interferes
+    res = json.loads(out.read_text())
+    assert res["settings"]["imperfections"] is True
+    assert res["settings"]["mesh_period"] is False
+    assert not any("uses perfect parts" in n for n in res["not_checked"])
+    assert any("entry gap" in n for n in res["not_checked"])
+    for suffix in ("profile", "vs_angle", "tightest"):
+        assert (tmp_path / f"pic_{suffix}.png").stat().st_size > 10_000
+    text_out = capsys.readouterr().out
+    assert "imperfect parts" in text_out and "NOT CHECKED: entry gap" in text_out
+
+
+def test_fixed_flexspline_keeps_the_perfect_audit_and_says_so(tmp_path):
+    # the imperfect poses take the rigid gear as the housing's member: with a fixed flexspline the
+    # audit stays on perfect parts and the summary says why
+    text = (TEMPLATES / "d1_involute.toml").read_text() + "\n[imperfections]\n"
+    text = edit_toml(edit_toml(text, "imperfections", "rigid_runout_um", "20.0"), "drive", "fixed", '"flexspline"')
+    p = tmp_path / "d1_fixed_flex.toml"
+    p.write_text(text)
+    out = tmp_path / "a.json"
+    main(["audit", str(p), "--step-deg", "4", "--json", str(out), "--quiet", "--no-refine"])
+    res = json.loads(out.read_text())
+    assert "imperfections" not in res["settings"]
+    assert any("uses perfect parts (imperfect parts are modelled with a fixed rigid gear only)" in n for n in res["not_checked"])
+
+
+@pytest.mark.parametrize("name", ["d3_external", "d1_odd"])
+def test_bounds_hold_on_other_geometries(name, tmp_path):
+    # external deformation (d3, no coning) and odd tooth counts (201/203: the waves interleave): the
+    # bounded sweep gives the every-sample answer, and zero errors the perfect audit's
+    if name == "d1_odd":
+        text = (TEMPLATES / "d1_involute.toml").read_text()
+        p = tmp_path / "d1_odd.toml"
+        p.write_text(edit_toml(edit_toml(text, "drive", "z_flex", "201"), "drive", "z_rigid", "203"))
+        design = load_design(p)
+    else:
+        design = load_design(TEMPLATES / f"{name}.toml")
+    d = build_drive(design)
+    imp = Imperfections(flex_runout=0.03, rigid_runout=0.03, rigid_runout_phase=0.7, cam_cam=0.02, cam_fixed=0.015,
+                        cam_fixed_phase=2.0, flex_ecc=0.01, rigid_ecc=0.008, rigid_ecc_phase=1.1)
+    st = _settings(d, 8.0, refine=False)
+    a = IM.audit_imperfect(d, st, imp)
+    b = IM.audit_imperfect(d, _settings(d, 8.0, refine=False, bound=False), imp)
+    assert a.min_clearance == b.min_clearance and a.worst == b.worst
+    assert abs(IM.audit_imperfect(d, st, Imperfections()).min_clearance - audit(d, st).min_clearance) <= 1e-9

@@ -1,0 +1,430 @@
+"""The clearance audit of an imperfect drive: every (generator angle, tooth, section) sample with its own pose, swept in chunks (docs/models.md 5, 6.2, 7).
+
+Run-out, eccentricities and a cam offset tied to a gear or the housing
+break the mesh period, the identical waves and the mirror symmetry
+(:func:`wgcad.accuracy.imperfect.shortcuts`): every sample has its own pose.
+What still saves work (docs/models.md 7, last paragraph):
+
+* **the perfect twin**: a sample's clearance is at least the perfect
+  drive's ``c(phi)`` at its tooth angle less how far the errors move its
+  tooth against the rigid tooth it faces
+  (:mod:`wgcad.clearance.imperfect_bounds`); ``c(phi)`` is bounded by the
+  perfect engine's own culling and branch and bound, which the perfect
+  drive's symmetries still serve, on a fixed grid of tooth angles;
+* **lowest bounds first**: the samples with the lowest bounds anywhere set
+  the bar; then only samples whose bound is below the running minimum are
+  posed and measured, so nothing rests on a periodicity of the imperfect
+  drive;
+* **chunks**: the sweep is cut into blocks of generator angles; each block's
+  bounds are dropped once it is done, and only the running minimum and the
+  samples that can still hold it are kept, so the memory does not grow with
+  the sweep length.
+"""
+
+from __future__ import annotations
+
+import time
+from math import pi
+
+import numpy as np
+import shapely
+
+from .. import constants
+from ..accuracy.imperfect import (Imperfections, cam_offset, coning_factor, flex_deviations, rigid_poses,
+                                  rigid_translation, shortcuts)
+from ..placement import pose_from_displacements, transform
+from .imperfect_bounds import ErrorBound, PerfectBound, PerfectBounds, chunk_bounds
+from .scene import Scene, clearance_at_poses, refine_min
+
+__all__ = ["ImperfectScene", "flex_poses_batch", "PerfectBound", "ErrorBound", "audit_imperfect", "chunk_angles", "CHUNK_SAMPLES"]
+
+#: samples (generator angles x teeth x sections) per chunk: a chunk's bounds and their temporaries
+#: (~10 arrays of 8 bytes a sample) hold ~5 MB at 2**16, and the per-chunk overhead (a few array
+#: passes) stays well below the evaluations' cost
+CHUNK_SAMPLES = 1 << 16
+#: polygons measured per call (as wgcad.clearance.search._CHUNK)
+_BATCH = 4096
+#: samples with the lowest bounds evaluated first, to set the bar for the sweep
+_SEED = 256
+#: candidates above this many are first sorted out on polygons 8 times finer (as the engine does)
+_FINE_ABOVE = 48
+_FINE = 8
+#: candidates measured at once on the finer polygons
+_FINE_BATCH = 256
+#: candidates refined in one call (the 16 lowest first above that)
+_ONE_CALL = 48
+
+
+def chunk_angles(z_g: int, sections: int, chunk_samples: int = CHUNK_SAMPLES) -> int:
+    """Generator angles per chunk for ``z_g`` teeth and ``sections`` sections."""
+    return max(1, chunk_samples // (z_g * max(1, sections)))
+
+
+class ImperfectScene(Scene):
+    """A :class:`Scene` whose rigid teeth carry the rigid gear's run-out, in the frame of the rigid gear's own centre.
+
+    Built from a perfect scene (templates and exact curves are shared). The
+    rigid gear's eccentric shift ``T`` is taken out of the frame: the rigid
+    teeth stay about the origin (turned by their run-out) and flexspline
+    poses are given relative to the rigid centre (:meth:`relative`), so the
+    perfect scene's neighbour search and third-tooth bound, which measure
+    angles about the origin, hold as they are. Run-out turns a tooth by at
+    most ``F_b / (2 r_b)``, far below half a pitch, so the bracketing teeth
+    stay the bracketing teeth.
+    """
+
+    @classmethod
+    def from_scene(cls, scene: Scene, imp: Imperfections) -> "ImperfectScene":
+        new = cls.__new__(cls)
+        new.__dict__.update(scene.__dict__)
+        new.imp = imp
+        new.center_b = rigid_translation(imp)
+        rot, shift = rigid_poses(scene.drive, imp)
+        new.rigid_rot, new.rigid_shift = rot, shift - new.center_b  # zero: the frame of the rigid centre
+        new.rigid_pts = transform(scene.rigid.local, rot, new.rigid_shift)
+        new.rigid_pts.setflags(write=False)
+        new.rigid_geoms = shapely.polygons(new.rigid_pts)
+        shapely.prepare(new.rigid_geoms)
+        return new
+
+    def relative(self, shift: np.ndarray) -> np.ndarray:
+        """Flexspline shifts (rigid-gear frame) in the frame of the rigid gear's own centre."""
+        return shift - self.center_b
+
+
+def flex_poses_batch(drive, imp: Imperfections, phi_h: np.ndarray, k: np.ndarray, sections: list):
+    """Poses of flexspline teeth ``k`` at generator angles ``phi_h`` in every section, as :func:`wgcad.accuracy.imperfect.flex_poses`.
+
+    Parameters
+    ----------
+    phi_h, k : (K,) float, int
+        Generator angle (rad, relative to the rigid gear) and tooth of each sample.
+    sections : list of (float or None)
+
+    Returns
+    -------
+    list over sections of ``(rot (K,), shift (K, 2))``.
+
+    For laws linear in W0 the law is evaluated once for every section
+    (a coned section's displacements are the centre's scaled by ``W0(z)/W0``).
+    """
+    d = drive.design.drive
+    z_g = d.z_flex
+    from ..kinematics import gear_ratios
+
+    phi_h = np.asarray(phi_h, dtype=float)
+    k = np.asarray(k)
+    phi_g = phi_h / gear_ratios(z_g, d.z_rigid)["u_hg"]
+    dalpha, drho = flex_deviations(imp, k, z_g, drive.flex.r)
+    phi = 2.0 * pi * k / z_g + phi_g + dalpha - phi_h
+    E = cam_offset(imp, phi_h, phi_g)
+    base = drive.law
+    shared = base.linear_in_w0 and all(z is None or drive.coned for z in sections)
+    st = base.state(phi) if shared else None
+    out = []
+    for z in sections:
+        if shared:
+            f = 1.0 if z is None else drive.law_at(z).w0 / base.w0
+            rot, shift = pose_from_displacements(phi, f * st.w, f * st.v, f * st.theta, drive.r_m, phi_h)
+        else:
+            law = base if z is None else drive.law_at(z)
+            s2 = law.state(phi)
+            rot, shift = pose_from_displacements(phi, s2.w, s2.v, s2.theta, drive.r_m, phi_h)
+        shift = shift + drho[:, None] * np.stack([np.cos(rot), np.sin(rot)], axis=-1)
+        shift += coning_factor(drive, z) * E
+        out.append((rot, shift))
+    return out
+
+
+def _evaluate_poses(scene, rot, shift) -> np.ndarray:
+    vals = np.empty(len(rot))
+    for a in range(0, len(rot), _BATCH):
+        b = min(a + _BATCH, len(rot))
+        vals[a:b] = clearance_at_poses(scene, rot[a:b], shift[a:b])["min"]
+    return vals
+
+
+def _classify(scene: Scene, rot: float, shift: np.ndarray, j: int) -> str:
+    """Where on the flexspline tooth at pose ``(rot, shift)`` the closest approach to rigid tooth ``j`` lies.
+
+    As :func:`wgcad.clearance.scene.classify`, from the pose itself (an
+    imperfect tooth's pose is not a function of its tooth angle).
+    """
+    pts = transform(scene.flex_local, np.array([rot]), shift[None, :])[0]
+    a = shapely.Polygon(pts)
+    b = scene.rigid_geoms[j]
+    if a.intersects(b):
+        inter = a.intersection(b)
+        p = np.asarray(inter.representative_point().coords[0]) if not inter.is_empty else pts[0]
+    else:
+        p = np.asarray(shapely.shortest_line(a, b).coords[0])
+    c, s = np.cos(-rot), np.sin(-rot)
+    q = p - shift
+    loc = np.array([c * q[0] - s * q[1], s * q[0] + c * q[1]])  # tooth frame: the tooth centred on +x
+    R = float(np.hypot(*loc))
+    g = scene.drive.flex
+    m = g.spec.module
+    if abs(R - g.r_a) < 0.05 * m:
+        return "tip"
+    if (abs(R - g.r_f) < (g.spec.fillet_coef + 0.05) * m) if g.spec.form == "involute" else abs(R - g.r_f) < 0.05 * m:
+        return "root"
+    side = "upper" if loc[1] > 0 else "lower"
+    return "working flank" if side == scene.working else "non-working flank"
+
+
+def _poses_of(drive, imp, angles, a_idx, k_idx, s_idx, sections):
+    """Poses of samples (angle index, tooth, section index) relative to the rigid gear's centre (:class:`ImperfectScene`), ``(K,)``, ``(K, 2)``."""
+    rot = np.empty(len(a_idx))
+    shift = np.empty((len(a_idx), 2))
+    for si, z in enumerate(sections):
+        sel = np.nonzero(s_idx == si)[0]
+        if sel.size:
+            rot[sel], shift[sel] = flex_poses_batch(drive, imp, angles[a_idx[sel]], k_idx[sel], [z])[0]
+    return rot, shift - rigid_translation(imp)
+
+
+def audit_imperfect(drive, settings, imp: Imperfections, progress=None, chunk_samples: int = CHUNK_SAMPLES):
+    """Clearance audit of a drive with imperfect parts (module docstring): the smallest clearance and where.
+
+    Parameters
+    ----------
+    drive : wgcad.drive.Drive
+    settings : wgcad.clearance.search.AuditSettings
+        ``angles``, ``sections``, ``cull``, ``bound``, ``refine`` and
+        ``interference_tol`` are used; the mesh period, wave and mirror
+        shortcuts do not hold with these errors and are not used.
+    imp : Imperfections
+    progress : callable, optional
+        ``progress(done, total, stage)``.
+    chunk_samples : int
+        Samples per chunk (memory; the figures do not depend on it).
+
+    Returns
+    -------
+    wgcad.clearance.engine.AuditResult
+        Entry gap and pinch are not computed (NaN, ``entry`` says why); the
+        backlash is the imperfect drive's at the first generator angle.
+    """
+    from .engine import AuditResult
+
+    t0 = time.perf_counter()
+    scene = Scene(drive)
+    isc = ImperfectScene.from_scene(scene, imp)
+    angles = np.asarray(settings.angles, dtype=float)
+    sections = [None] if not drive.coned else [float(z) for z in settings.sections]
+    z_g = scene.z_g
+    S = len(sections)
+    margin = 2.0 * scene.chord_gap if settings.refine else 0.0
+    B = min(len(angles), chunk_angles(z_g, S, chunk_samples))
+    A = len(angles)
+    eb = ErrorBound(scene, imp, sections)
+    # the widest the errors can move a tooth against its rigid teeth: the imperfect minimum is within
+    # that of the perfect one, so the perfect bounds are needed up to twice that above it
+    e_max = eb.largest(angles)
+    # the perfect drive's bounds, first as far as a perfect audit needs them; then as far as the sweep
+    # needs them: a grid point whose bound is above (imperfect best + margin + e_max) prunes every sample
+    perfect = PerfectBounds(scene, sections, settings)
+    perfect.extend(margin)
+    pb = perfect.pb
+    if progress is not None:
+        progress(300, 1000, "clearance")
+    best = np.inf
+    n_ev = n_pruned = 0
+    keep_v, keep_a, keep_k, keep_s = [np.zeros(0)], [np.zeros(0, int)], [np.zeros(0, int)], [np.zeros(0, int)]
+
+    def run(sel_s, sel_k, sel_a):
+        """Evaluate samples (in the order given, in batches), keep those within the margin; returns the best."""
+        nonlocal best, n_ev, keep_v, keep_a, keep_k, keep_s
+        for a in range(0, len(sel_s), _BATCH):
+            s_, k_, a_ = sel_s[a : a + _BATCH], sel_k[a : a + _BATCH], sel_a[a : a + _BATCH]
+            rot, shift = _poses_of(drive, imp, angles, a_, k_, s_, sections)
+            v = _evaluate_poses(isc, rot, shift)
+            n_ev += len(v)
+            best = min(best, float(v.min()))
+            ok = v <= best + margin
+            keep_v.append(v[ok]), keep_a.append(a_[ok]), keep_k.append(k_[ok]), keep_s.append(s_[ok])
+        v = np.concatenate(keep_v)
+        ok = v <= best + margin
+        keep_v, keep_a, keep_k, keep_s = ([x[ok]] for x in (v, np.concatenate(keep_a), np.concatenate(keep_k),
+                                                              np.concatenate(keep_s)))
+
+    if not settings.bound:
+        # the reference: every sample in every chunk
+        for a0 in range(0, A, B):
+            a1 = min(A, a0 + B)
+            s_, k_, b_ = np.meshgrid(np.arange(S), np.arange(z_g), np.arange(a0, a1), indexing="ij")
+            run(s_.ravel(), k_.ravel(), b_.ravel())
+    else:
+        # first pass: the few samples with the lowest bounds anywhere set the bar; second pass: every
+        # sample whose bound is below it, chunk by chunk, lowest bounds first
+        seed = []
+        for a0 in range(0, A, B):
+            a1 = min(A, a0 + B)
+            L = chunk_bounds(pb, eb, angles, a0, a1, z_g, S).ravel()
+            m = min(_SEED, L.size)
+            idx = np.argpartition(L, m - 1)[:m].copy()  # a copy: the view would keep the chunk's whole array alive
+            seed.append((L[idx], idx, a0, a1))
+        allL = np.concatenate([x[0] for x in seed])
+        top = np.argsort(allL, kind="stable")[:_SEED]
+        sel = []
+        at = 0
+        for L, idx, a0, a1 in seed:
+            mine = top[(top >= at) & (top < at + len(L))] - at
+            s_, k_, b_ = np.unravel_index(idx[mine], (S, z_g, a1 - a0))
+            sel.append((s_, k_, b_ + a0))
+            at += len(L)
+        run(*(np.concatenate(x) for x in zip(*sel)))
+        # the seeds' best is the imperfect minimum's upper bound; it is within e_max of the perfect one
+        perfect.extend(min(best + margin + e_max - perfect.best, 2.0 * e_max + margin))
+        done = set(zip(*(np.concatenate(x).tolist() for x in zip(*sel))))
+        for a0 in range(0, A, B):
+            a1 = min(A, a0 + B)
+            L = chunk_bounds(pb, eb, angles, a0, a1, z_g, S).ravel()
+            idx = np.nonzero(L < best + margin)[0]
+            n_pruned += L.size - idx.size
+            idx = idx[np.argsort(L[idx], kind="stable")]
+            s_, k_, b_ = np.unravel_index(idx, (S, z_g, a1 - a0))
+            b_ = b_ + a0
+            fresh = np.array([(x, y, w) not in done for x, y, w in zip(s_.tolist(), k_.tolist(), b_.tolist())], dtype=bool)
+            # re-checked against the bar as it falls: a batch is dropped once its bounds are above it
+            s_, k_, b_, Lc = s_[fresh], k_[fresh], b_[fresh], L[idx][fresh]
+            for a in range(0, len(s_), _BATCH):
+                live = Lc[a : a + _BATCH] < best + margin
+                if not live.any():
+                    n_pruned += len(Lc) - a
+                    break
+                n_pruned += int((~live).sum())
+                run(s_[a : a + _BATCH][live], k_[a : a + _BATCH][live], b_[a : a + _BATCH][live])
+            if progress is not None:
+                progress(300 + int(500 * a1 / A), 1000, "clearance")
+    cand_v, cand_a, cand_k, cand_s = keep_v[0], keep_a[0], keep_k[0], keep_s[0]
+    o = np.argsort(cand_v, kind="stable")
+    cand_v, cand_a, cand_k, cand_s = cand_v[o], cand_a[o], cand_k[o], cand_s[o]
+    best_poly = float(best)
+    n_refined = n_fine = 0
+    where = 0
+    if settings.refine and len(cand_v):
+        ref = isc
+        if len(cand_v) > _FINE_ABOVE:
+            from ..drive import build_drive
+
+            fine_drive = build_drive(drive.design, tol=drive.tol / _FINE)
+            ref = ImperfectScene.from_scene(Scene(fine_drive), imp)
+            rot, shift = _poses_of(drive, imp, angles, cand_a, cand_k, cand_s, sections)
+            # in batches: a candidate on the finer polygons holds ~18 kB while measured, and their number
+            # grows with the sampling density (2900 at 0.05 deg on D1 [S4])
+            cand_v = np.concatenate([clearance_at_poses(ref, rot[a : a + _FINE_BATCH], shift[a : a + _FINE_BATCH])["min"]
+                                     for a in range(0, len(rot), _FINE_BATCH)])
+            n_fine = len(cand_v)
+            o = np.argsort(cand_v, kind="stable")
+            cand_v, cand_a, cand_k, cand_s = cand_v[o], cand_a[o], cand_k[o], cand_s[o]
+            keep = cand_v <= cand_v[0] + 2.0 * ref.chord_gap
+            cand_v, cand_a, cand_k, cand_s = cand_v[keep], cand_a[keep], cand_k[keep], cand_s[keep]
+        exact_best = np.inf
+        at = 0
+        while at < len(cand_v):
+            if cand_v[at] - ref.chord_gap >= exact_best:
+                break
+            # a refinement's cost is mostly per call: a few candidates go in one call, many in two
+            # (the 16 lowest set the bar for the rest)
+            first = len(cand_v) if len(cand_v) <= _ONE_CALL else 16
+            live = np.nonzero(cand_v[at:] - ref.chord_gap < exact_best)[0] + at if at else np.arange(first)
+            if live.size == 0:
+                break
+            rot, shift = _poses_of(drive, imp, angles, cand_a[live], cand_k[live], cand_s[live], sections)
+            vals = refine_min(isc, rot, shift, clearance_at_poses(isc, rot, shift))["min"]
+            n_refined += len(vals)
+            j = int(np.argmin(vals))
+            if vals[j] < exact_best:
+                exact_best, where = float(vals[j]), int(live[j])
+            at = int(live[-1]) + 1 if at == 0 else len(cand_v)
+        best = exact_best
+    if progress is not None:
+        progress(900, 1000, "refine")
+    ai, k, si = int(cand_a[where]), int(cand_k[where]), int(cand_s[where])
+    z_w = sections[si]
+    rot, shift = _poses_of(drive, imp, angles, np.array([ai]), np.array([k]), np.array([si]), sections)
+    det = clearance_at_poses(isc, rot, shift, area=True)
+    side = min(("lower", "upper", "third"), key=lambda s: det[s][0])
+    j = int(det["lo"][0] if side == "lower" else det["up"][0] if side == "upper" else det["th"][0])
+    area = det.get(f"{side}_area", np.zeros(1))[0] if side != "third" else 0.0
+    phi_tooth = float((2 * pi * k / z_g + angles[ai] / scene.ratios["u_hg"] - angles[ai] + pi) % (2 * pi) - pi)
+    phi_major = float((phi_tooth + pi / scene.n_w) % (2 * pi / scene.n_w) - pi / scene.n_w)
+    worst = {
+        "clearance_um": round(1e3 * best, 4),
+        "tooth": k,
+        "generator_angle_deg": round(float(np.rad2deg(angles[ai])), 6),
+        "tooth_angle_deg": round(float(np.rad2deg(phi_major)), 6),
+        "section_z_mm": None if z_w is None else round(z_w, 6),
+        "location": _classify(isc, float(rot[0]), shift[0], j),
+        "mirror": None,  # the errors break the mirror symmetry
+        "sample_tooth_angle_deg": round(float(np.rad2deg(phi_tooth)), 6),
+        "rigid_tooth": j,
+        "overlap_area_um2": round(1e6 * float(area), 4),
+        "polygon_clearance_um": round(1e3 * best_poly, 4),
+    }
+    # backlash of the imperfect drive at the first generator angle, middle section: the rigid turn of the
+    # flexspline between contact either way, from the exact poses (wgcad.accuracy.ke.closing_direct)
+    z_mid = sections[len(sections) // 2]
+    bl = _backlash(drive, imp, float(angles[0]), z_mid)
+    if progress is not None:
+        progress(1000, 1000, "done")
+    sc = shortcuts(imp)
+    bw = drive.design.drive.face_width
+    ends = (not drive.coned) or (min(sections) <= 1e-9 and max(sections) >= bw - 1e-9)
+    rs = {
+        "engine": "2d",
+        "angles": int(A),
+        "angle_step_deg": round(float(np.rad2deg(np.median(np.diff(angles)))), 6) if A > 1 else None,
+        "sections_z_mm": [None if z is None else round(z, 6) for z in sections],
+        "sections_note": ("identical sections (no coning): one computed" if not drive.coned else
+                          "coned: every section computed" + ("" if ends else "; the face ends were NOT checked")),
+        "face_ends_checked": bool(ends),
+        "mesh_period": False,
+        "identical_waves": False,
+        "mirror_symmetry": False,
+        "culling": bool(settings.cull),
+        "branch_and_bound": bool(settings.bound),
+        "imperfections": True,
+        "shortcuts_that_hold": {k2: sc[k2] for k2 in ("mesh_period", "identical_waves", "mirror_symmetry")},
+        "shortcuts_note": ("imperfect parts: every (generator angle, tooth, section) sample posed with its errors, "
+                           f"in chunks of {B} generator angles; bounds only along a tooth's track ({sc['why']})"),
+        "chord_tol_um": round(1e3 * drive.tol, 6),
+        "refined": bool(settings.refine),
+        "refine_tol_um": round(1e3 * constants.REFINE_TOL, 6) if settings.refine else None,
+        "error_side": ("figures on the exact curves, within refine_tol_um either side" if settings.refine else
+                       "polygon figures: chords lie inside convex and outside concave curve parts, "
+                       "so each figure is within 2 x chord_tol_um of the exact one, either side"),
+        "working_flank": scene.working,
+        "rigid_pitch_radius_mm": drive.rigid.r,
+    }
+    counts = {"samples": int(A * z_g * S), "unique_tooth_angles": int(A * z_g), "sections": S, "evaluated": int(n_ev),
+              "culled": int(n_pruned), "perfect_evaluated": perfect.evaluated, "refined": int(n_refined), "fine_polygon": int(n_fine), "chunks": -(-A // B)}
+    entry = {"tooth_angle_deg": None, "section_z_mm": None, "side": "entry (+phi)" if scene.entry_sign > 0 else "entry (-phi)",
+             "pinch_um": None, "pinch_tooth_angle_deg": None, "pinch_section_z_mm": None, "pinch_location": None,
+             "tip_to_tip_risk": False,
+             "note": "not computed for imperfect parts (the entry gap and pinch are figures of the perfect drive's c(phi))"}
+    res = AuditResult(
+        settings=rs, min_clearance=best, worst=worst, entry_gap=float("nan"), entry=entry, backlash=bl,
+        backlash_range={"generator_angle_deg": round(float(np.rad2deg(angles[0])), 6),
+                        "section_z_mm": None if z_mid is None else round(z_mid, 6)},
+        interference=best < -settings.interference_tol, interference_tol=settings.interference_tol,
+        counts=counts, settings_angles=angles,
+        raw={"worst_phi": phi_major, "entry_phi": None, "pinch_phi": None, "min_clearance_polygon": best_poly},
+    )
+    res.elapsed_s = time.perf_counter() - t0
+    return res
+
+
+def _backlash(drive, imp: Imperfections, phi_h: float, z) -> float:
+    """Dead travel (rad) of the imperfect drive at ``phi_h``: closing rotations either way; NaN if the teeth interfere."""
+    from ..accuracy.ke import closing_direct
+
+    if drive.design.drive.fixed != "rigid":
+        return float("nan")
+    up = closing_direct(drive, imp, phi_h, 1, sections=[z])
+    dn = closing_direct(drive, imp, phi_h, -1, sections=[z])
+    tot = up + dn
+    if not np.isfinite(tot):
+        return float("inf")
+    return float(tot) if tot >= 0 and up >= 0 and dn >= 0 else float("nan")
