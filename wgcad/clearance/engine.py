@@ -286,7 +286,7 @@ def audit(drive, settings: AuditSettings, progress=None) -> AuditResult:
     # backlash at the first requested generator angle, middle section
     z_mid = sections[len(sections) // 2]
     bl = float(backlash(scene, float(angles[0]), z_mid))
-    backlash_f = Finding("backlash", bl if np.isfinite(bl) else float("nan"), "brent",
+    backlash_f = Finding("backlash", bl, "brent",
                          generator_angle=float(angles[0]), section_z=z_mid)
     tick(1.0, "done")
     evaluated = int(sum(r.evaluated.sum() for r in results))

@@ -35,7 +35,8 @@ class Finding:
         mm for clearances and gaps (negative: penetration depth), rad for
         backlash; ``nan`` when the figure does not exist on this drive (the
         tips never cross the rigid tip circle, the teeth interfere so there
-        is no dead travel, no pinch after the entry).
+        is no dead travel, no pinch after the entry); backlash ``inf`` when
+        no tooth engages at that generator angle (unbounded dead travel).
     method : str
         A key of :data:`METHODS`.
     tooth_angle : float or None

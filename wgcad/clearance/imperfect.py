@@ -206,6 +206,7 @@ def audit_imperfect(drive, settings, imp: Imperfections, progress=None, chunk_sa
         backlash is the imperfect drive's at the first generator angle.
     """
     from .engine import AuditResult
+    from .findings import Finding
 
     t0 = time.perf_counter()
     scene = Scene(drive)
@@ -350,19 +351,11 @@ def audit_imperfect(drive, settings, imp: Imperfections, progress=None, chunk_sa
     area = det.get(f"{side}_area", np.zeros(1))[0] if side != "third" else 0.0
     phi_tooth = float((2 * pi * k / z_g + angles[ai] / scene.ratios["u_hg"] - angles[ai] + pi) % (2 * pi) - pi)
     phi_major = float((phi_tooth + pi / scene.n_w) % (2 * pi / scene.n_w) - pi / scene.n_w)
-    worst = {
-        "clearance_um": round(1e3 * best, 4),
-        "tooth": k,
-        "generator_angle_deg": round(float(np.rad2deg(angles[ai])), 6),
-        "tooth_angle_deg": round(float(np.rad2deg(phi_major)), 6),
-        "section_z_mm": None if z_w is None else round(z_w, 6),
-        "location": _classify(isc, float(rot[0]), shift[0], j),
-        "mirror": None,  # the errors break the mirror symmetry
-        "sample_tooth_angle_deg": round(float(np.rad2deg(phi_tooth)), 6),
-        "rigid_tooth": j,
-        "overlap_area_um2": round(1e6 * float(area), 4),
-        "polygon_clearance_um": round(1e3 * best_poly, 4),
-    }
+    worst = Finding("min_clearance", float(best), "exact" if settings.refine else "polygon", tooth_angle=phi_major,
+                    section_z=z_w, location=_classify(isc, float(rot[0]), shift[0], j),
+                    generator_angle=float(angles[ai]), tooth=k, polygon_value=float(best_poly),
+                    details={"mirror": None,  # the errors break the mirror symmetry
+                             "sample_tooth_angle": phi_tooth, "rigid_tooth": j, "overlap_area": float(area)})
     # backlash of the imperfect drive at the first generator angle, middle section: the rigid turn of the
     # flexspline between contact either way, from the exact poses (wgcad.accuracy.ke.closing_direct)
     z_mid = sections[len(sections) // 2]
@@ -400,18 +393,17 @@ def audit_imperfect(drive, settings, imp: Imperfections, progress=None, chunk_sa
     }
     counts = {"samples": int(A * z_g * S), "unique_tooth_angles": int(A * z_g), "sections": S, "evaluated": int(n_ev),
               "culled": int(n_pruned), "perfect_evaluated": perfect.evaluated, "refined": int(n_refined), "fine_polygon": int(n_fine), "chunks": -(-A // B)}
-    entry = {"tooth_angle_deg": None, "section_z_mm": None, "side": "entry (+phi)" if scene.entry_sign > 0 else "entry (-phi)",
-             "pinch_um": None, "pinch_tooth_angle_deg": None, "pinch_section_z_mm": None, "pinch_location": None,
-             "tip_to_tip_risk": False,
-             "note": "not computed for imperfect parts (the entry gap and pinch are figures of the perfect drive's c(phi))"}
-    res = AuditResult(
-        settings=rs, min_clearance=best, worst=worst, entry_gap=float("nan"), entry=entry, backlash=bl,
-        backlash_range={"generator_angle_deg": round(float(np.rad2deg(angles[0])), 6),
-                        "section_z_mm": None if z_mid is None else round(z_mid, 6)},
-        interference=best < -settings.interference_tol, interference_tol=settings.interference_tol,
-        counts=counts, settings_angles=angles,
-        raw={"worst_phi": phi_major, "entry_phi": None, "pinch_phi": None, "min_clearance_polygon": best_poly},
-    )
+    note = "not computed for imperfect parts (the entry gap and pinch are figures of the perfect drive's c(phi))"
+    exact = "exact" if settings.refine else "polygon"
+    rs["entry_side"] = "entry (+phi)" if scene.entry_sign > 0 else "entry (-phi)"
+    findings = {
+        "min_clearance": worst,
+        "entry_gap": Finding("entry_gap", float("nan"), exact, details={"note": note}),
+        "entry_pinch": Finding("entry_pinch", float("nan"), exact, details={"tip_to_tip_risk": False}),
+        "backlash": Finding("backlash", float(bl), "brent", generator_angle=float(angles[0]), section_z=z_mid),
+    }
+    res = AuditResult(settings=rs, findings=findings, interference=best < -settings.interference_tol,
+                      interference_tol=settings.interference_tol, counts=counts, settings_angles=angles)
     res.elapsed_s = time.perf_counter() - t0
     return res
 

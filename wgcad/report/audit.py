@@ -17,20 +17,25 @@ def _z(z):
 
 def worst_json(f) -> dict:
     """The tightest spot (a ``min_clearance`` :class:`~wgcad.clearance.findings.Finding`) for the JSON document."""
-    mirror_phi, mirror_loc = f.details["mirror"]
-    return {
+    mirror = f.details.get("mirror")  # None where errors break the mirror symmetry
+    out = {
         "clearance_um": round(1e3 * f.value, 4),
         "tooth": f.tooth,
         "generator_angle_deg": _deg(f.generator_angle),
         "tooth_angle_deg": _deg(f.tooth_angle),
         "section_z_mm": _z(f.section_z),
         "location": f.location,
-        "mirror": {"tooth_angle_deg": _deg(mirror_phi), "location": mirror_loc},
+        "mirror": None if mirror is None else {"tooth_angle_deg": _deg(mirror[0]), "location": mirror[1]},
         "sample_tooth_angle_deg": _deg(f.details["sample_tooth_angle"]),
+    }
+    if "rigid_tooth" in f.details:
+        out["rigid_tooth"] = int(f.details["rigid_tooth"])
+    out.update({
         "overlap_area_um2": round(1e6 * f.details["overlap_area"], 4),
         "polygon_clearance_um": None if f.polygon_value is None else round(1e3 * f.polygon_value, 4),
         "method": f.method,
-    }
+    })
+    return out
 
 
 def entry_json(gap, pinch, side: str) -> dict:
@@ -52,6 +57,8 @@ def entry_json(gap, pinch, side: str) -> dict:
     else:
         out.update({"pinch_um": None, "pinch_tooth_angle_deg": None, "pinch_section_z_mm": None,
                     "pinch_location": None, "tip_to_tip_risk": False})
+    if gap.details.get("note"):
+        out["note"] = gap.details["note"]
     out["method"] = gap.method
     return out
 
@@ -72,6 +79,7 @@ def audit_json(result) -> dict:
         "backlash_arcmin": None if not finite_bl else round(float(np.rad2deg(r.backlash) * 60.0), 5),
         "backlash_um_at_pitch": None if not finite_bl else round(1e3 * r.backlash * r_b, 4),
         "backlash_at": r.backlash_range,
+        "backlash_unbounded": bool(np.isinf(r.backlash)),
         "interference": bool(r.interference),
         "interference_tol_um": round(1e3 * r.interference_tol, 4),
         "worst": r.worst,
@@ -127,7 +135,9 @@ def audit_summary(name: str, res: dict) -> str:
         lines.append("  entry gap: none (the tips never cross the rigid tip circle)")
     b = res["backlash_at"]
     if res["backlash_arcmin"] is None:
-        if res["interference"]:
+        if res.get("backlash_unbounded"):
+            lines.append(f"  backlash: unbounded (no flexspline tooth engages at generator angle {b['generator_angle_deg']:g} deg)")
+        elif res["interference"]:
             lines.append(f"  backlash: none, teeth interfere at generator angle {b['generator_angle_deg']:g} deg")
         else:
             lines.append(f"  backlash: none (the teeth touch at generator angle {b['generator_angle_deg']:g} deg)")
