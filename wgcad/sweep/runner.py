@@ -12,7 +12,7 @@ Dask's round trip is measured with empty tasks and one sample's time with
 a probe task (the probe's samples are kept as the first chunk), then
 
 * at least ``overhead / (0.02 t_sample)`` samples, so that Dask's overhead stays
-  under 2 % of a task;
+  under 2 % of a task, and at least 1 s of work (a chunk file per second per worker);
 * at most ``30 s / t_sample``: a killed run loses at most ~30 s per worker
   and the progress bar moves;
 * at most ``remaining / (4 workers)``: every worker gets several tasks
@@ -39,6 +39,8 @@ OVERHEAD_SHARE = 0.02
 TASK_MAX_S = 30.0
 #: tasks per worker at least (load balance at the end of the run)
 TASKS_PER_WORKER = 4
+#: shortest task aimed at, s: one chunk file per second per worker keeps the store's file count sane
+TASK_MIN_S = 1.0
 
 
 @dataclass
@@ -63,7 +65,7 @@ class RunInfo:
 def plan_batch(sample_s: float, overhead_s: float, remaining: int, workers: int) -> int:
     """Samples per task from the measured sample time and Dask round trip (module docstring)."""
     sample_s = max(sample_s, 1e-6)
-    lo = math.ceil(overhead_s / (OVERHEAD_SHARE * sample_s))
+    lo = math.ceil(max(overhead_s / OVERHEAD_SHARE, TASK_MIN_S) / sample_s)
     hi = min(max(1, int(TASK_MAX_S / sample_s)), max(1, math.ceil(remaining / (TASKS_PER_WORKER * max(workers, 1)))))
     return max(1, min(lo, hi))
 

@@ -3,7 +3,9 @@
 What samples share is cached per process (:data:`_CACHE`, small LRU maps
 keyed by a hash of what decides the object): the drive (tooth outlines) per
 geometry, the KE contact table per geometry and cam-borne offset, the
-elastic model per geometry and bearing. A Dask worker keeps its process
+elastic model per geometry and bearing; and the figures of the models that
+do not see a sample's varied tables (the no-load audit of a tolerance
+sample sees the nominal geometry: one audit serves them all). A Dask worker keeps its process
 between tasks, so a Monte Carlo over tolerances builds them once per worker;
 nothing heavy is shipped with a task (its payload is the spec as data).
 
@@ -32,7 +34,7 @@ __all__ = ["run_batch", "run_sample", "columns_of", "cache_info", "clear_cache",
 _AS = 180.0 / math.pi * 3600.0
 #: entries kept per kind: a grid study walks its grid point by point (samples of a point are
 #: consecutive), so a few entries suffice; each D2 contact table is ~100 MB at most
-_SIZES = {"base": 4, "drive": 4, "table": 3, "model": 2}
+_SIZES = {"base": 4, "drive": 4, "table": 3, "model": 2, "audit": 64, "load": 64}
 _CACHE: dict = {k: OrderedDict() for k in _SIZES}
 _LOCK = threading.RLock()
 _STATS = {"built": 0, "hits": 0}
@@ -119,7 +121,13 @@ def _ke(payload, data, design, drive) -> dict:
             "lost_motion_max_arcsec": float(lm.max()) * _AS}
 
 
-def _audit(payload, drive) -> dict:
+def _audit(payload, data, drive) -> dict:
+    # the audit sees the geometry only: the samples of one grid point share it (computed once per worker)
+    key = _h([_geometry_key(data), payload["audit_step_deg"], payload["audit_sections"]])
+    return dict(_cached("audit", key, lambda: _audit_run(payload, drive)))
+
+
+def _audit_run(payload, drive) -> dict:
     from ..clearance.engine import AuditSettings, audit
 
     n = int(round(360.0 / payload["audit_step_deg"]))
@@ -131,6 +139,13 @@ def _audit(payload, drive) -> dict:
 
 
 def _load(payload, data, design, drive, torques) -> dict:
+    # the load model sees the geometry and [material], [bearing], [load]: not [imperfections]
+    key = _h([data.get(k) for k in ("drive", "tooth", "flexspline", "rigid", "generator", "material", "bearing", "load")]
+             + [payload["load_sections"], sorted(torques)])
+    return dict(_cached("load", key, lambda: _load_run(payload, data, design, drive, torques)))
+
+
+def _load_run(payload, data, design, drive, torques) -> dict:
     from ..deformation.elastic.model import build_model
     from ..deformation.elastic.sweep import torque_sweep
 
@@ -176,7 +191,7 @@ def run_sample(payload: dict, i: int) -> dict:
         if "ke" in kinds:
             figs.update(_ke(payload, data, design, drive))
         if "audit" in kinds:
-            figs.update(_audit(payload, drive))
+            figs.update(_audit(payload, data, drive))
         if "load" in kinds:
             figs.update(_load(payload, data, design, drive, kinds["load"]))
         for name in payload["record"]:
