@@ -42,6 +42,7 @@ def test_template_spec_is_valid():
     ({"sweep": {"design": D4}}, "sweep.seed", "required"),
     ({"figures": {"record": ["ke_pp_arcsecs"]}}, "figures.record", "did you mean 'ke_pp_arcsec'"),
     ({"figures": {"record": ["entry_gap_um@500Nm"]}}, "figures.record", "[bearing]"),
+    ({"figures": {"record": ["ke_pp_arcsec"], "ke_table": "each"}}, "figures.ke_table", "shared, per_sample"),
     ({"parameters": {"generator": {"w0_cof": {"grid": [1.0]}}}}, "parameters.generator.w0_cof", "did you mean 'generator.w0_coef'"),
     ({"parameters": {"imperfections": {"rigid_runout_um": {"distribution": "normal", "mean": 1.0, "sd": 0.0}}}},
      "parameters.imperfections.rigid_runout_um.sd", "> 0"),

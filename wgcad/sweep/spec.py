@@ -49,7 +49,9 @@ MAX_SAMPLES = 100_000_000
 DISTRIBUTIONS = ("normal", "uniform", "grid")
 _TOP = ("sweep", "figures", "parameters", "limits")
 _SWEEP_KEYS = ("name", "design", "samples", "seed", "batch")
-_FIG_KEYS = ("record", "audit_step_deg", "audit_sections", "load_sections", "ke_per_mesh")
+_FIG_KEYS = ("record", "audit_step_deg", "audit_sections", "load_sections", "ke_per_mesh", "ke_table")
+#: ``figures.ke_table``: one KE contact table per worker for the sweep's largest amplitudes, or one per sample
+KE_TABLES = ("shared", "per_sample")
 _PARAM_KEYS = {"normal": ("distribution", "mean", "sd"), "uniform": ("distribution", "lo", "hi"),
                "grid": ("distribution", "values", "grid")}
 
@@ -105,6 +107,7 @@ class SweepSpec:
     audit_sections: int = 3
     load_sections: int = 3
     ke_per_mesh: int = 16
+    ke_table: str = "shared"
     source: str = "<memory>"
 
     @property
@@ -131,7 +134,7 @@ class SweepSpec:
         """Hash of everything that decides the samples and their results (not the limits, not the batch size)."""
         doc = {"design": self.design_data, "parameters": [p.__dict__ for p in self.parameters],
                "record": list(self.record), "samples": self.samples, "seed": self.seed,
-               "settings": [self.audit_step_deg, self.audit_sections, self.load_sections, self.ke_per_mesh]}
+               "settings": [self.audit_step_deg, self.audit_sections, self.load_sections, self.ke_per_mesh, self.ke_table]}
         return hashlib.sha256(json.dumps(doc, sort_keys=True, default=str).encode()).hexdigest()[:16]
 
     def payload(self) -> dict:
@@ -139,7 +142,7 @@ class SweepSpec:
         return {"design": self.design_data, "parameters": self.parameters, "record": self.record,
                 "samples": self.samples, "seed": self.seed, "grid_shape": tuple(len(p.values) for p in self.grid),
                 "audit_step_deg": self.audit_step_deg, "audit_sections": self.audit_sections,
-                "load_sections": self.load_sections, "ke_per_mesh": self.ke_per_mesh,
+                "load_sections": self.load_sections, "ke_per_mesh": self.ke_per_mesh, "ke_table": self.ke_table,
                 "fingerprint": self.fingerprint()}
 
 
@@ -320,12 +323,15 @@ def parse_spec(data: dict, source: str = "<memory>", base_dir: Path | None = Non
     step = _number("figures.audit_step_deg", fig.get("audit_step_deg", 0.5))
     if not 0.01 <= step <= 10.0:
         raise DesignError("figures.audit_step_deg", f"must be in [0.01, 10] degrees, got {step:g}")
+    kt = fig.get("ke_table", "shared")
+    if kt not in KE_TABLES:
+        raise DesignError("figures.ke_table", f"must be one of {', '.join(KE_TABLES)}; got {kt!r}")
     spec = SweepSpec(
         name=name, design_path=dpath, design_data=design_data, parameters=params, record=tuple(rec), samples=samples,
         seed=seed, limits={}, batch=batch, audit_step_deg=step,
         audit_sections=_whole("figures.audit_sections", fig.get("audit_sections", 3), 1, 50),
         load_sections=_whole("figures.load_sections", fig.get("load_sections", 3), 1, 20),
-        ke_per_mesh=_whole("figures.ke_per_mesh", fig.get("ke_per_mesh", 16), 1, 512), source=source)
+        ke_per_mesh=_whole("figures.ke_per_mesh", fig.get("ke_per_mesh", 16), 1, 512), ke_table=kt, source=source)
     check_figures(spec, base)
     lim = data.get("limits", {})
     if not isinstance(lim, dict):

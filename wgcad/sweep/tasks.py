@@ -107,9 +107,12 @@ def _ke(payload, data, design, drive) -> dict:
     imp = Imperfections.from_spec(design.imperfections)
     # the table is built for the sweep's largest amplitudes (module docstring of sampling) and the
     # sample's own cam-borne offset (exact in the table); a sample beyond them gets its own table
-    env = envelope_amplitudes_um(_base(payload).imperfections, payload["parameters"])
     amp = design.imperfections.amplitudes_um
-    env = {k: max(env[k], amp[k]) for k in env}
+    if payload.get("ke_table", "shared") == "per_sample":
+        env = dict(amp)  # the table of wgcad ke for this very drive
+    else:
+        env = envelope_amplitudes_um(_base(payload).imperfections, payload["parameters"])
+        env = {k: max(env[k], amp[k]) for k in env}
     env["cam_offset_cam_um"] = amp["cam_offset_cam_um"]
     env_spec = ImperfectionsSpec(**{**design.imperfections.__dict__, **env})
     tab_imp = Imperfections.from_spec(env_spec)
