@@ -81,6 +81,13 @@ def test_dask_run_is_bit_identical_to_in_process(client, reference, tmp_path):
     _same(_read(out2, _spec()), reference)
 
 
+def test_a_running_scheduler_by_address(client, reference, tmp_path):
+    # --scheduler tcp://HOST:PORT: the runner connects its own client to an existing scheduler
+    info = run_sweep(_spec(), tmp_path, scheduler=client.scheduler.address, batch=4)
+    assert info.executor.startswith("Dask scheduler tcp://127.0.0.1:") and info.computed == 12
+    _same(_read(tmp_path, _spec()), reference)
+
+
 def test_refused_samples_are_recorded_not_fatal(reference):
     st = reference["status"]
     refused = st == "refused"

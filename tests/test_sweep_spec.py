@@ -128,3 +128,36 @@ def test_cli_run_in_process_writes_results_summary_and_pictures(tmp_path, capsys
     # a rerun computes nothing; the summary alone reads the store
     assert main(["sweep", str(p), "--workers", "0", "--out", str(out), "--no-plots"]) == 0
     assert "0 samples computed, 4 already stored" in capsys.readouterr().out
+
+
+def test_a_sample_that_fails_or_errors_is_counted_not_fatal(tmp_path, monkeypatch):
+    # a model that gives up (a WgcadError that is not a rule) and a bug (any other exception) in two samples
+    from wgcad.deformation.elastic.solve import ContactSolveError
+    from wgcad.sweep import tasks
+    from wgcad.sweep.runner import run_sweep
+    from wgcad.sweep.store import Store
+    from wgcad.sweep.summary import summarize
+
+    real = tasks._ke
+
+    def flaky(payload, data, design, drive):
+        amp = design.imperfections.rigid_runout_um
+        if amp > 25.0:
+            raise ContactSolveError("load state: tooth positions still moving")
+        if amp < 5.0:
+            raise ZeroDivisionError("boom")
+        return real(payload, data, design, drive)
+
+    monkeypatch.setattr(tasks, "_ke", flaky)
+    spec = parse_spec(_spec(sweep={"design": D4, "samples": 12, "seed": 3}))
+    info = run_sweep(spec, tmp_path, workers=0, batch=5)
+    assert info.computed == 12
+    pl = spec.payload()
+    cols = Store(tmp_path, pl["fingerprint"], tasks.columns_of(pl), 12).read()
+    amp = cols["imperfections.rigid_runout_um"]
+    np.testing.assert_array_equal(cols["status"] == "failed", amp > 25.0)
+    np.testing.assert_array_equal(cols["status"] == "error", amp < 5.0)
+    assert (cols["status"] == "ok").sum() == ((amp >= 5.0) & (amp <= 25.0)).sum() > 0
+    assert all(r.startswith("ZeroDivisionError: boom") for r in cols["reason"][amp < 5.0])
+    s = summarize(spec, cols)
+    assert s["counts"]["failed"] == int((amp > 25.0).sum()) and s["counts"]["error"] == int((amp < 5.0).sum())

@@ -35,16 +35,18 @@ def _scheduler(text: str) -> str:
 
 
 def cmd_sweep(args) -> int:
-    from ..errors import OutputError
+    from ..errors import DesignError, OutputError
     from ..export.atomic import atomic_batch, check_writable_dir
     from ..sweep.spec import load_spec
     from .common import Progress, want_progress
 
     if args.scheduler and args.workers is not None:
-        raise OutputError("--workers starts a local cluster; with --scheduler the scheduler's workers are used: give one of them")
+        raise DesignError("--workers", "starts a local cluster; with --scheduler the scheduler's workers are used: give one of them")
     spec = load_spec(args.spec)
     out = Path(args.out) if args.out else Path("output") / f"sweep_{Path(args.spec).stem}"
     check_writable_dir(out)
+    if args.summary_only and not (out / "sweep.json").is_file():
+        raise OutputError(f"--summary-only: {out} holds no sweep results (no sweep.json)")
     from ..sweep.runner import run_sweep
     from ..sweep.store import Store
     from ..sweep.summary import format_summary, summarize
@@ -84,7 +86,7 @@ def register(sub) -> None:
     import argparse
 
     s = sub.add_parser("sweep", help="tolerance Monte Carlo or design study over a sweep spec, on Dask; resumable",
-                       epilog=EPILOG, formatter_class=argparse.RawDescriptionHelpFormatter,
+                       epilog=EPILOG + "  4    the Dask cluster failed (a worker died, the scheduler went away): the chunks done are kept, run again to resume\n", formatter_class=argparse.RawDescriptionHelpFormatter,
                        description="Runs every sample of SPEC not yet stored in --out (rerun after an interruption: only "
                                    "the missing samples are computed). Example spec: templates/d2_tolerance_sweep.toml")
     s.add_argument("spec", help="sweep spec (TOML): [sweep] design, samples, seed; [parameters.TABLE.KEY]; [figures] record; [limits]")

@@ -72,8 +72,8 @@ def histograms_png(spec, cols: dict, summ: dict) -> bytes:
         axes[k // ncol][k % ncol].axis("off")
     c = summ["counts"]
     head = f"{summ['name']}: {c['ok']} samples computed of {c['total']}"
-    if c["refused"] or c["failed"]:
-        head += f" ({c['refused']} refused, {c['failed']} failed, not shown)"
+    if c["refused"] or c["failed"] or c["error"]:
+        head += f" ({c['refused']} refused, {c['failed']} failed, {c['error']} errors: not shown)"
     y = summ.get("yield")
     if y and y["of"]:
         head += f"\nyield {100 * y['fraction']:.2f} %, {100 * summ['confidence']:.0f} % interval {100 * y['ci'][0]:.2f} .. {100 * y['ci'][1]:.2f} % (Clopper-Pearson)"
@@ -96,25 +96,39 @@ def sensitivity_png(spec, cols: dict, summ: dict) -> bytes:
         v = r["failure"] if by_fail else r["figures"].get(fig_name)
         return 0.0 if v is None else v
 
-    fig, ax = plt.subplots(1, 2, figsize=(13, 0.45 * len(rows) + 3.2), dpi=90, gridspec_kw={"width_ratios": [1, 1.2]})
+    fig, ax = plt.subplots(1, 2, figsize=(13, 0.5 * len(rows) + 3.2), dpi=90, gridspec_kw={"width_ratios": [1, 1.2]})
     names = [r["parameter"] + (" (phase: |circular r|)" if r["phase"] else "") for r in rows]
-    vals = [score(r) for r in rows]
-    yy = np.arange(len(rows))[::-1]
-    ax[0].barh(yy, vals, color=["tab:red" if v > 0 else "tab:blue" for v in vals])
+    yy = np.arange(len(rows))[::-1].astype(float)
+    # with few failures the rank correlation with failing is weak and noisy: the correlation with the
+    # figure itself (the margin to its limit) is shown beside it
+    fig_vals = [(r["figures"].get(fig_name) or 0.0) for r in rows]
+    if by_fail:
+        ax[0].barh(yy + 0.2, [score(r) for r in rows], height=0.38, color="tab:red", label="with failing")
+        ax[0].barh(yy - 0.2, fig_vals, height=0.38, color="0.55", label=f"with {fig_name}")
+        ax[0].legend(fontsize=8, loc="lower right")
+    else:
+        ax[0].barh(yy, fig_vals, color="0.55")
     ax[0].set_yticks(yy, names, fontsize=8)
     ax[0].axvline(0, color="k", lw=0.6)
     ax[0].set_xlim(-1, 1)
-    ax[0].set_xlabel("rank correlation with failing" if by_fail else f"rank correlation with {fig_name}")
+    ax[0].set_xlabel("rank correlation (phases: circular, 0..1)")
     ax[0].set_title("parameters driving failures" if by_fail else "parameters driving " + fig_name, fontsize=10)
     ax[0].grid(alpha=0.3, axis="x")
     if rows:
         p = next(q for q in spec.parameters if q.name == rows[0]["parameter"])
         x = np.asarray(cols[p.name][ok], float)
         y = cols[fig_name][ok]
+        shown = ""
+        if len(x) > 20000:  # a scatter of a million points is a blot: an even subsample (every k-th sample)
+            k = -(-len(x) // 20000)
+            shown = f" (every {k}th of {len(x)} samples)"
+            x, y = x[::k], y[::k]
         if spec.limits:
             from ..sweep.summary import passes
 
             good = passes(cols, spec.limits)[ok]
+            if shown:
+                good = good[::k]
             ax[1].scatter(x[good], y[good], s=5, color="0.4", label="within the limits", rasterized=True)
             ax[1].scatter(x[~good], y[~good], s=7, color="tab:red", label="outside", rasterized=True)
         else:
@@ -122,7 +136,7 @@ def sensitivity_png(spec, cols: dict, summ: dict) -> bytes:
         _limit_lines(ax[1], spec.limits.get(fig_name), vertical=False)
         ax[1].set_xlabel(p.name)
         ax[1].set_ylabel(fig_name)
-        ax[1].set_title(f"{fig_name} against the leading parameter", fontsize=10)
+        ax[1].set_title(f"{fig_name} against the leading parameter{shown}", fontsize=10)
         ax[1].grid(alpha=0.3)
         ax[1].legend(fontsize=8, loc="best")
     return _png(fig, plt)

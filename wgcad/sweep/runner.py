@@ -31,7 +31,13 @@ from ..errors import WgcadError
 from .store import Store
 from .tasks import columns_of, noop, run_batch
 
-__all__ = ["RunInfo", "run_sweep", "plan_batch", "local_cluster"]
+__all__ = ["RunInfo", "ClusterError", "run_sweep", "plan_batch", "local_cluster"]
+
+
+class ClusterError(WgcadError, RuntimeError):
+    """The cluster failed under a sweep (a worker died twice on a task, the scheduler went away); the chunks done are kept."""
+
+    exit_code = 4
 
 #: Dask's share of a task's time the grain aims below
 OVERHEAD_SHARE = 0.02
@@ -188,7 +194,11 @@ def run_sweep(spec, out, *, client=None, scheduler: str | None = None, workers: 
         ac = as_completed(futs)
         try:
             for f in ac:
-                res = f.result()
+                try:
+                    res = f.result()
+                except Exception as e:  # noqa: BLE001 - KilledWorker, lost scheduler, CommClosedError...
+                    raise ClusterError(f"a Dask task failed ({type(e).__name__}: {' '.join(str(e).split())[:200]}); "
+                                       f"{info.chunks_written} chunks stored this run are kept: run again to resume") from e
                 if stored(res):
                     info.stopped_early = info.computed + info.skipped < spec.total
                     break

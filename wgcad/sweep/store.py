@@ -150,35 +150,45 @@ class Store:
         parts = [self._decode(self.path(a, b)) for a, b in self.done_ranges()]
         out = {}
         for c in self.columns:
-            vals = [x for p in parts for x in p[c]]
-            if c in ("sample", "grid_point", "draw"):
-                out[c] = np.asarray(vals, dtype=np.int64)
-            elif c in ("status", "reason") or any(isinstance(x, str) for x in vals):
-                out[c] = np.asarray(vals, dtype=object)
-            else:
-                out[c] = np.asarray(vals, dtype=float)
+            arrs = [p[c] for p in parts]
+            text = c in ("status", "reason") or any(a.dtype == object for a in arrs)
+            dtype = np.int64 if c in ("sample", "grid_point", "draw") else object if text else float
+            out[c] = np.concatenate([a.astype(dtype) for a in arrs]) if arrs else np.zeros(0, dtype)
         if parts:
             order = np.argsort(out["sample"], kind="stable")
             out = {k: v[order] for k, v in out.items()}
         return out
 
     def _decode(self, path: Path) -> dict:
+        """One chunk: column -> numpy array (object arrays for text)."""
+        import numpy as np
+
         if self.fmt == "parquet":
+            import pyarrow as pa
             import pyarrow.parquet as pq
 
             t = pq.read_table(path)
-            return {c: t.column(c).to_pylist() for c in self.columns}
+            out = {}
+            for c in self.columns:
+                col = t.column(c)
+                if pa.types.is_string(col.type) or pa.types.is_large_string(col.type):
+                    out[c] = np.asarray(col.to_pylist(), dtype=object)
+                else:
+                    out[c] = col.to_numpy()
+            return out
         with open(path, newline="") as f:
             rows = list(csv.reader(f))
         head = rows[0]
         cols = {c: [r[head.index(c)] for r in rows[1:]] for c in self.columns}
+        out = {}
         for c, v in cols.items():
             if c in ("sample", "grid_point", "draw"):
-                cols[c] = [int(x) for x in v]
-            elif c not in ("status", "reason"):
+                out[c] = np.asarray([int(x) for x in v], dtype=np.int64)
+            elif c in ("status", "reason"):
+                out[c] = np.asarray(v, dtype=object)
+            else:
                 try:
-                    cols[c] = [float(x) for x in v]
+                    out[c] = np.asarray([float(x) for x in v], dtype=float)
                 except ValueError:  # a text parameter (generator.law)
-                    pass
-        return cols
-
+                    out[c] = np.asarray(v, dtype=object)
+        return out

@@ -3,8 +3,8 @@
 The yield is the fraction of computed samples (status ``ok``) whose every
 limited figure lies within its limits (a NaN figure, e.g. no backlash, is
 outside any limit); its interval is Clopper-Pearson's exact binomial one,
-conservative at any count. Refused and failed samples are counted apart and
-also given as the yield that counts them as failures.
+conservative at any count. Refused, failed and error samples are counted
+apart and also given as the yield that counts them as failures.
 
 Sensitivity: how strongly each random parameter goes with failing, as the
 Spearman rank correlation of the parameter with the failure indicator
@@ -100,7 +100,7 @@ def summarize(spec, cols: dict, conf: float = 0.95) -> dict:
     st = cols["status"]
     ok = st == "ok"
     counts = {"total": spec.total, "done": n, "ok": int(ok.sum()), "refused": int((st == "refused").sum()),
-              "failed": int((st == "failed").sum())}
+              "failed": int((st == "failed").sum()), "error": int((st == "error").sum())}
     reasons = collections.Counter(r for r, s in zip(cols["reason"], st) if s != "ok")
     out = {"name": spec.name, "design": spec.design_path, "seed": spec.seed, "counts": counts,
            "reasons": [{"reason": r, "samples": c} for r, c in reasons.most_common(8)],
@@ -142,22 +142,26 @@ def summarize(spec, cols: dict, conf: float = 0.95) -> dict:
         gp = cols["grid_point"]
         surf = {}
         for f in spec.record:
+            v = cols[f]
+            sel = ok & np.isfinite(v)
+            cnt = np.bincount(gp[sel], minlength=G)
             mean = np.full(G, np.nan)
-            lo = np.full(G, np.nan)
-            hi = np.full(G, np.nan)
-            for g in range(G):
-                v = cols[f][(gp == g) & ok]
-                v = v[np.isfinite(v)]
-                if v.size:
-                    mean[g], lo[g], hi[g] = v.mean(), v.min(), v.max()
+            has = cnt > 0
+            mean[has] = np.bincount(gp[sel], weights=v[sel], minlength=G)[has] / cnt[has]
+            lo = np.full(G, np.inf)
+            hi = np.full(G, -np.inf)
+            np.minimum.at(lo, gp[sel], v[sel])
+            np.maximum.at(hi, gp[sel], v[sel])
+            lo[~has], hi[~has] = np.nan, np.nan
             surf[f] = {"mean": mean.reshape(shape).tolist(), "min": lo.reshape(shape).tolist(), "max": hi.reshape(shape).tolist()}
         ylds = None
         if spec.limits:
             pas = passes(cols, spec.limits)
             ylds = []
+            m_all = np.bincount(gp[ok], minlength=G)
+            k_all = np.bincount(gp[ok & pas], minlength=G)
             for g in range(G):
-                sel = (gp == g) & ok
-                k, m = int(pas[sel].sum()), int(sel.sum())
+                k, m = int(k_all[g]), int(m_all[g])
                 ylds.append({"pass": k, "of": m, "fraction": k / m if m else None, "ci": list(clopper_pearson(k, m, conf))})
         out["grid"] = {"parameters": [p.name for p in grid], "values": [list(p.values) for p in grid], "shape": list(shape),
                        "surfaces": surf, "yield": ylds}
@@ -172,7 +176,7 @@ def format_summary(s: dict, info=None) -> str:
     """The summary for people, a few lines."""
     c = s["counts"]
     lines = [f"{s['name']}: {c['done']} of {c['total']} samples stored ({c['ok']} computed, {c['refused']} refused by the rules, "
-             f"{c['failed']} failed)"]
+             f"{c['failed']} failed in a model" + (f", {c['error']} ERRORS (a bug: please report)" if c["error"] else "") + ")"]
     if info is not None:
         lines.append(f"  this run: {info.computed} samples computed, {info.skipped} already stored; {info.executor}; "
                      f"{info.batch} samples per task" + (f" (measured: {1e3 * info.sample_s:.0f} ms per sample, Dask round trip "
@@ -193,8 +197,8 @@ def format_summary(s: dict, info=None) -> str:
                          for k, v in s["limits"].items())
         lines.append(f"  YIELD {100 * y['fraction']:.2f} % ({y['pass']} of {y['of']}), {100 * s['confidence']:.0f} % interval "
                      f"{100 * y['ci'][0]:.2f} .. {100 * y['ci'][1]:.2f} % (Clopper-Pearson); limits: {lims}")
-        if c["refused"] or c["failed"]:
-            lines.append(f"  counting refused and failed samples as failures: {100 * y['counting_refused_as_failures']:.2f} %")
+        if c["refused"] or c["failed"] or c["error"]:
+            lines.append(f"  counting refused, failed and error samples as failures: {100 * y['counting_refused_as_failures']:.2f} %")
     if s["sensitivity"]:
         top = [r for r in s["sensitivity"] if r["failure"] is not None][:5]
         if top:

@@ -25,7 +25,7 @@ from collections import OrderedDict
 
 import numpy as np
 
-from ..errors import WgcadError
+from ..errors import DesignError, WgcadError
 from .figures import parse_figure
 from .sampling import envelope_amplitudes_um, sample_design_data, sample_values
 
@@ -165,12 +165,13 @@ def _load_run(payload, data, design, drive, torques) -> dict:
 
 
 def run_sample(payload: dict, i: int) -> dict:
-    """One sample: its parameter values, every recorded figure, and ``status`` (ok, refused, failed) with the reason.
+    """One sample: its parameter values, every recorded figure, and ``status`` with the reason.
 
-    A design the rules refuse (:class:`~wgcad.errors.WgcadError`: a field rule,
-    a derived-geometry rule, a solver that gives up with a reason) is
-    ``refused``; any other exception is ``failed`` with its type and message
-    (a bug to report). Neither stops the sweep.
+    ``refused``: a design rule refuses the sample (:class:`~wgcad.errors.DesignError`:
+    a field rule, a derived-geometry rule); ``failed``: a model gives up with
+    its reason (another :class:`~wgcad.errors.WgcadError`, e.g. the contact
+    solver does not converge); ``error``: any other exception, with its type
+    and message (a bug to report). None of them stops the sweep.
     """
     from ..design.schema import parse_design
 
@@ -199,10 +200,12 @@ def run_sample(payload: dict, i: int) -> dict:
             figs.update(_load(payload, data, design, drive, kinds["load"]))
         for name in payload["record"]:
             row[name] = float(figs[name])
-    except WgcadError as e:
+    except DesignError as e:
         row["status"], row["reason"] = "refused", " ".join(str(e).split())[:300]
-    except Exception as e:  # noqa: BLE001 - one sample's bug must not stop a day-long sweep; it is counted and shown
+    except WgcadError as e:  # a model that gives up with its reason (contact solver not converged, geometry)
         row["status"], row["reason"] = "failed", f"{type(e).__name__}: {' '.join(str(e).split())}"[:300]
+    except Exception as e:  # noqa: BLE001 - one sample's bug must not stop a day-long sweep; it is counted and shown
+        row["status"], row["reason"] = "error", f"{type(e).__name__}: {' '.join(str(e).split())}"[:300]
     return row
 
 
