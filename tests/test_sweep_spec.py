@@ -35,6 +35,8 @@ def test_template_spec_is_valid():
     s = load_spec(TEMPLATES / "d2_tolerance_sweep.toml")
     assert s.total == 10000 and s.record == ("ke_pp_arcsec", "lost_motion_min_arcsec")
     assert {p.key for p in s.parameters} >= {"flex_runout_um", "rigid_runout_phase_deg"}
+    d = load_spec(TEMPLATES / "d1_design_study.toml")
+    assert d.total == 6 and d.grid_points == 6 and not d.random
 
 
 @pytest.mark.parametrize("change, field, words", [
@@ -161,3 +163,26 @@ def test_a_sample_that_fails_or_errors_is_counted_not_fatal(tmp_path, monkeypatc
     assert all(r.startswith("ZeroDivisionError: boom") for r in cols["reason"][amp < 5.0])
     s = summarize(spec, cols)
     assert s["counts"]["failed"] == int((amp > 25.0).sum()) and s["counts"]["error"] == int((amp < 5.0).sum())
+
+
+def test_loaded_figures_are_the_elastic_models():
+    # figures under load against the elastic model called directly (wgcad audit --torque-nm's path);
+    # the torque may be written 500.0 or 500
+    from wgcad.deformation.elastic.model import build_model
+    from wgcad.deformation.elastic.sweep import torque_sweep
+    from wgcad.design import load_design
+    from wgcad.drive import build_drive
+    from wgcad.sweep.tasks import run_sample
+
+    d1 = str(TEMPLATES / "d1_involute.toml")
+    spec = parse_spec({"sweep": {"design": d1, "seed": 1},
+                       "figures": {"record": ["entry_gap_um@500.0Nm", "teeth_in_contact@500Nm"]},
+                       "parameters": {"load": {"cam_offset_um": {"grid": [30.0]}}}})
+    row = run_sample(spec.payload(), 0)
+    assert row["status"] == "ok", row["reason"]
+    drive = build_drive(load_design(d1))
+    lv = torque_sweep(build_model(drive, 3), [500.0], 30.0, drive.design.load.cam_offset_deg)["levels"][0]
+    assert row["entry_gap_um@500.0Nm"] == lv["entry_gap_um"] and row["teeth_in_contact@500Nm"] == lv["teeth_in_contact"]
+    with pytest.raises(DesignError, match="named twice"):
+        parse_spec({"sweep": {"design": d1, "seed": 1}, "figures": {"record": ["entry_gap_um@500.0Nm", "entry_gap_um@500Nm"]},
+                    "parameters": {"load": {"cam_offset_um": {"grid": [30.0]}}}})

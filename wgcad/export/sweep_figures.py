@@ -177,12 +177,14 @@ def surface_png(spec, summ: dict) -> bytes:
             m = mean.reshape(shape[0], shape[1], -1)
             with np.errstate(invalid="ignore"):
                 m = np.nanmean(m, axis=2) if m.shape[2] > 1 else m[:, :, 0]
-            im = ax.imshow(m.T, origin="lower", aspect="auto", cmap="viridis")
+            is_yield = f == "yield %"
+            im = ax.imshow(m.T, origin="lower", aspect="auto", cmap="RdYlGn" if is_yield else "viridis",
+                           vmin=0.0 if is_yield else None, vmax=100.0 if is_yield else None)
             for i in range(m.shape[0]):
                 for j in range(m.shape[1]):
                     if np.isfinite(m[i, j]):
                         ax.text(i, j, f"{m[i, j]:.3g}", ha="center", va="center", fontsize=7,
-                                color="white" if m[i, j] < np.nanmean(m) else "black")
+                                color="black" if is_yield or m[i, j] >= np.nanmean(m) else "white")
             ax.set_xticks(range(shape[0]), [str(v) for v in values[0]], fontsize=8)
             ax.set_yticks(range(shape[1]), [str(v) for v in values[1]], fontsize=8)
             ax.set_xlabel(names[0])

@@ -84,6 +84,9 @@ def figure_doc(name: str) -> str:
 
 def check_figures(spec, base_design) -> None:
     """Refuse what cannot be computed: a figure the base design's model cannot give, a parameter no figure sees."""
+    canon = [(b if t is None else f"{b}@{t:g}Nm") for _, b, t in map(parse_figure, spec.record)]
+    if len(set(canon)) != len(canon):
+        raise DesignError("figures.record", "a figure is named twice (the same torque written two ways)")
     models = {parse_figure(r)[0] for r in spec.record}
     if "ke" in models and base_design.drive.fixed != "rigid":
         raise DesignError("figures.record", "the KE figures model a fixed rigid gear (docs/models.md 6.2); the base design has drive.fixed = flexspline")

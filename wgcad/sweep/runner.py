@@ -63,6 +63,7 @@ class RunInfo:
     sample_s: float | None = None
     wall_s: float = 0.0
     worker_s: float = 0.0
+    worker_cpu_s: float = 0.0
     stopped_early: bool = False
     executor: str = ""
     notes: list = field(default_factory=list)
@@ -125,6 +126,7 @@ def run_sweep(spec, out, *, client=None, scheduler: str | None = None, workers: 
         info.computed += res["stop"] - res["start"]
         info.chunks_written += 1
         info.worker_s += res["compute_s"]
+        info.worker_cpu_s += res.get("cpu_s", 0.0)
         tick(f"{info.skipped + info.computed}/{spec.total} samples")
         return max_chunks is not None and info.chunks_written >= max_chunks
 
@@ -218,7 +220,7 @@ def _timed_batch(payload, start, stop):
     """:func:`run_batch` with each sample's time (the probe task)."""
     ts = []
     cols = None
-    t0 = time.perf_counter()
+    t0, c0 = time.perf_counter(), time.process_time()
     for i in range(start, stop):
         s = time.perf_counter()
         r = run_batch(payload, i, i + 1)
@@ -228,4 +230,5 @@ def _timed_batch(payload, start, stop):
         else:
             for k, v in r["columns"].items():
                 cols[k].extend(v)
-    return {"columns": cols, "start": start, "stop": stop, "compute_s": time.perf_counter() - t0, "sample_s": ts, "built": 0}
+    return {"columns": cols, "start": start, "stop": stop, "compute_s": time.perf_counter() - t0, "cpu_s": time.process_time() - c0,
+            "sample_s": ts, "built": 0}

@@ -199,7 +199,8 @@ def run_sample(payload: dict, i: int) -> dict:
         if "load" in kinds:
             figs.update(_load(payload, data, design, drive, kinds["load"]))
         for name in payload["record"]:
-            row[name] = float(figs[name])
+            model, base, t = parse_figure(name)  # "x@500.0Nm" and "x@500Nm" are the same figure
+            row[name] = float(figs[base if t is None else f"{base}@{t:g}Nm"])
     except DesignError as e:
         row["status"], row["reason"] = "refused", " ".join(str(e).split())[:300]
     except WgcadError as e:  # a model that gives up with its reason (contact solver not converged, geometry)
@@ -216,11 +217,13 @@ def run_batch(payload: dict, start: int, stop: int) -> dict:
     -------
     dict
         ``columns`` (name -> list), ``start``, ``stop``, ``compute_s``
-        (seconds in this task), ``built`` (shared objects this task had to build).
+        (seconds in this task), ``cpu_s`` (this process's CPU seconds in it: less
+        than ``compute_s`` when the cores are shared), ``built`` (shared objects
+        this task had to build).
     """
-    t0 = time.perf_counter()
+    t0, c0 = time.perf_counter(), time.process_time()
     b0 = _STATS["built"]
     rows = [run_sample(payload, i) for i in range(start, stop)]
     cols = {c: [r.get(c) for r in rows] for c in columns_of(payload)}
     return {"columns": cols, "start": start, "stop": stop, "compute_s": time.perf_counter() - t0,
-            "built": _STATS["built"] - b0}
+            "cpu_s": time.process_time() - c0, "built": _STATS["built"] - b0}
