@@ -38,6 +38,8 @@ def _limit_lines(ax, lim, vertical=True):
 def histograms_png(spec, cols: dict, summ: dict) -> bytes:
     """One histogram per recorded figure (computed samples), limits dashed, the share within them in the title; the yield in the heading."""
     plt = _plt()
+    from matplotlib.ticker import MaxNLocator
+
     figs = list(spec.record)
     n = len(figs)
     ncol = min(3, n)
@@ -65,6 +67,7 @@ def histograms_png(spec, cols: dict, summ: dict) -> bytes:
         ax.set_title(title + (f" ({nan} without a value)" if nan else ""), fontsize=9)
         ax.set_xlabel(f)
         ax.set_ylabel("samples")
+        ax.yaxis.set_major_locator(MaxNLocator(integer=True))
         ax.grid(alpha=0.3)
         if lim is not None:
             ax.legend(fontsize=7, loc="upper right")
@@ -163,8 +166,14 @@ def surface_png(spec, summ: dict) -> bytes:
         ax = axes[k // ncol][k % ncol]
         if len(shape) == 1:
             xs = np.arange(shape[0]) if text_axis[0] else np.asarray(values[0], float)
-            ax.plot(xs, mean, "o-", color="k", label="mean over the draws")
-            if np.any(hi > lo):
+            if f == "yield %":
+                ci = np.asarray([y["ci"] for y in g["yield"]], float) * 100.0
+                ax.errorbar(xs, mean, yerr=[mean - ci[:, 0], ci[:, 1] - mean], fmt="o-", color="k", capsize=3,
+                            label=f"yield, {100 * summ['confidence']:.0f} % interval")
+                ax.set_ylim(-3, 103)
+            else:
+                ax.plot(xs, mean, "o-", color="k", label="mean over the draws")
+            if f != "yield %" and np.any(hi > lo):
                 ax.fill_between(xs, lo, hi, color="0.8", label="range over the draws")
             if text_axis[0]:
                 ax.set_xticks(xs, values[0], fontsize=8)
