@@ -14,7 +14,7 @@ for _var in ("OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
 
 from .. import __version__
 from ..errors import WgcadError
-from . import audit, generate, ke, kinematics, parts, sector
+from . import audit, generate, ke, kinematics, parts, sector, sweep
 from .common import (  # noqa: F401
     EPILOG,
     EXIT_INPUT,
@@ -39,8 +39,8 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--traceback", action="store_true",
                    help=f"on an internal error (exit 3) also print the Python traceback (same as {TRACEBACK_ENV}=1)")
     sub = p.add_subparsers(dest="command", required=True, parser_class=Parser, metavar="COMMAND",
-                           help="generate, audit, kinematics, ke, sector or parts; wgcad COMMAND --help for its flags")
-    for mod in (generate, audit, kinematics, ke, sector, parts):
+                           help="generate, audit, kinematics, ke, sector, parts or sweep; wgcad COMMAND --help for its flags")
+    for mod in (generate, audit, kinematics, ke, sector, parts, sweep):
         mod.register(sub)
     return p
 

@@ -1,0 +1,164 @@
+"""Sweeps on a real Dask LocalCluster (two worker processes on loopback): bit-identical to an in-process run, resumable, refusals recorded."""
+
+import os
+import signal
+import subprocess
+import sys
+import time
+
+import numpy as np
+import pytest
+
+from conftest import ROOT, TEMPLATES
+from wgcad.errors import OutputError
+from wgcad.sweep.runner import plan_batch, run_sweep
+from wgcad.sweep.spec import parse_spec
+from wgcad.sweep.store import Store
+from wgcad.sweep.tasks import columns_of
+
+distributed = pytest.importorskip("distributed")
+D4 = str(TEMPLATES / "d4_discrete.toml")
+
+
+def _spec(seed=5, samples=6):
+    # a grid of two generator deformations x random errors; the rigid run-out is normal about 5 um
+    # with sd 10 um, so about a third of the draws are negative amplitudes the design rules refuse
+    return parse_spec({
+        "sweep": {"name": "dask test", "design": D4, "samples": samples, "seed": seed},
+        "figures": {"record": ["ke_pp_arcsec", "lost_motion_min_arcsec", "min_clearance_um"], "audit_step_deg": 1.0},
+        "parameters": {
+            "generator": {"w0_coef": {"grid": [1.05, 1.1]}},
+            "imperfections": {"rigid_runout_um": {"distribution": "normal", "mean": 5.0, "sd": 10.0},
+                              "flex_runout_um": {"distribution": "uniform", "lo": 0.0, "hi": 20.0},
+                              "flex_runout_phase_deg": {"distribution": "uniform", "lo": 0.0, "hi": 360.0}},
+        },
+        "limits": {"ke_pp_arcsec": {"max": 30.0}},
+    })
+
+
+@pytest.fixture(scope="module")
+def client():
+    from distributed import Client, LocalCluster
+
+    cluster = LocalCluster(n_workers=2, threads_per_worker=1, processes=True, host="127.0.0.1",
+                           dashboard_address=None, silence_logs=40)
+    c = Client(cluster)
+    yield c
+    c.close()
+    cluster.close()
+
+
+@pytest.fixture(scope="module")
+def reference(tmp_path_factory):
+    out = tmp_path_factory.mktemp("ref")
+    info = run_sweep(_spec(), out, workers=0, batch=5)
+    assert info.computed == 12 and not info.stopped_early
+    return _read(out, _spec())
+
+
+def _read(out, spec):
+    pl = spec.payload()
+    return Store(out, pl["fingerprint"], columns_of(pl), spec.total).read()
+
+
+def _same(a, b):
+    assert a.keys() == b.keys()
+    for k in a:
+        if a[k].dtype == object:
+            assert list(a[k]) == list(b[k]), k
+        else:
+            # bit for bit: the same bytes, NaNs included
+            assert a[k].tobytes() == b[k].tobytes(), k
+
+
+def test_dask_run_is_bit_identical_to_in_process(client, reference, tmp_path):
+    info = run_sweep(_spec(), tmp_path, client=client)  # grain measured: probe task, then planned batches
+    assert info.computed == 12 and info.workers == 2 and info.sample_s > 0 and info.overhead_s > 0
+    _same(_read(tmp_path, _spec()), reference)
+    # a different grain and completion order: still the same bits
+    out2 = tmp_path / "b"
+    run_sweep(_spec(), out2, client=client, batch=1)
+    _same(_read(out2, _spec()), reference)
+
+
+def test_a_running_scheduler_by_address(client, reference, tmp_path):
+    # --scheduler tcp://HOST:PORT: the runner connects its own client to an existing scheduler
+    info = run_sweep(_spec(), tmp_path, scheduler=client.scheduler.address, batch=4)
+    assert info.executor.startswith("Dask scheduler tcp://127.0.0.1:") and info.computed == 12
+    _same(_read(tmp_path, _spec()), reference)
+
+
+def test_refused_samples_are_recorded_not_fatal(reference):
+    st = reference["status"]
+    refused = st == "refused"
+    assert refused.any() and (st == "ok").any() and not (st == "failed").any()
+    neg = reference["imperfections.rigid_runout_um"] < 0
+    np.testing.assert_array_equal(refused, neg)  # exactly the negative amplitudes, with the rule as reason
+    assert all(r.startswith("imperfections.rigid_runout_um: must be in [0,") for r in reference["reason"][refused])
+    assert np.isnan(reference["ke_pp_arcsec"][refused]).all() and np.isfinite(reference["ke_pp_arcsec"][~refused]).all()
+
+
+def test_resume_computes_only_the_missing_chunks(client, reference, tmp_path):
+    first = run_sweep(_spec(), tmp_path, client=client, batch=2, max_chunks=2)
+    assert first.stopped_early and first.computed == 4
+    pl = _spec().payload()
+    store = Store(tmp_path, pl["fingerprint"], columns_of(pl), 12)
+    assert len(store.done_ranges()) == 2 and sum(b - a for a, b in store.missing()) == 8
+    done_before = {p: os.stat(store.chunks / p).st_mtime_ns for p in os.listdir(store.chunks)}
+    # a killed writer's temporary file (a pid that cannot exist) is swept, never read as a chunk
+    (store.chunks / ".chunk-000000004-000000006.parquet.999999999-0123456789ab.tmp").write_bytes(b"half")
+    second = run_sweep(_spec(), tmp_path, client=client, batch=3)
+    assert second.skipped == 4 and second.computed == 8
+    for p, t in done_before.items():  # the chunks of the first run were not rewritten
+        assert os.stat(store.chunks / p).st_mtime_ns == t
+    assert not [f for f in os.listdir(store.chunks) if f.endswith(".tmp")]
+    _same(_read(tmp_path, _spec()), reference)
+    third = run_sweep(_spec(), tmp_path, client=client)
+    assert third.computed == 0 and third.skipped == 12
+
+
+def test_resume_after_kill_9(reference, tmp_path):
+    # a real kill: the CLI in process mode, one sample per chunk, SIGKILL once two chunks are on disk
+    spec_file = tmp_path / "s.toml"
+    spec_file.write_text(
+        f'[sweep]\nname = "dask test"\ndesign = "{D4}"\nsamples = 6\nseed = 5\n'
+        '[figures]\nrecord = ["ke_pp_arcsec", "lost_motion_min_arcsec", "min_clearance_um"]\naudit_step_deg = 1.0\n'
+        '[parameters.generator.w0_coef]\ngrid = [1.05, 1.1]\n'
+        '[parameters.imperfections.rigid_runout_um]\ndistribution = "normal"\nmean = 5.0\nsd = 10.0\n'
+        '[parameters.imperfections.flex_runout_um]\ndistribution = "uniform"\nlo = 0.0\nhi = 20.0\n'
+        '[parameters.imperfections.flex_runout_phase_deg]\ndistribution = "uniform"\nlo = 0.0\nhi = 360.0\n'
+        '[limits]\nke_pp_arcsec = { max = 30.0 }\n')
+    out = tmp_path / "o"
+    env = {**os.environ, "PYTHONPATH": str(ROOT)}
+    cmd = [sys.executable, "-m", "wgcad", "sweep", str(spec_file), "--workers", "0", "--batch", "1", "--out", str(out), "--no-plots"]
+    p = subprocess.Popen(cmd, env=env, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    chunks = out / "chunks"
+    t0 = time.monotonic()
+    while time.monotonic() - t0 < 60:
+        if chunks.is_dir() and len([f for f in os.listdir(chunks) if f.startswith("chunk-")]) >= 2:
+            break
+        time.sleep(0.02)
+    p.send_signal(signal.SIGKILL)
+    p.wait()
+    n_done = len([f for f in os.listdir(chunks) if f.startswith("chunk-")])
+    assert 2 <= n_done < 12
+    r = subprocess.run(cmd, env=env, capture_output=True, text=True, timeout=120)
+    assert r.returncode == 0, r.stderr
+    assert f"{12 - n_done} samples computed, {n_done} already stored" in r.stdout
+    _same(_read(out, _spec()), reference)
+
+
+def test_another_spec_in_the_same_folder_is_refused(reference, tmp_path):
+    run_sweep(_spec(samples=1), tmp_path, workers=0)
+    with pytest.raises(OutputError, match="another sweep spec"):
+        run_sweep(_spec(seed=6, samples=1), tmp_path, workers=0)
+
+
+def test_grain_plan():
+    # 0.1 s samples, 10 ms round trip: >= 10 samples for 1 s of work (overhead 1 %); the balance cap wins on small runs
+    assert plan_batch(0.1, 0.01, 100_000, 2) == 10
+    assert plan_batch(0.1, 0.01, 40, 2) == 5
+    # very slow samples: one per task; very fast ones: 1 s of work, and never more than 30 s
+    assert plan_batch(60.0, 0.01, 1000, 2) == 1
+    assert plan_batch(1e-4, 0.01, 10**8, 2) == 10_000
+    assert plan_batch(1e-4, 10.0, 10**8, 2) == 300_000

@@ -1,0 +1,102 @@
+"""``wgcad sweep``: a tolerance Monte Carlo or a design study over a sweep spec, on Dask (local cluster or a scheduler), resumable."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+from .common import EPILOG, EXIT_OK
+
+__all__ = ["register", "cmd_sweep"]
+
+
+def _count(lo: int, hi: int, what: str):
+    import argparse
+
+    def conv(text: str) -> int:
+        try:
+            n = int(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"'{text}' is not a whole number") from None
+        if not lo <= n <= hi:
+            raise argparse.ArgumentTypeError(f"must be {lo}..{hi} {what}, got {n}")
+        return n
+
+    return conv
+
+
+def _scheduler(text: str) -> str:
+    import argparse
+
+    if not (text.startswith("tcp://") or text.startswith("tls://")) or ":" not in text[6:]:
+        raise argparse.ArgumentTypeError(f"expected tcp://HOST:PORT (or tls://), got '{text}'")
+    return text
+
+
+def cmd_sweep(args) -> int:
+    from ..errors import DesignError, OutputError
+    from ..export.atomic import atomic_batch, check_writable_dir
+    from ..sweep.spec import load_spec
+    from .common import Progress, want_progress
+
+    if args.scheduler and args.workers is not None:
+        raise DesignError("--workers", "starts a local cluster; with --scheduler the scheduler's workers are used: give one of them")
+    spec = load_spec(args.spec)
+    out = Path(args.out) if args.out else Path("output") / f"sweep_{Path(args.spec).stem}"
+    check_writable_dir(out)
+    if args.summary_only and not (out / "sweep.json").is_file():
+        raise OutputError(f"--summary-only: {out} holds no sweep results (no sweep.json)")
+    from ..sweep.runner import run_sweep
+    from ..sweep.store import Store
+    from ..sweep.summary import format_summary, summarize
+    from ..sweep.tasks import columns_of
+
+    bar = Progress(want_progress(args.progress) and not args.quiet)
+    bar.start("starting the cluster")
+    info = None
+    if not args.summary_only:
+        info = run_sweep(spec, out, scheduler=args.scheduler, workers=args.workers, batch=args.batch, progress=bar)
+    payload = spec.payload()
+    store = Store(out, payload["fingerprint"], columns_of(payload), spec.total, name=spec.name)
+    if args.summary_only:
+        store.open()
+    bar.set(1.0, "summary")
+    cols = store.read()
+    summ = summarize(spec, cols)
+    if info is not None:
+        summ["run"] = {k: v for k, v in info.__dict__.items()}
+    summ["results"] = {"folder": str(out), "format": store.fmt, "chunks": len(store.done_ranges())}
+    with atomic_batch() as batch:
+        Path(batch.temp_path(out / "summary.json")).write_text(json.dumps(summ, indent=2, default=str) + "\n")
+        if not args.no_plots and len(cols["sample"]):
+            from ..export.sweep_figures import sweep_pngs
+
+            for name, png in sweep_pngs(spec, cols, summ).items():
+                Path(batch.temp_path(out / name)).write_bytes(png)
+    bar.close()
+    if not args.quiet:
+        print(format_summary(summ, info))
+        print(f"  results: {out}/chunks ({store.fmt}), {out}/summary.json" + ("" if args.no_plots else f", {out}/*.png"))
+    return EXIT_OK
+
+
+def register(sub) -> None:
+    """Add the subcommand to the ``wgcad`` parser's subparsers."""
+    import argparse
+
+    s = sub.add_parser("sweep", help="tolerance Monte Carlo or design study over a sweep spec, on Dask; resumable",
+                       epilog=EPILOG + "  4    the Dask cluster failed (a worker died, the scheduler went away): the chunks done are kept, run again to resume\n", formatter_class=argparse.RawDescriptionHelpFormatter,
+                       description="Runs every sample of SPEC not yet stored in --out (rerun after an interruption: only "
+                                   "the missing samples are computed). Example spec: templates/d2_tolerance_sweep.toml")
+    s.add_argument("spec", help="sweep spec (TOML): [sweep] design, samples, seed; [parameters.TABLE.KEY]; [figures] record; [limits]")
+    s.add_argument("--scheduler", type=_scheduler, help="address of a running Dask scheduler, tcp://HOST:PORT (default: a local cluster)")
+    s.add_argument("--workers", type=_count(0, 4096, "worker processes"), default=None,
+                   help="worker processes of the local cluster (default: one per core; 0: in this process without Dask)")
+    s.add_argument("--batch", type=_count(1, 1_000_000, "samples per task"), default=None,
+                   help="samples per task (default: the spec's sweep.batch, else chosen by measuring a probe task)")
+    s.add_argument("--out", help="results folder (default output/sweep_SPECNAME); reused to resume")
+    s.add_argument("--summary-only", action="store_true", help="compute nothing: summarise the samples stored in --out")
+    s.add_argument("--no-plots", action="store_true", help="no PNGs")
+    s.add_argument("--progress", action="store_true", help="draw the progress bar even when stderr is not a terminal")
+    s.add_argument("--quiet", action="store_true", help="no summary on stdout")
+    s.set_defaults(func=cmd_sweep)
