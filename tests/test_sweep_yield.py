@@ -130,3 +130,18 @@ def test_per_sample_table_is_wgcad_ke_exactly():
     pl = spec.payload()
     for i in (0, 1):
         assert run_sample(pl, i)["ke_pp_arcsec"] == _own_table_ke(pl, i)
+
+
+def test_d2_samples_carry_the_deep_overlap_share_and_the_summary_warns(tmp_path, capsys):
+    # D2 as templated interferes deeply at its open end: the linear KE model is flagged there
+    # (accuracy/ke.py DEEP_OVERLAP) and a sweep of its KE must say so, not just print a yield
+    from wgcad.cli import main
+
+    text = (TEMPLATES / "d2_tolerance_sweep.toml").read_text().replace("samples = 10000", "samples = 2")
+    text = text.replace('design = "d2_imperfect.toml"', f'design = "{TEMPLATES / "d2_imperfect.toml"}"')
+    spec = tmp_path / "d2_small.toml"
+    spec.write_text(text)
+    assert main(["sweep", str(spec), "--workers", "0", "--out", str(tmp_path / "out"), "--no-plots"]) == 0
+    out = capsys.readouterr().out
+    assert "ke_deep_overlap_fraction: mean 1," in out
+    assert "WARNING: KE of samples resting on deeply overlapping contacts" in out

@@ -34,6 +34,8 @@ FIGURES = {
     "ke_pp_arcsec": ("ke", "largest kinematic error (peak to peak over one flexspline revolution), no load"),
     "lost_motion_min_arcsec": ("ke", "smallest lost motion over the revolution (negative: the teeth interfere)"),
     "lost_motion_max_arcsec": ("ke", "largest lost motion over the revolution"),
+    "ke_deep_overlap_fraction": ("ke", "share of the angles whose first contact overlaps so deeply (turns back > 300 "
+                                       "arcsec to separate) that the linear error model is not to be trusted there"),
     "min_clearance_um": ("audit", "smallest clearance of the perfect drive, no load (negative: interference)"),
     "entry_gap_um": ("audit", "entry gap of the perfect drive, no load"),
     "backlash_arcmin": ("audit", "backlash of the perfect drive (NaN where the teeth touch or interfere)"),

@@ -199,6 +199,10 @@ def format_summary(s: dict, info=None) -> str:
                      f"{100 * y['ci'][0]:.2f} .. {100 * y['ci'][1]:.2f} % (Clopper-Pearson); limits: {lims}")
         if c["refused"] or c["failed"] or c["error"]:
             lines.append(f"  counting refused, failed and error samples as failures: {100 * y['counting_refused_as_failures']:.2f} %")
+    deep = s["figures"].get("ke_deep_overlap_fraction")
+    if deep and deep.get("n") and deep["max"] > 0:
+        lines.append(f"  WARNING: KE of samples resting on deeply overlapping contacts (mean share of angles "
+                     f"{100 * deep['mean']:.1f} %): the linear error model is not to be trusted there (README, kinematic error)")
     if s["sensitivity"]:
         top = [r for r in s["sensitivity"] if r["failure"] is not None][:5]
         if top:

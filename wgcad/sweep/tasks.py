@@ -121,7 +121,7 @@ def _ke(payload, data, design, drive) -> dict:
     res = K.kinematic_error(drive, imp, table=tab)
     lm = res.lost_motion
     return {"ke_pp_arcsec": res.ke_pp * _AS, "lost_motion_min_arcsec": float(lm.min()) * _AS,
-            "lost_motion_max_arcsec": float(lm.max()) * _AS}
+            "lost_motion_max_arcsec": float(lm.max()) * _AS, "ke_deep_overlap_fraction": float(res.deep_overlap_fraction)}
 
 
 def _audit(payload, data, drive) -> dict:
