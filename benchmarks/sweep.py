@@ -11,7 +11,7 @@ machine may be shared):
 * Dask's per-task overhead: the round trip of an empty task (median of 50,
   one at a time) and the throughput of 400 empty tasks submitted at once, on
   a LocalCluster of 2 processes;
-* one sample of templates/d2_tolerance_sweep.toml in this process: the
+* one sample of templates/sweeps/d2_tolerance_sweep.toml in this process: the
   shared data (drive and KE contact table, built once per worker) and the
   per-sample time after it (best of 3 over 5 samples), wall and CPU (on a
   shared machine the CPU time is the process's own work);
@@ -42,7 +42,7 @@ sys.path.insert(0, str(ROOT))
 from wgcad.sweep.runner import local_cluster, run_sweep  # noqa: E402
 from wgcad.sweep.spec import load_spec  # noqa: E402
 
-SPEC = ROOT / "templates" / "d2_tolerance_sweep.toml"
+SPEC = ROOT / "templates" / "sweeps" / "d2_tolerance_sweep.toml"
 
 
 def load() -> str:

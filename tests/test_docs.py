@@ -37,7 +37,7 @@ def cited_sections(text: str) -> list[str]:
 
 
 def _sources():
-    files = sorted((ROOT / "wgcad").rglob("*.py")) + sorted((ROOT / "templates").glob("*.toml"))
+    files = sorted((ROOT / "wgcad").rglob("*.py")) + sorted((ROOT / "templates").rglob("*.toml"))
     files += sorted((ROOT / "benchmarks").glob("*.py"))
     return files
 

@@ -32,10 +32,10 @@ def _spec(**over):
 
 
 def test_template_spec_is_valid():
-    s = load_spec(TEMPLATES / "d2_tolerance_sweep.toml")
+    s = load_spec(TEMPLATES / "sweeps" / "d2_tolerance_sweep.toml")
     assert s.total == 10000 and s.record == ("ke_pp_arcsec", "lost_motion_min_arcsec", "ke_deep_overlap_fraction")
     assert {p.key for p in s.parameters} >= {"flex_runout_um", "rigid_runout_phase_deg"}
-    d = load_spec(TEMPLATES / "d1_design_study.toml")
+    d = load_spec(TEMPLATES / "sweeps" / "d1_design_study.toml")
     assert d.total == 6 and d.grid_points == 6 and not d.random
 
 

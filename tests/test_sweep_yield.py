@@ -112,7 +112,7 @@ def test_shared_table_gives_the_per_sample_table_result():
     # 0.01 arcsec the summary prints.
     from wgcad.sweep.spec import load_spec
 
-    pl = load_spec(TEMPLATES / "d2_tolerance_sweep.toml").payload()
+    pl = load_spec(TEMPLATES / "sweeps" / "d2_tolerance_sweep.toml").payload()
     for i in (0, 1):
         row = run_sample(pl, i)
         assert row["status"] == "ok" and abs(row["ke_pp_arcsec"] - _own_table_ke(pl, i)) < 1e-6
@@ -137,8 +137,8 @@ def test_d2_samples_carry_the_deep_overlap_share_and_the_summary_warns(tmp_path,
     # (accuracy/ke.py DEEP_OVERLAP) and a sweep of its KE must say so, not just print a yield
     from wgcad.cli import main
 
-    text = (TEMPLATES / "d2_tolerance_sweep.toml").read_text().replace("samples = 10000", "samples = 2")
-    text = text.replace('design = "d2_imperfect.toml"', f'design = "{TEMPLATES / "d2_imperfect.toml"}"')
+    text = (TEMPLATES / "sweeps" / "d2_tolerance_sweep.toml").read_text().replace("samples = 10000", "samples = 2")
+    text = text.replace('design = "../d2_imperfect.toml"', f'design = "{TEMPLATES / "d2_imperfect.toml"}"')
     spec = tmp_path / "d2_small.toml"
     spec.write_text(text)
     assert main(["sweep", str(spec), "--workers", "0", "--out", str(tmp_path / "out"), "--no-plots"]) == 0

@@ -87,7 +87,7 @@ def register(sub) -> None:
     s = sub.add_parser("sweep", help="tolerance Monte Carlo or design study over a sweep spec, on Dask; resumable",
                        epilog=EPILOG + "  4    the Dask cluster failed (a worker died, the scheduler went away): the chunks done are kept, run again to resume\n", formatter_class=argparse.RawDescriptionHelpFormatter,
                        description="Runs every sample of SPEC not yet stored in --out (rerun after an interruption: only "
-                                   "the missing samples are computed). Example spec: templates/d2_tolerance_sweep.toml")
+                                   "the missing samples are computed). Example spec: templates/sweeps/d2_tolerance_sweep.toml")
     s.add_argument("spec", help="sweep spec (TOML): [sweep] design, samples, seed; [parameters.TABLE.KEY]; [figures] record; [limits]")
     s.add_argument("--scheduler", type=_scheduler, help="address of a running Dask scheduler, tcp://HOST:PORT (default: a local cluster)")
     s.add_argument("--workers", type=_count(0, 4096, "worker processes"), default=None,
