@@ -69,6 +69,20 @@ def _deepest(pts: np.ndarray, template, rot: np.ndarray, shift: np.ndarray):
     return depth, vert, near
 
 
+def _project(a: np.ndarray, ab: np.ndarray, L2: np.ndarray, q: np.ndarray):
+    """Nearest edge ``e`` ``(K,)`` of a closed outline (vertices ``a`` ``(N, 2)``, edges ``ab`` from vertex i to i+1,
+    squared lengths ``L2``) to points ``q`` ``(K, 2)``, and the place ``t`` in [0, 1] on it of the nearest point.
+
+    What ``shapely.line_locate_point`` on the outline's ring gives, without building a geometry per call (the
+    first edge where two are equally near: at a shared vertex both give the same interpolated normal).
+    """
+    rel = q[:, None, :] - a[None, :, :]  # (K, N, 2)
+    t = np.clip((rel[..., 0] * ab[:, 0] + rel[..., 1] * ab[:, 1]) / L2, 0.0, 1.0)
+    dx, dy = rel[..., 0] - t * ab[:, 0], rel[..., 1] - t * ab[:, 1]
+    e = np.argmin(dx * dx + dy * dy, axis=1)
+    return e, t[np.arange(len(q)), e]
+
+
 def _smooth_normals(local: np.ndarray, rot: np.ndarray, shift: np.ndarray, p: np.ndarray):
     """Outward normals of copies ``R(rot) local + shift`` of one counter-clockwise outline at points ``p`` ``(K, 2)`` on them.
 
@@ -97,13 +111,10 @@ def _smooth_normals(local: np.ndarray, rot: np.ndarray, shift: np.ndarray, p: np
     c, s = np.cos(rot), np.sin(rot)
     d = p - shift
     q = np.stack([c * d[:, 0] + s * d[:, 1], -s * d[:, 0] + c * d[:, 1]], axis=-1)
-    # the nearest edge and the place on it: GEOS projects the points onto the template's ring
-    L = np.sqrt(L2)
-    cum = np.concatenate([[0.0], np.cumsum(L)])
-    sl = shapely.line_locate_point(shapely.linearrings(local), shapely.points(q))
+    # the nearest edge and the place on it (the points lie on the outline): every edge at once, (K, N)
+    e, te = _project(local, ab, L2, q)
     N = len(local)
-    e = np.clip(np.searchsorted(cum, sl, side="right") - 1, 0, N - 1)
-    te = np.clip((sl - cum[e]) / L[e], 0.0, 1.0)[:, None]
+    te = te[:, None]
     n = (1.0 - te) * vn[e] + te * vn[(e + 1) % N]
     n /= np.hypot(n[:, 0], n[:, 1])[:, None]
     return np.stack([c * n[:, 0] - s * n[:, 1], s * n[:, 0] + c * n[:, 1]], axis=-1), kink_edge[e]
