@@ -54,7 +54,14 @@ def _deepest(pts: np.ndarray, template, rot: np.ndarray, shift: np.ndarray):
     kk, ii = np.nonzero(ins)
     if kk.size == 0:
         return depth, vert, near
-    dist = shapely.distance(template.ring, shapely.points(qx[kk, ii], qy[kk, ii]))
+    # distance of the inside vertices to the outline and the nearest point on it, every edge at once (the
+    # engine's Template.boundary_distance, which also keeps the point)
+    loc = template.local
+    ab = np.roll(loc, -1, axis=0) - loc
+    q = np.stack([qx[kk, ii], qy[kk, ii]], axis=-1)
+    e, t = _project(loc, ab, np.maximum((ab * ab).sum(axis=-1), 1e-300), q)
+    foot = loc[e] + t[:, None] * ab[e]
+    dist = np.hypot(*(q - foot).T)
     full = np.full((K, N), -1.0)
     full[kk, ii] = dist
     best = np.argmax(full, axis=1)
@@ -62,8 +69,9 @@ def _deepest(pts: np.ndarray, template, rot: np.ndarray, shift: np.ndarray):
     k = np.nonzero(has)[0]
     depth[k] = full[k, best[k]]
     vert[k] = pts[k, best[k]]
-    seg = shapely.get_coordinates(shapely.shortest_line(template.ring, shapely.points(qx[k, best[k]], qy[k, best[k]])))
-    nl = seg.reshape(-1, 2, 2)[:, 0]
+    fk = np.full((K, N), -1, dtype=int)
+    fk[kk, ii] = np.arange(len(kk))
+    nl = foot[fk[k, best[k]]]
     ck, sk = c[k, 0], s[k, 0]
     near[k] = np.stack([ck * nl[:, 0] - sk * nl[:, 1], sk * nl[:, 0] + ck * nl[:, 1]], axis=-1) + shift[k]
     return depth, vert, near
