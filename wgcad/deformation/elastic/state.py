@@ -310,7 +310,11 @@ def solve_load(model: ElasticModel, torque_nm: float, cam_offset_um: float = 0.0
         if settled >= 3:
             relaxed = True
             break
-        if it >= 5 and change > 0.95 * last_change:  # a cycle, not a slow contraction
+        cycling = it >= 5 and change > 0.95 * last_change  # a cycle, not a slow contraction
+        # once relaxing: a step not yet settled while the change does not halve per pass relaxes further
+        # (a 2-cycle's change stays near its amplitude; halving only on the passes where it grows took twice the passes)
+        unsettled = omega < 1.0 and change > 0.5 * last_change and change * omega >= 0.25 * tol
+        if cycling or unsettled:
             omega = max(omega * 0.5, _OMEGA_MIN)
             acc.reset()
         last_change = change
