@@ -57,9 +57,9 @@ def _deepest(pts: np.ndarray, template, rot: np.ndarray, shift: np.ndarray):
     # distance of the inside vertices to the outline and the nearest point on it, every edge at once (the
     # engine's Template.boundary_distance, which also keeps the point)
     loc = template.local
-    ab = np.roll(loc, -1, axis=0) - loc
+    ab, L2, _, _ = _outline(loc)
     q = np.stack([qx[kk, ii], qy[kk, ii]], axis=-1)
-    e, t = _project(loc, ab, np.maximum((ab * ab).sum(axis=-1), 1e-300), q)
+    e, t = _project(loc, ab, L2, q)
     foot = loc[e] + t[:, None] * ab[e]
     dist = np.hypot(*(q - foot).T)
     full = np.full((K, N), -1.0)
@@ -91,6 +91,30 @@ def _project(a: np.ndarray, ab: np.ndarray, L2: np.ndarray, q: np.ndarray):
     return e, t[np.arange(len(q)), e]
 
 
+_OUTLINES: dict = {}
+
+
+def _outline(local: np.ndarray):
+    """Edges ``ab`` ``(N, 2)`` (vertex i to i+1), their squared lengths, the unit vertex normals (mean of the two
+    edge normals) and how sharp the outline turns at the ends of each edge, rad: computed once per outline."""
+    key = local.tobytes()
+    got = _OUTLINES.get(key)
+    if got is None:
+        ab = np.roll(local, -1, axis=0) - local
+        L2 = np.maximum((ab * ab).sum(axis=-1), 1e-300)
+        en = np.stack([ab[:, 1], -ab[:, 0]], axis=-1) / np.sqrt(L2)[:, None]  # edge i: vertex i -> i+1
+        vn = en + np.roll(en, 1, axis=0)  # vertex i: edges i-1 and i
+        vn /= np.hypot(vn[:, 0], vn[:, 1])[:, None]
+        turn = np.arccos(np.clip((np.roll(en, 1, axis=0) * en).sum(axis=-1), -1.0, 1.0))  # at vertex i
+        got = (ab, L2, vn, np.maximum(turn, np.roll(turn, -1)))
+        for x in got:
+            x.setflags(write=False)
+        if len(_OUTLINES) > 32:
+            _OUTLINES.clear()
+        _OUTLINES[key] = got
+    return got
+
+
 def _smooth_normals(local: np.ndarray, rot: np.ndarray, shift: np.ndarray, p: np.ndarray):
     """Outward normals of copies ``R(rot) local + shift`` of one counter-clockwise outline at points ``p`` ``(K, 2)`` on them.
 
@@ -106,15 +130,7 @@ def _smooth_normals(local: np.ndarray, rot: np.ndarray, shift: np.ndarray, p: np
     kink : (K,) float
         How sharp the outline turns at the ends of that edge, rad (0: straight, pi/2: a right-angled corner).
     """
-    a = local
-    b = np.roll(local, -1, axis=0)
-    ab = b - a
-    L2 = np.maximum((ab * ab).sum(axis=-1), 1e-300)
-    en = np.stack([ab[:, 1], -ab[:, 0]], axis=-1) / np.sqrt(L2)[:, None]  # edge i: vertex i -> i+1
-    vn = en + np.roll(en, 1, axis=0)  # vertex i: edges i-1 and i
-    vn /= np.hypot(vn[:, 0], vn[:, 1])[:, None]
-    turn = np.arccos(np.clip((np.roll(en, 1, axis=0) * en).sum(axis=-1), -1.0, 1.0))  # at vertex i
-    kink_edge = np.maximum(turn, np.roll(turn, -1))
+    ab, L2, vn, kink_edge = _outline(local)
     # the points in the template's frame
     c, s = np.cos(rot), np.sin(rot)
     d = p - shift
