@@ -8,7 +8,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from wgcad.errors import DesignError
-from wgcad.placement import pose_from_displacements, transform
+from wgcad.placement import pose_from_displacements
 
 from .loaded import LoadedLaw
 from .model import ElasticModel
@@ -139,8 +139,11 @@ def _poses(model: ElasticModel, loads: np.ndarray, rigid):
     c, sn = np.cos(phi).ravel(), np.sin(phi).ravel()
     w, v = w.ravel(), v.ravel()
     origin = np.stack([(d.r_m + w) * c - v * sn, (d.r_m + w) * sn + v * c], axis=-1)
-    tips = transform(model.scene.flex_tip_local, rot, shift)
-    R = np.hypot(tips[..., 0], tips[..., 1]).max(axis=1)
+    # outermost tip radius of each placed tooth: |R p + s|^2 = |p|^2 + |s|^2 + 2 p . R^T s, one small product
+    tip = model.scene.flex_tip_local
+    cr, sr = np.cos(rot), np.sin(rot)
+    u = np.stack([cr * shift[:, 0] + sr * shift[:, 1], -sr * shift[:, 0] + cr * shift[:, 1]], axis=-1)
+    R = np.sqrt(((tip * tip).sum(axis=1) + 2.0 * (u @ tip.T)).max(axis=1) + (shift * shift).sum(axis=1))
     cand = np.nonzero(R >= model.scene.r_tip_b - RADIAL_MARGIN)[0]
     return rot, shift, origin, el, cand
 
