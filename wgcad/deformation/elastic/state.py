@@ -181,6 +181,17 @@ def _assemble(model: ElasticModel, pairs: MeasuredPairs, keys, el, rigid, e, F_p
             np.concatenate([A_b, pairs.A[keys]]), np.concatenate([q_b, q_t]), np.concatenate([s_b, s_t]))
 
 
+def _first_guess(model: ElasticModel, keys, q, Z: int, torque_nm: float):
+    """Contacts guessed to carry load in a cold start's first contact solve: the closed ones (q < 0), less the
+    non-working flanks under torque (the torque unloads them). Only the solver's starting point: its solution
+    is unique (strictly convex), the pivots to reach it fewer."""
+    act = q < 0.0
+    if torque_nm > 0 and len(keys):
+        working = 1 if model.scene.working == "upper" else 0
+        act[Z:] &= (keys % 2) == working
+    return act
+
+
 def _merge_loads(phi, loads):
     """Generalized loads summed per distinct angle, zero ones dropped (same field, far fewer kernel evaluations)."""
     nz = np.any(loads != 0.0, axis=1)
@@ -280,7 +291,7 @@ def solve_load(model: ElasticModel, torque_nm: float, cam_offset_um: float = 0.0
                 M = M.with_contact(s_c)
                 active = F > 0
             try:
-                sol = solve_contact_qp(M, q, A, f_ext, active=active if (it or h) else None)
+                sol = solve_contact_qp(M, q, A, f_ext, active=active if (it or h) else _first_guess(model, keys, q, Z, torque_nm))
             except ContactSolveError as exc:
                 if torque_nm > 0 and len(keys) and "balance" in str(exc):
                     raise DesignError("generator.w0_coef", f"no set of tooth contacts can carry {torque_nm:g} N m: the teeth never meet "
