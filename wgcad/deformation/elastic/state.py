@@ -182,9 +182,9 @@ def _assemble(model: ElasticModel, pairs: MeasuredPairs, keys, el, rigid, e, F_p
 
 
 def _first_guess(model: ElasticModel, keys, q, Z: int, torque_nm: float):
-    """Contacts guessed to carry load in a cold start's first contact solve: the closed ones (q < 0), less the
-    non-working flanks under torque (the torque unloads them). Only the solver's starting point: its solution
-    is unique (strictly convex), the pivots to reach it fewer."""
+    """Contacts guessed to carry load in a state's first contact solve (cold, or warm from another torque): the
+    closed ones (q < 0), less the non-working flanks under torque (the torque unloads them). Only the solver's
+    starting point: its solution is unique (strictly convex), the pivots to reach it fewer."""
     act = q < 0.0
     if torque_nm > 0 and len(keys):
         working = 1 if model.scene.working == "upper" else 0
