@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from wgcad.clearance.engine import Scene, clearance_at_poses
-from wgcad.deformation.elastic.teeth import flank_contacts
+from wgcad.deformation.elastic.teeth import flank_contacts, pair_contacts
 from wgcad.design import load_design
 from wgcad.drive import build_drive
 from wgcad.placement import tooth_pose
@@ -35,3 +35,43 @@ def test_flank_gaps_are_the_engines_signed_clearance(name):
                 n = got[key].normal
                 assert np.allclose(np.hypot(n[:, 0], n[:, 1]), 1.0)
     assert n_over > 0  # the overlapping branch was exercised
+
+
+@pytest.mark.parametrize("name", ["d1_involute", "d1_cycloidal"])
+def test_contact_points_located_on_the_outline_as_geos_does(name):
+    # the smooth normals interpolate along the edge nearest to each contact point; _project finds it in numpy:
+    # the place along the outline must be shapely.line_locate_point's to 1e-12 mm, for the contact points of
+    # both teeth (ends of the shortest segments between placed teeth, deepest vertices) on the real templates
+    import shapely
+
+    from wgcad.deformation.elastic.teeth import _project
+    from wgcad.placement import transform
+
+    drive = build_drive(load_design(ROOT / "templates" / f"{name}.toml"))
+    scene = Scene(drive)
+    phi = 2 * np.pi * np.arange(drive.design.drive.z_flex) / drive.design.drive.z_flex
+    checked = 0
+    for dv in ((0.0, 0.0), (0.01, -0.02), (-0.03, 0.01)):
+        rot, shift = tooth_pose(drive.law_at(0.0), phi, drive.r_m)
+        shift = shift + np.array(dv)
+        lo, up, _ = scene.neighbours(shift, rot)
+        for rigid in (lo, up):
+            flex = shapely.polygons(transform(scene.flex_local, rot, shift))
+            seg = shapely.get_coordinates(shapely.shortest_line(flex, scene.rigid_geoms[rigid])).reshape(-1, 2, 2)
+            g = pair_contacts(scene, rot, shift, rigid)
+            for local, r, s, p in ((scene.flex_local, rot, shift, g.point),
+                                   (scene.rigid.local, scene.rigid_rot[rigid], scene.rigid_shift[rigid], seg[:, 1])):
+                c, sn = np.cos(r), np.sin(r)
+                d = p - s
+                q = np.stack([c * d[:, 0] + sn * d[:, 1], -sn * d[:, 0] + c * d[:, 1]], axis=-1)
+                ab = np.roll(local, -1, axis=0) - local
+                L2 = (ab * ab).sum(axis=-1)
+                e, t = _project(local, ab, L2, q)
+                cum = np.concatenate([[0.0], np.cumsum(np.sqrt(L2))])
+                got = cum[e] + t * np.sqrt(L2[e])
+                ref = shapely.line_locate_point(shapely.linearrings(local), shapely.points(q))
+                per = cum[-1]  # the start vertex is both 0 and the perimeter along the ring
+                assert np.abs((got - ref + 0.5 * per) % per - 0.5 * per).max() < 1e-12
+                checked += len(q)
+        assert (g.gap < 0).any()  # overlapping pairs (deepest vertices) among them
+    assert checked > 2000

@@ -56,18 +56,18 @@ class _Dense:
         return self.M[:, W]
 
 
-def _gap(M, q, A, F, a, W):
-    """``q + M F - A a`` for ``F`` supported on ``W``."""
-    return q + M.cols(W) @ F[W] - A @ a
+def _gap(M, q, A, F, a, W, MW=None):
+    """``q + M F - A a`` for ``F`` supported on ``W`` (``MW``: ``M[:, W]`` when already at hand)."""
+    return q + (M.cols(W) if MW is None else MW) @ F[W] - A @ a
 
 
-def _kkt(M, q, A, f, W):
+def _kkt(M, q, A, f, W, MW=None):
     """Solve the equality-constrained system on the active set ``W``; least-norm multipliers when rank-deficient."""
     m, r = A.shape
     F = np.zeros(m)
     if W.size == 0:
         return F, np.zeros(r)
-    Mw = M.cols(W)[W]
+    Mw = (M.cols(W) if MW is None else MW)[W]
     Aw = A[W]
     # inputs are finite by construction (geometry and compliances checked where they are made)
     cf = cho_factor(Mw, check_finite=False)
@@ -119,14 +119,15 @@ def solve_contact_qp(M, q, A, f, active=None, tol_gap: float = 1e-12, max_iter: 
     best, p_left = m + 1, 3
     for it in range(max_iter):
         W = np.nonzero(act)[0]
-        F, a = _kkt(M, q, A, f, W)
-        gap = _gap(M, q, A, F, a, W)
+        MW = M.cols(W)  # once per pivot: the system and the gaps both need these columns
+        F, a = _kkt(M, q, A, f, W, MW)
+        gap = _gap(M, q, A, F, a, W, MW)
         bad_F = act & (F < -tol_F)
         bad_g = ~act & (gap < -tol_gap)
         n_bad = int(bad_F.sum() + bad_g.sum())
         if n_bad == 0:
             F = np.where(act, np.maximum(F, 0.0), 0.0)
-            gap = _gap(M, q, A, F, a, W)
+            gap = _gap(M, q, A, F, a, W, MW)
             return _finish(M, q, A, f, F, a, gap, it, tol_gap)
         if n_bad < best:
             best, p_left = n_bad, 3

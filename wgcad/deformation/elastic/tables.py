@@ -118,6 +118,19 @@ class Compliance:
             self._have[new] = True
         return self._D[:, W]
 
+    def with_contact(self, s: np.ndarray) -> "Compliance":
+        """The same ring part with contact compliances ``s`` ``(m,)`` on the diagonal (the columns built so far kept)."""
+        new = object.__new__(Compliance)
+        new.__dict__.update(self.__dict__)
+        s = np.asarray(s, dtype=float)
+        new._s = s
+        new._D = self._D.copy()
+        j = np.nonzero(self._have)[0]
+        new._D[j, j] += s[j] - self._s[j]
+        new._have = self._have.copy()
+        new.diag = self.diag - self._s + s
+        return new
+
     def dense(self) -> np.ndarray:
         """The whole matrix (tests, small problems)."""
         return self.cols(np.arange(self.shape[0]))

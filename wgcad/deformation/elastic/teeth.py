@@ -54,7 +54,14 @@ def _deepest(pts: np.ndarray, template, rot: np.ndarray, shift: np.ndarray):
     kk, ii = np.nonzero(ins)
     if kk.size == 0:
         return depth, vert, near
-    dist = shapely.distance(template.ring, shapely.points(qx[kk, ii], qy[kk, ii]))
+    # distance of the inside vertices to the outline and the nearest point on it, every edge at once (the
+    # engine's Template.boundary_distance, which also keeps the point)
+    loc = template.local
+    ab, L2, _, _ = _outline(loc)
+    q = np.stack([qx[kk, ii], qy[kk, ii]], axis=-1)
+    e, t = _project(loc, ab, L2, q)
+    foot = loc[e] + t[:, None] * ab[e]
+    dist = np.hypot(*(q - foot).T)
     full = np.full((K, N), -1.0)
     full[kk, ii] = dist
     best = np.argmax(full, axis=1)
@@ -62,11 +69,50 @@ def _deepest(pts: np.ndarray, template, rot: np.ndarray, shift: np.ndarray):
     k = np.nonzero(has)[0]
     depth[k] = full[k, best[k]]
     vert[k] = pts[k, best[k]]
-    seg = shapely.get_coordinates(shapely.shortest_line(template.ring, shapely.points(qx[k, best[k]], qy[k, best[k]])))
-    nl = seg.reshape(-1, 2, 2)[:, 0]
+    fk = np.full((K, N), -1, dtype=int)
+    fk[kk, ii] = np.arange(len(kk))
+    nl = foot[fk[k, best[k]]]
     ck, sk = c[k, 0], s[k, 0]
     near[k] = np.stack([ck * nl[:, 0] - sk * nl[:, 1], sk * nl[:, 0] + ck * nl[:, 1]], axis=-1) + shift[k]
     return depth, vert, near
+
+
+def _project(a: np.ndarray, ab: np.ndarray, L2: np.ndarray, q: np.ndarray):
+    """Nearest edge ``e`` ``(K,)`` of a closed outline (vertices ``a`` ``(N, 2)``, edges ``ab`` from vertex i to i+1,
+    squared lengths ``L2``) to points ``q`` ``(K, 2)``, and the place ``t`` in [0, 1] on it of the nearest point.
+
+    What ``shapely.line_locate_point`` on the outline's ring gives, without building a geometry per call (the
+    first edge where two are equally near: at a shared vertex both give the same interpolated normal).
+    """
+    rel = q[:, None, :] - a[None, :, :]  # (K, N, 2)
+    t = np.clip((rel[..., 0] * ab[:, 0] + rel[..., 1] * ab[:, 1]) / L2, 0.0, 1.0)
+    dx, dy = rel[..., 0] - t * ab[:, 0], rel[..., 1] - t * ab[:, 1]
+    e = np.argmin(dx * dx + dy * dy, axis=1)
+    return e, t[np.arange(len(q)), e]
+
+
+_OUTLINES: dict = {}
+
+
+def _outline(local: np.ndarray):
+    """Edges ``ab`` ``(N, 2)`` (vertex i to i+1), their squared lengths, the unit vertex normals (mean of the two
+    edge normals) and how sharp the outline turns at the ends of each edge, rad: computed once per outline."""
+    key = local.tobytes()
+    got = _OUTLINES.get(key)
+    if got is None:
+        ab = np.roll(local, -1, axis=0) - local
+        L2 = np.maximum((ab * ab).sum(axis=-1), 1e-300)
+        en = np.stack([ab[:, 1], -ab[:, 0]], axis=-1) / np.sqrt(L2)[:, None]  # edge i: vertex i -> i+1
+        vn = en + np.roll(en, 1, axis=0)  # vertex i: edges i-1 and i
+        vn /= np.hypot(vn[:, 0], vn[:, 1])[:, None]
+        turn = np.arccos(np.clip((np.roll(en, 1, axis=0) * en).sum(axis=-1), -1.0, 1.0))  # at vertex i
+        got = (ab, L2, vn, np.maximum(turn, np.roll(turn, -1)))
+        for x in got:
+            x.setflags(write=False)
+        if len(_OUTLINES) > 32:
+            _OUTLINES.clear()
+        _OUTLINES[key] = got
+    return got
 
 
 def _smooth_normals(local: np.ndarray, rot: np.ndarray, shift: np.ndarray, p: np.ndarray):
@@ -84,26 +130,15 @@ def _smooth_normals(local: np.ndarray, rot: np.ndarray, shift: np.ndarray, p: np
     kink : (K,) float
         How sharp the outline turns at the ends of that edge, rad (0: straight, pi/2: a right-angled corner).
     """
-    a = local
-    b = np.roll(local, -1, axis=0)
-    ab = b - a
-    L2 = np.maximum((ab * ab).sum(axis=-1), 1e-300)
-    en = np.stack([ab[:, 1], -ab[:, 0]], axis=-1) / np.sqrt(L2)[:, None]  # edge i: vertex i -> i+1
-    vn = en + np.roll(en, 1, axis=0)  # vertex i: edges i-1 and i
-    vn /= np.hypot(vn[:, 0], vn[:, 1])[:, None]
-    turn = np.arccos(np.clip((np.roll(en, 1, axis=0) * en).sum(axis=-1), -1.0, 1.0))  # at vertex i
-    kink_edge = np.maximum(turn, np.roll(turn, -1))
+    ab, L2, vn, kink_edge = _outline(local)
     # the points in the template's frame
     c, s = np.cos(rot), np.sin(rot)
     d = p - shift
     q = np.stack([c * d[:, 0] + s * d[:, 1], -s * d[:, 0] + c * d[:, 1]], axis=-1)
-    # the nearest edge and the place on it: GEOS projects the points onto the template's ring
-    L = np.sqrt(L2)
-    cum = np.concatenate([[0.0], np.cumsum(L)])
-    sl = shapely.line_locate_point(shapely.linearrings(local), shapely.points(q))
+    # the nearest edge and the place on it (the points lie on the outline): every edge at once, (K, N)
+    e, te = _project(local, ab, L2, q)
     N = len(local)
-    e = np.clip(np.searchsorted(cum, sl, side="right") - 1, 0, N - 1)
-    te = np.clip((sl - cum[e]) / L[e], 0.0, 1.0)[:, None]
+    te = te[:, None]
     n = (1.0 - te) * vn[e] + te * vn[(e + 1) % N]
     n /= np.hypot(n[:, 0], n[:, 1])[:, None]
     return np.stack([c * n[:, 0] - s * n[:, 1], s * n[:, 0] + c * n[:, 1]], axis=-1), kink_edge[e]
