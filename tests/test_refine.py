@@ -89,3 +89,20 @@ def test_boundary_distance_matches_shapely():
     pts = rng.uniform(lo - 0.2, hi + 0.2, size=(5000, 2))
     ref = shapely.distance(t.ring, shapely.points(pts))
     assert np.abs(t.boundary_distance(pts) - ref).max() < 1e-12
+
+
+def test_backlash_on_the_exact_curves_matches_dense_polygons_at_any_chord_tolerance():
+    # issue 8: backlash is a figure of the summary, so it too must not depend on the chord
+    # tolerance. D4 has dead travel at generator angle 0 (0.8 arcmin). The reference is the polygon
+    # backlash of 0.00005 um outlines: their clearance is within 1e-7 mm of the curves', which at the
+    # contacts' slopes (~19 mm per rad of turn on D4) moves each side's contact by ~5e-9 rad; two
+    # sides: tolerance 2e-8 rad (0.004 arcsec). The 1 um polygons alone are 2.6 arcsec short.
+    from wgcad.clearance.backlash import backlash
+
+    design = load_design(TEMPLATES / "d4_discrete.toml")
+    ref = backlash(Scene(build_drive(design, tol=5e-8)), 0.0, None)
+    exact = [backlash(Scene(build_drive(design, tol=t)), 0.0, None, exact=True) for t in (1e-2, 1e-3)]
+    poly = backlash(Scene(build_drive(design, tol=1e-3)), 0.0, None)
+    assert abs(exact[0] - ref) < 2e-8 and abs(exact[1] - ref) < 2e-8
+    assert abs(exact[0] - exact[1]) < 1e-10
+    assert abs(poly - ref) > 5e-6  # the polygon figure was off: the test would have caught it

@@ -285,8 +285,8 @@ def audit(drive, settings: AuditSettings, progress=None) -> AuditResult:
     _stage(tick, "backlash")(0.0)
     # backlash at the first requested generator angle, middle section
     z_mid = sections[len(sections) // 2]
-    bl = float(backlash(scene, float(angles[0]), z_mid))
-    backlash_f = Finding("backlash", bl, "brent",
+    bl = float(backlash(scene, float(angles[0]), z_mid, exact=settings.refine))
+    backlash_f = Finding("backlash", bl, "exact" if settings.refine else "brent",
                          generator_angle=float(angles[0]), section_z=z_mid)
     tick(1.0, "done")
     evaluated = int(sum(r.evaluated.sum() for r in results))
