@@ -77,8 +77,10 @@ def backlash(scene: Scene, phi_h: float, z=None, exact: bool = False) -> float:
     sides = []
     for idx, direction in ((up, 1.0), (lo, -1.0)):
         d = scene.clearance_to(rot0, shift0, idx)
+        if d.min() + gap < 0:
+            return float("nan")  # interfere on the curves too: the polygon figure is within gap of theirs
         if exact:  # whether the teeth touch or interfere is decided on the exact curves
-            near = np.nonzero(d < 2.0 * gap)[0]
+            near = np.nonzero(d < gap)[0]
             if near.size:
                 d = d.copy()
                 d[near] = scene.exact_to(rot0[near], shift0[near], idx[near])[0]
@@ -95,9 +97,11 @@ def backlash(scene: Scene, phi_h: float, z=None, exact: bool = False) -> float:
             # the best found, no later tooth can beat it (less the polygon-curve gap when exact)
             if (d[i] - gap) / r_max >= best:
                 break
-            angle[int(i)] = contact_angle(int(i), int(idx[i]), direction)
+            # (a pair the polygons overlap but the curves do not starts from no turn)
+            angle[int(i)] = max(contact_angle(int(i), int(idx[i]), direction), 0.0) if exact else \
+                contact_angle(int(i), int(idx[i]), direction)
             best = min(best, angle[int(i)])
-        if exact and np.isfinite(best) and best > 0:
+        if exact and np.isfinite(best):
             best = _exact_side(scene, turned, idx, direction, d, angle, best, gap)
         total += best
     return float(total)
@@ -112,9 +116,10 @@ def _exact_side(scene, turned, idx, direction, d, angle, best, gap) -> float:
     is solved by Newton on the exact clearance (``Scene.exact_to``; the
     derivative by a 1e-9 rad difference), all in one batch per step.
     """
-    rows = np.array([i for i, a in angle.items() if np.isfinite(a) and a > 0], dtype=int)
+    rows = np.array([i for i, a in angle.items() if np.isfinite(a)], dtype=int)
     a = np.array([angle[i] for i in rows])
-    slope = np.maximum(d[rows] / a, 1e-12)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        slope = np.where(a > 0, np.maximum(d[rows] / a, 1e-12), np.inf)
     j = int(np.argmin(a))
     keep = a - 2.0 * gap / slope <= a[j] + 2.0 * gap / slope[j]
     rows, x = rows[keep], a[keep].copy()
