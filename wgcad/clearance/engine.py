@@ -314,12 +314,7 @@ def audit(drive, settings: AuditSettings, progress=None) -> AuditResult:
         "mirror_symmetry": bool(settings.use_mirror),
         "culling": bool(settings.cull),
         "branch_and_bound": bool(settings.bound),
-        "chord_tol_um": round(1e3 * drive.tol, 6),
-        "refined": bool(settings.refine),
-        "refine_tol_um": round(1e3 * constants.REFINE_TOL, 6) if settings.refine else None,
-        "error_side": ("figures on the exact curves, within refine_tol_um either side" if settings.refine else
-                       "polygon figures: chords lie inside convex and outside concave curve parts, "
-                       "so each figure is within 2 x chord_tol_um of the exact one, either side"),
+        **accuracy_settings(drive, settings.refine),
         "working_flank": scene.working,
         "entry_side": "entry (+phi)" if scene.entry_sign > 0 else "entry (-phi)",
         "rigid_pitch_radius_mm": drive.rigid.r,
@@ -334,6 +329,18 @@ def audit(drive, settings: AuditSettings, progress=None) -> AuditResult:
     )
     res.elapsed_s = time.perf_counter() - t0
     return res
+
+
+def accuracy_settings(drive, refine: bool) -> dict:
+    """The settings entries that say how exact an audit's figures are (shared by the perfect and imperfect audits)."""
+    return {
+        "chord_tol_um": round(1e3 * drive.tol, 6),
+        "refined": bool(refine),
+        "refine_tol_um": round(1e3 * constants.REFINE_TOL, 6) if refine else None,
+        "error_side": ("figures on the exact curves, within refine_tol_um either side" if refine else
+                       "polygon figures: chords lie inside convex and outside concave curve parts, "
+                       "so each figure is within 2 x chord_tol_um of the exact one, either side"),
+    }
 
 
 def _worst_finding(scene: Scene, phi_all, period, phi_w: float, z_w, exact: bool, angles, best: float, best_poly: float) -> Finding:

@@ -29,7 +29,6 @@ from math import pi
 import numpy as np
 import shapely
 
-from .. import constants
 from ..accuracy.imperfect import (Imperfections, cam_offset, coning_factor, flex_deviations, rigid_poses,
                                   rigid_translation, shortcuts)
 from ..placement import pose_from_displacements, transform
@@ -205,7 +204,7 @@ def audit_imperfect(drive, settings, imp: Imperfections, progress=None, chunk_sa
         Entry gap and pinch are not computed (NaN, ``entry`` says why); the
         backlash is the imperfect drive's at the first generator angle.
     """
-    from .engine import AuditResult
+    from .engine import AuditResult, accuracy_settings
     from .findings import Finding
 
     t0 = time.perf_counter()
@@ -382,12 +381,7 @@ def audit_imperfect(drive, settings, imp: Imperfections, progress=None, chunk_sa
         "shortcuts_that_hold": {k2: sc[k2] for k2 in ("mesh_period", "identical_waves", "mirror_symmetry")},
         "shortcuts_note": ("imperfect parts: every (generator angle, tooth, section) sample posed with its errors, "
                            f"in chunks of {B} generator angles; bounds only along a tooth's track ({sc['why']})"),
-        "chord_tol_um": round(1e3 * drive.tol, 6),
-        "refined": bool(settings.refine),
-        "refine_tol_um": round(1e3 * constants.REFINE_TOL, 6) if settings.refine else None,
-        "error_side": ("figures on the exact curves, within refine_tol_um either side" if settings.refine else
-                       "polygon figures: chords lie inside convex and outside concave curve parts, "
-                       "so each figure is within 2 x chord_tol_um of the exact one, either side"),
+        **accuracy_settings(drive, settings.refine),
         "working_flank": scene.working,
         "rigid_pitch_radius_mm": drive.rigid.r,
     }

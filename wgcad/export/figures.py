@@ -2,10 +2,11 @@
 
 from __future__ import annotations
 
-import io
 from math import ceil, pi
 
 import numpy as np
+
+from .mpl import png_bytes, pyplot
 
 __all__ = [
     "DPI",
@@ -34,23 +35,12 @@ _STRIP_MIN_IN = 1.15
 _STRIP_WIDTH_IN = 10.5
 
 
-def _pyplot():
-    """matplotlib.pyplot on the Agg backend, imported only when a picture is drawn (~1 s)."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    return plt
+_pyplot = pyplot
 
 
 def _png(fig) -> bytes:
     """Render a figure to PNG bytes at :data:`DPI` and release it."""
-    plt = _pyplot()
-    buf = io.BytesIO()
-    fig.savefig(buf, format="png", dpi=DPI)
-    plt.close(fig)
-    return buf.getvalue()
+    return png_bytes(fig, dpi=DPI)
 
 
 def _unroll(pts: np.ndarray, r_ref: float, a_ref: float) -> np.ndarray:

@@ -2,30 +2,18 @@
 
 from __future__ import annotations
 
-import io
 
 import numpy as np
+
+from .mpl import png_bytes, pyplot as _plt
 
 __all__ = ["ke_png", "install_png", "flank_png"]
 
 _AS = 180.0 / np.pi * 3600.0
 
 
-def _plt():
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    return plt
-
-
 def _png(fig, plt) -> bytes:
-    buf = io.BytesIO()
-    fig.tight_layout()
-    fig.savefig(buf, format="png")
-    plt.close(fig)
-    return buf.getvalue()
+    return png_bytes(fig, tight_layout=True)
 
 
 def ke_png(title: str, res, orders, amp, expected: dict, intrinsic=None) -> bytes:

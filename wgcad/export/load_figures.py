@@ -2,27 +2,21 @@
 
 from __future__ import annotations
 
-import io
 
 import numpy as np
+
+from .mpl import png_bytes, pyplot
 
 __all__ = ["entry_gap_png", "force_distribution_png"]
 
 
 def _fig(w=9.0, h=5.0):
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
+    plt = pyplot()
     return plt, plt.figure(figsize=(w, h), dpi=110)
 
 
 def _png(plt, fig) -> bytes:
-    buf = io.BytesIO()
-    fig.savefig(buf, format="png", bbox_inches="tight", metadata={"Software": None})
-    plt.close(fig)
-    return buf.getvalue()
+    return png_bytes(fig, bbox_inches="tight", metadata={"Software": None})
 
 
 def entry_gap_png(series: list, title: str, tol_um: float = 1.0) -> bytes:

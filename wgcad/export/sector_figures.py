@@ -2,28 +2,22 @@
 
 from __future__ import annotations
 
-import io
 
 import numpy as np
+
+from .mpl import png_bytes, pyplot
 
 __all__ = ["heights_png", "motion_png", "audit_png"]
 
 
 def _fig(nrows, figsize, **kw):
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
+    plt = pyplot()
     fig, axs = plt.subplots(nrows, 1, figsize=figsize, dpi=100, **kw)
     return plt, fig, axs
 
 
 def _png(plt, fig) -> bytes:
-    buf = io.BytesIO()
-    fig.savefig(buf, format="png")
-    plt.close(fig)
-    return buf.getvalue()
+    return png_bytes(fig)
 
 
 def _shade_sectors(ax, bounds_deg, kinds, lo, hi):

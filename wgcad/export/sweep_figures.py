@@ -2,29 +2,17 @@
 
 from __future__ import annotations
 
-import io
 import math
 
 import numpy as np
 
+from .mpl import png_bytes, pyplot as _plt
+
 __all__ = ["sweep_pngs", "histograms_png", "sensitivity_png", "surface_png"]
 
 
-def _plt():
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    return plt
-
-
 def _png(fig, plt) -> bytes:
-    buf = io.BytesIO()
-    fig.tight_layout()
-    fig.savefig(buf, format="png")
-    plt.close(fig)
-    return buf.getvalue()
+    return png_bytes(fig, tight_layout=True)
 
 
 def _limit_lines(ax, lim, vertical=True):
