@@ -223,18 +223,39 @@ def _second_features(flex, rigid, rows, k, idx, rot, shift, drot, dshift, m_all,
     where a corner turns the other way the smaller rotation would be wrong).
     """
     out = []
-    # the lines known per pair (the perfect contact's, then those added): closing rotation at the
-    # perfect pose and a_rho, NaN where a pair has fewer
-    lines = [(rows["g"], rows["a_rho"])]
-    for f in _RADIAL_STEPS:  # closest first: a line found there is not added again further out
-        ii = idx[k]
-        dr = f * rho
-        sh = shift[ii] + dr * np.stack([np.cos(rot[ii]), np.sin(rot[ii])], -1)
+
+    def solve(f, kk):
+        ii = idx[k[kk]]
+        sh = shift[ii] + f * rho * np.stack([np.cos(rot[ii]), np.sin(rot[ii])], -1)
         with np.errstate(invalid="ignore"):
-            c2 = closing_rotation(flex, rot[ii], sh, rigid, rb[k], np.zeros((len(k), 2)), side, reach)
+            c2 = closing_rotation(flex, rot[ii], sh, rigid, rb[k[kk]], np.zeros((len(kk), 2)), side, reach)
             c2.delta = np.where(c2.ok, c2.delta, 0.0)
-            r2 = _rows(c2, np.arange(len(k)), ii, rot, shift, drot[k], dshift[k], m_all, j[k], cz, side,
-                       np.ones(len(k)))
+            r2 = _rows(c2, np.arange(len(kk)), ii, rot, shift, drot[k[kk]], dshift[k[kk]], m_all, j[k[kk]], cz,
+                       side, np.ones(len(kk)))
+        return c2, r2
+
+    # the full reach first, every pair: those whose closing rotation there is off the perfect contact's
+    # line (either way) or not found are the ones whose feature changes within the reach
+    full = {}
+    for f in (-1.0, 1.0):
+        c2, r2 = solve(f, np.arange(len(k)))
+        pred = rows["g"] - f * rho * rows["a_rho"]
+        moved = ~c2.ok | (np.abs(c2.delta - pred) > _LINE_TOL)
+        full[f] = (c2, r2, np.nonzero(moved)[0])
+    kk = np.unique(np.concatenate([full[-1.0][2], full[1.0][2]]))
+    if kk.size == 0:
+        return out
+    # the lines known per moved pair (the perfect contact's, then those added): closing rotation at the
+    # perfect pose and a_rho, NaN where a pair has fewer
+    lines = [(rows["g"][kk], rows["a_rho"][kk])]
+    for f in _RADIAL_STEPS:  # closest first: a line found there is not added again further out
+        if abs(f) == 1.0:
+            c2, r2, _ = full[f]
+            c2 = type(c2)(c2.delta[kk], c2.p[kk], c2.q[kk], c2.nt[kk], c2.ok[kk])
+            r2 = {key: v[kk] for key, v in r2.items()}
+        else:
+            c2, r2 = solve(f, kk)
+        dr = f * rho
         # back to the perfect pose: the radial move changed the closing rotation by -dr a_rho
         g0 = c2.delta + dr * r2["a_rho"]
         # below every line known: another feature is first here
@@ -242,7 +263,7 @@ def _second_features(flex, rigid, rows, k, idx, rot, shift, drot, dshift, m_all,
         for g_l, a_l in lines:
             off &= ~(c2.delta >= g_l - dr * a_l - _LINE_TOL)  # a NaN line (none) does not hold it back
         new = (off & np.all(np.isfinite(c2.nt), axis=1) & (np.hypot(*c2.nt.T) * r_b <= NT_MAX)
-               & (g0 >= rows["g"] - 1e-12))
+               & (g0 >= rows["g"][kk] - 1e-12))
         sel = np.nonzero(new)[0]
         lines.append((np.where(new, g0, np.nan), np.where(new, r2["a_rho"], np.nan)))
         if sel.size:
