@@ -238,3 +238,25 @@ def test_finite_differences_started_near_the_contact_equal_those_from_rest(monke
     a = K.kinematic_error(drive, imp, table=near, samples=8 * 202 * 10)
     b = K.kinematic_error(drive, imp, table=rest, samples=8 * 202 * 10)
     assert np.abs(a.ke - b.ke).max() * AS < 0.02
+
+
+def test_a_tip_running_into_the_root_fillet_is_followed_by_the_table():
+    # D4 as templated: at the major axis the flexspline tip reaches 18.340 mm, 3 um short of the end of
+    # the rigid involute (18.343 mm, then a 0.1 mm root fillet). A few um of radial error (sweep sample
+    # of tests/test_sweep_yield.py, seed 9 #1) carry the contact into the fillet, where the closing
+    # rotation's slope changes (4.3x steeper on the working side). The table linearised the flank
+    # contact alone: 31 % of 401 samples were 0.5 to 18.7 arcsec off the direct computation (exact poses,
+    # fresh search; at i = 58495 17.96'' against 3.09'') and the largest KE read 92.94'' instead of 107.95''.
+    # Each pair's further features are now candidates too (ke._second_features): over the 401 samples
+    # 0.029'' at most with the table built for these errors, 0.049'' with the one built for the sweep's
+    # largest (40, 15, 20 um); 0.1'' is the tolerance (the linear model's second-order residual at these
+    # errors, cf. the D2 tests above).
+    drive = build_drive(load_design(TEMPLATES / "d4_discrete.toml"))
+    imp = Imperfections(rigid_runout=12.191382894030646e-3, flex_ecc=4.115553110055613e-3, cam_fixed=7.163634705787521e-3)
+    big = imp.replace(rigid_runout=40e-3, flex_ecc=15e-3, cam_fixed=20e-3)
+    for tab in (K.contact_table(drive, imp), K.contact_table(drive, big)):
+        res = K.kinematic_error(drive, imp, table=tab)
+        for i in (0, 58495, 18724, 38807):
+            for side, arr in ((tab.side_w, res.delta_w), (-tab.side_w, res.delta_n)):
+                ref = K.closing_direct(drive, imp, res.phi_h[i], side)
+                assert abs(arr[i] - ref) * AS < 0.1, (i, side, arr[i] * AS, ref * AS)

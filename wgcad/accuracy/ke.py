@@ -23,6 +23,12 @@ What is exploited (tested against the direct computation in tests/test_ke.py):
   stationary cam offsets move the teeth by tens of micrometres; their effect
   on a contact's closing rotation is ``(u_b - u_f) . nt`` with ``nt`` stored
   per contact (:mod:`wgcad.accuracy.contact`);
+* **second features**: where those errors carry a contact onto another
+  feature (a tip running past the end of the other's involute into its root
+  fillet: D4 at the major axis) the closing rotation is the lower of the
+  features' lines; each pair is solved again with its flexspline tooth moved
+  radially within the errors' reach and the other features' lines join the
+  candidates;
 * **pruning**: a contact whose perfect closing rotation exceeds the best of
   its lattice class by more than both error bounds can never be the first;
 * **installation angles**: the closing rotations depend on an installation
@@ -160,25 +166,111 @@ def contact_table(drive, imp: Imperfections, n_per_mesh: int = DEFAULT_N, sectio
                                    reach_pitches * 2 * pi / z_g)
             good = con.ok & (np.hypot(con.nt[:, 0], con.nt[:, 1]) * drive.rigid.r <= NT_MAX)
             k = np.nonzero(good)[0]
-            t = side * con.delta[k]
-            ct, st = np.cos(t), np.sin(t)
-            sh = np.stack([ct * shift[idx[k], 0] - st * shift[idx[k], 1], st * shift[idx[k], 0] + ct * shift[idx[k], 1]], -1)
-            ds = np.stack([ct * dshift[k, 0] - st * dshift[k, 1], st * dshift[k, 0] + ct * dshift[k, 1]], -1)
-            p, q, nt = con.p[k], con.q[k], con.nt[k]
-            dP = drot[k, None] * np.stack([-(p[:, 1] - sh[:, 1]), p[:, 0] - sh[:, 0]], -1) + ds
-            rr = rot[idx[k]] + t
-            parts[side].append({
-                "m": m_all[idx[k]], "g": con.delta[k], "nt": nt,
-                "a_phi": np.einsum("ij,ij->i", dP, nt),
-                "a_rho": np.cos(rr) * nt[:, 0] + np.sin(rr) * nt[:, 1],
-                "a_beta": -q[:, 1] * nt[:, 0] + q[:, 0] * nt[:, 1],
-                "j": j[k], "c": np.full(len(k), cz),
-                "dP": dP, "rr": rr, "q": q, "rot": rot[idx[k]], "shift": shift[idx[k]],
-            })
+            rows = _rows(con, k, idx, rot, shift, drot, dshift, m_all, j, cz, side, np.zeros(len(k)))
+            parts[side].append(rows)
+            # the touching feature can change within the errors' radial reach (a tip reaching past the
+            # end of the other's involute into its root fillet): each pair solved again with its
+            # flexspline tooth moved radially, and the contact found there, carried back to the
+            # perfect pose along its own sensitivity, added as a further candidate (_second_features)
+            rho = cz * (imp.cam_flex + imp.cam_fixed) + imp.flex_ecc + imp.rigid_ecc
+            if rho > 0.0 and k.size:
+                parts[side].extend(_second_features(flex, rigid, rows, k, idx, rot, shift, drot, dshift, m_all,
+                                                    j, cz, side, rb, rho, reach_pitches * 2 * pi / z_g,
+                                                    drive.rigid.r))
     for side in (1, -1):
         tab.sides[side] = {key: np.concatenate([p[key] for p in parts[side]]) for key in parts[side][0]}
         _refine(tab, side, imp, flex, rigid, reach_pitches * 2 * pi / z_g)
     return tab
+
+
+def _rows(con, k, idx, rot, shift, drot, dshift, m_all, j, cz, side, extra):
+    """Table rows of contacts ``k`` of a closing-rotation solve (poses ``rot``, ``shift`` indexed by ``idx[k]``)."""
+    t = side * con.delta[k]
+    ct, st = np.cos(t), np.sin(t)
+    sh = np.stack([ct * shift[idx[k], 0] - st * shift[idx[k], 1], st * shift[idx[k], 0] + ct * shift[idx[k], 1]], -1)
+    ds = np.stack([ct * dshift[k, 0] - st * dshift[k, 1], st * dshift[k, 0] + ct * dshift[k, 1]], -1)
+    p, q, nt = con.p[k], con.q[k], con.nt[k]
+    dP = drot[k, None] * np.stack([-(p[:, 1] - sh[:, 1]), p[:, 0] - sh[:, 0]], -1) + ds
+    rr = rot[idx[k]] + t
+    return {
+        "m": m_all[idx[k]], "g": con.delta[k], "nt": nt,
+        "a_phi": np.einsum("ij,ij->i", dP, nt),
+        "a_rho": np.cos(rr) * nt[:, 0] + np.sin(rr) * nt[:, 1],
+        "a_beta": -q[:, 1] * nt[:, 0] + q[:, 0] * nt[:, 1],
+        "j": j[k], "c": np.full(len(k), cz),
+        "dP": dP, "rr": rr, "q": q, "rot": rot[idx[k]], "shift": shift[idx[k]], "extra": extra,
+    }
+
+
+#: radial moves of a flexspline tooth, in units of the errors' radial reach, at which each pair is solved
+#: again for the feature it touches there
+_RADIAL_STEPS = (-0.25, 0.25, -0.5, 0.5, -1.0, 1.0)
+#: a contact found with the tooth moved is another feature when it closes earlier than the lines known
+#: predict by more than this, rad (0.01 arcsec)
+_LINE_TOL = 0.01 / 206264.80624709636
+
+
+def _second_features(flex, rigid, rows, k, idx, rot, shift, drot, dshift, m_all, j, cz, side, rb, rho, reach, r_b):
+    """Contacts on the features a pair touches once the errors move its flexspline tooth radially by up to ``rho``.
+
+    Where the tooth space is locally convex (a tip running from the other's
+    flank into its root fillet), the closing rotation is the smaller of the
+    two features' and each is linear in the errors: the second feature's
+    closing rotation, carried back to the perfect pose along its own
+    sensitivity, is one more candidate of the lattice class, and the KE's
+    minimum over candidates picks it where it is first. Kept only where it is
+    no earlier than the perfect contact at the perfect pose (a lower envelope;
+    where a corner turns the other way the smaller rotation would be wrong).
+    """
+    out = []
+
+    def solve(f, kk):
+        ii = idx[k[kk]]
+        sh = shift[ii] + f * rho * np.stack([np.cos(rot[ii]), np.sin(rot[ii])], -1)
+        with np.errstate(invalid="ignore"):
+            c2 = closing_rotation(flex, rot[ii], sh, rigid, rb[k[kk]], np.zeros((len(kk), 2)), side, reach)
+            c2.delta = np.where(c2.ok, c2.delta, 0.0)
+            r2 = _rows(c2, np.arange(len(kk)), ii, rot, shift, drot[k[kk]], dshift[k[kk]], m_all, j[k[kk]], cz,
+                       side, np.ones(len(kk)))
+        return c2, r2
+
+    # the full reach first, every pair: those whose closing rotation there is off the perfect contact's
+    # line (either way) or not found are the ones whose feature changes within the reach
+    full = {}
+    for f in (-1.0, 1.0):
+        c2, r2 = solve(f, np.arange(len(k)))
+        pred = rows["g"] - f * rho * rows["a_rho"]
+        moved = ~c2.ok | (np.abs(c2.delta - pred) > _LINE_TOL)
+        full[f] = (c2, r2, np.nonzero(moved)[0])
+    kk = np.unique(np.concatenate([full[-1.0][2], full[1.0][2]]))
+    if kk.size == 0:
+        return out
+    # the lines known per moved pair (the perfect contact's, then those added): closing rotation at the
+    # perfect pose and a_rho, NaN where a pair has fewer
+    lines = [(rows["g"][kk], rows["a_rho"][kk])]
+    for f in _RADIAL_STEPS:  # closest first: a line found there is not added again further out
+        if abs(f) == 1.0:
+            c2, r2, _ = full[f]
+            c2 = type(c2)(c2.delta[kk], c2.p[kk], c2.q[kk], c2.nt[kk], c2.ok[kk])
+            r2 = {key: v[kk] for key, v in r2.items()}
+        else:
+            c2, r2 = solve(f, kk)
+        dr = f * rho
+        # back to the perfect pose: the radial move changed the closing rotation by -dr a_rho
+        g0 = c2.delta + dr * r2["a_rho"]
+        # below every line known: another feature is first here
+        off = c2.ok.copy()
+        for g_l, a_l in lines:
+            off &= ~(c2.delta >= g_l - dr * a_l - _LINE_TOL)  # a NaN line (none) does not hold it back
+        new = (off & np.all(np.isfinite(c2.nt), axis=1) & (np.hypot(*c2.nt.T) * r_b <= NT_MAX)
+               & (g0 >= rows["g"][kk] - 1e-12))
+        sel = np.nonzero(new)[0]
+        lines.append((np.where(new, g0, np.nan), np.where(new, r2["a_rho"], np.nan)))
+        if sel.size:
+            r2 = {key: v[sel] for key, v in r2.items()}
+            r2["g"] = g0[sel]
+            out.append(r2)
+    return out
 
 
 #: gap (mm) before the unperturbed contact where the finite-difference solves start (0: from rest)
@@ -199,6 +291,7 @@ def _refine(tab: ContactTable, side: int, imp: Imperfections, flex, rigid, reach
     S = tab.sides[side]
     lanes = _lanes(tab, side, imp, slack=2.0)
     e = np.unique(lanes[lanes >= 0])
+    e = e[S["extra"][e] == 0]  # a second feature's solve from the perfect pose would find the first
     if e.size == 0:
         return
     rb = (S["j"][e] + 0.5) * 2 * pi / tab.z_b
