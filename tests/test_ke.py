@@ -7,6 +7,7 @@ import pytest
 
 from conftest import TEMPLATES, edit_toml
 from wgcad.accuracy import ke as K
+from wgcad.accuracy import ke_table
 from wgcad.accuracy.imperfect import Imperfections, flex_poses, rigid_poses, shortcuts
 from wgcad.cli import main
 from wgcad.design import load_design
@@ -223,14 +224,14 @@ def test_deep_overlaps_are_flagged_where_the_linear_model_fails():
 
 
 def test_finite_differences_started_near_the_contact_equal_those_from_rest(monkeypatch):
-    # The FD sensitivities' solves start 1 um of gap before the unperturbed contact (ke._FD_START) rather
+    # The FD sensitivities' solves start 1 um of gap before the unperturbed contact (ke_table._FD_START) rather
     # than from rest. Both end at the same convergence test (1e-8 mm gap), so the sensitivities agree to
     # the FD's own noise, 1e-10 rad / 1e-4 mm = 1e-6 rad/mm on |nt| ~ 1/80 per mm: 1e-4 relative, and the
     # KE to ~0.1 mm x 1e-6 rad/mm = 1e-7 rad = 0.02 arcsec. D2 [S4], open end, 8 per mesh.
     drive = build_drive(load_design(TEMPLATES / "d2_imperfect.toml"))
     imp = Imperfections.from_spec(drive.design.imperfections)
     near = K.contact_table(drive, imp, 8, sections=[0.0])
-    monkeypatch.setattr(K, "_FD_START", 0.0)
+    monkeypatch.setattr(ke_table, "_FD_START", 0.0)
     rest = K.contact_table(drive, imp, 8, sections=[0.0])
     for side in (1, -1):
         a, b = near.sides[side]["nt"], rest.sides[side]["nt"]

@@ -1,0 +1,374 @@
+"""The perfect drive's contact table for the kinematic error: every tooth pair's closing rotation on a lattice of tooth angles, with its sensitivities to the errors (docs/models.md 6.2, 7).
+
+Built once per drive (and cam-borne offset); :mod:`wgcad.accuracy.ke`
+computes a KE from it for any other errors. A pair's contact is solved on
+the exact poses, its sensitivities by central differences; where the
+errors' radial reach can move a contact onto another surface (a tip into
+the root fillet) that surface is tabulated too (``_second_features``).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from math import pi
+
+import numpy as np
+
+from ..clearance.distance import Template
+from ..errors import DesignError
+from ..kinematics import gear_ratios
+from ..placement import tooth_pose
+from .contact import closing_rotation
+from .imperfect import Imperfections, cam_offset, coning_factor, flex_deviations, rigid_deviations, rigid_translation
+
+__all__ = ["ContactTable", "contact_table", "DEFAULT_N", "NT_MAX"]
+
+#: generator angles per mesh period (2 pi / z_b); benchmarks/ke.py measures the error of
+#: 16 against 160: it is what keeps the full D2 revolution (323 200 angles) within seconds
+DEFAULT_N = 16
+_CHUNK = 8192
+#: contacts whose closing-rotation sensitivity |nt| exceeds this over the pitch radius are dropped:
+#: the contact normal is within 14 deg of radial (a tip grazing a root), a rotation hardly closes
+#: the gap, and a few micrometres of radial error change it by arcminutes (the linear model fails)
+NT_MAX = 2.0
+
+
+def _fold(x):
+    return (x + pi) % (2 * pi) - pi
+
+
+@dataclass
+class ContactTable:
+    """Contacts of the perfect drive (plus the cam-borne offset) on the tooth-angle lattice, per side.
+
+    ``sides[s]`` (s = +1: counter-clockwise, towards the rigid tooth above)
+    holds arrays over the contacts found: lattice index ``m``, ``g``
+    (closing rotation, rad), ``nt`` (E, 2), ``a_phi``, ``a_rho``, ``a_beta``
+    (sensitivities to a tooth's along-rim shift, radial offset, and a rigid
+    tooth's rotation), ``j`` (rigid tooth, table frame), ``c`` (coning factor).
+    """
+
+    z_g: int
+    z_b: int
+    N: int
+    sections: list
+    side_w: int
+    sigma: int
+    r_g: float
+    r_b: float
+    cam_cam: tuple
+    sides: dict = field(default_factory=dict)
+
+
+def _check(drive):
+    d = drive.design.drive
+    if d.fixed != "rigid":
+        raise DesignError("drive.fixed", f"wgcad ke models a fixed rigid gear, flexspline output (docs/models.md 6.2); got '{d.fixed}'")
+
+
+def contact_table(drive, imp: Imperfections, n_per_mesh: int = DEFAULT_N, sections=None, reach_pitches: float = 0.5) -> ContactTable:
+    """Tabulate every tooth's contact on both sides at the ``N z_g`` lattice angles (module docstring).
+
+    Parameters
+    ----------
+    drive : wgcad.drive.Drive
+    imp : Imperfections
+        Only the cam-borne offset enters the table (exactly); the rest is linear.
+    n_per_mesh : int
+        Generator angles per mesh period, N.
+    sections : list of float or None
+        Axial sections (mm from the open end); default the three of the audit
+        (ends and middle) with coning, one without.
+    reach_pitches : float
+        Contacts that need a rotation beyond this many flexspline pitches are dropped.
+    """
+    _check(drive)
+    if not isinstance(n_per_mesh, int) or n_per_mesh < 1:
+        raise DesignError("n_per_mesh", f"must be a positive whole number, got {n_per_mesh!r}")
+    d = drive.design.drive
+    z_g, z_b = d.z_flex, d.z_rigid
+    if sections is None:
+        sections = [float(z) for z in drive.sections(3)] if drive.coned else [None]
+    u = gear_ratios(z_g, z_b)["u_hg"]
+    sigma = 1 if d.rotation == "ccw" else -1
+    side_w = 1 if sigma / u < 0 else -1  # the flank facing against the relative motion carries the load
+    flex, rigid = Template(drive.flex.tooth_polygon()), Template(drive.rigid.tooth_polygon())
+    gamma_b = 2 * pi / z_b
+    M = z_g * n_per_mesh
+    m_all = np.arange(M)
+    phi = _fold(2 * pi * m_all / M)
+    fa = -phi * z_g / z_b  # generator angle that puts a tooth at phi with its material angle at phi (z_b - z_g)/z_b
+    # radial reach of the linear errors (the cam-borne offset is in the table exactly), plus 2 um
+    margin = 2e-3 + imp.flex_ecc + imp.rigid_ecc + imp.cam_flex + imp.cam_fixed
+    tab = ContactTable(z_g, z_b, n_per_mesh, list(sections), side_w, sigma, drive.flex.r, drive.rigid.r,
+                       (imp.cam_cam, imp.cam_cam_phase))
+    parts = {s: [] for s in (1, -1)}
+    h = 1e-6
+    for si, z in enumerate(sections):
+        law = drive.law if z is None else drive.law_at(z)
+        cz = coning_factor(drive, z)
+        off = cz * cam_offset(imp, fa, 0.0, parts=("cam",))
+        rot, shift = tooth_pose(law, phi, drive.r_m, frame_angle=fa)
+        shift = shift + off
+        # radially engaged (plus the errors' reach): the others cannot touch by turning
+        c, s = np.cos(rot), np.sin(rot)
+        xs = flex.local[:, 0][None, :] * c[:, None] - flex.local[:, 1][None, :] * s[:, None] + shift[:, :1]
+        ys = flex.local[:, 0][None, :] * s[:, None] + flex.local[:, 1][None, :] * c[:, None] + shift[:, 1:]
+        R = np.hypot(xs, ys)
+        # radially engaged, or within the errors' radial reach of it. A tooth that barely reaches past
+        # the rigid tip circle touches with a tip corner, and there a few micrometres of radial error
+        # decide whether it touches at all: the linear model holds only for errors well below that
+        # overlap (tests/test_ke.py, benchmarks/ke.py measure it against the direct computation)
+        over = (drive.rigid.r_a - R.min(axis=1)) if drive.external else (R.max(axis=1) - drive.rigid.r_a)
+        eng = over >= -margin
+        idx = np.nonzero(eng)[0]
+        a = np.arctan2(shift[idx, 1] + drive.r_m * s[idx], shift[idx, 0] + drive.r_m * c[idx])
+        lo = np.floor(a / gamma_b - 0.5).astype(int)
+        # derivative of the pose along the rim (tooth angle phi, frame fixed): for the along-rim shifts
+        rp, sp = tooth_pose(law, phi[idx] + h, drive.r_m, frame_angle=fa[idx])
+        rm_, sm = tooth_pose(law, phi[idx] - h, drive.r_m, frame_angle=fa[idx])
+        drot, dshift = (rp - rm_) / (2 * h), (sp - sm) / (2 * h)
+        for side in (1, -1):
+            j = (lo + (1 if side > 0 else 0)) % z_b
+            rb = (j + 0.5) * gamma_b
+            con = closing_rotation(flex, rot[idx], shift[idx], rigid, rb, np.zeros((len(idx), 2)), side,
+                                   reach_pitches * 2 * pi / z_g)
+            good = con.ok & (np.hypot(con.nt[:, 0], con.nt[:, 1]) * drive.rigid.r <= NT_MAX)
+            k = np.nonzero(good)[0]
+            rows = _rows(con, k, idx, rot, shift, drot, dshift, m_all, j, cz, side, np.zeros(len(k)))
+            parts[side].append(rows)
+            # the touching feature can change within the errors' radial reach (a tip reaching past the
+            # end of the other's involute into its root fillet): each pair solved again with its
+            # flexspline tooth moved radially, and the contact found there, carried back to the
+            # perfect pose along its own sensitivity, added as a further candidate (_second_features)
+            rho = cz * (imp.cam_flex + imp.cam_fixed) + imp.flex_ecc + imp.rigid_ecc
+            if rho > 0.0 and k.size:
+                parts[side].extend(_second_features(flex, rigid, rows, k, idx, rot, shift, drot, dshift, m_all,
+                                                    j, cz, side, rb, rho, reach_pitches * 2 * pi / z_g,
+                                                    drive.rigid.r))
+    for side in (1, -1):
+        tab.sides[side] = {key: np.concatenate([p[key] for p in parts[side]]) for key in parts[side][0]}
+        _refine(tab, side, imp, flex, rigid, reach_pitches * 2 * pi / z_g)
+    return tab
+
+
+def _rows(con, k, idx, rot, shift, drot, dshift, m_all, j, cz, side, extra):
+    """Table rows of contacts ``k`` of a closing-rotation solve (poses ``rot``, ``shift`` indexed by ``idx[k]``)."""
+    t = side * con.delta[k]
+    ct, st = np.cos(t), np.sin(t)
+    sh = np.stack([ct * shift[idx[k], 0] - st * shift[idx[k], 1], st * shift[idx[k], 0] + ct * shift[idx[k], 1]], -1)
+    ds = np.stack([ct * dshift[k, 0] - st * dshift[k, 1], st * dshift[k, 0] + ct * dshift[k, 1]], -1)
+    p, q, nt = con.p[k], con.q[k], con.nt[k]
+    dP = drot[k, None] * np.stack([-(p[:, 1] - sh[:, 1]), p[:, 0] - sh[:, 0]], -1) + ds
+    rr = rot[idx[k]] + t
+    return {
+        "m": m_all[idx[k]], "g": con.delta[k], "nt": nt,
+        "a_phi": np.einsum("ij,ij->i", dP, nt),
+        "a_rho": np.cos(rr) * nt[:, 0] + np.sin(rr) * nt[:, 1],
+        "a_beta": -q[:, 1] * nt[:, 0] + q[:, 0] * nt[:, 1],
+        "j": j[k], "c": np.full(len(k), cz),
+        "dP": dP, "rr": rr, "q": q, "rot": rot[idx[k]], "shift": shift[idx[k]], "extra": extra,
+    }
+
+
+#: radial moves of a flexspline tooth, in units of the errors' radial reach, at which each pair is solved
+#: again for the feature it touches there
+_RADIAL_STEPS = (-0.25, 0.25, -0.5, 0.5, -1.0, 1.0)
+#: a contact found with the tooth moved is another feature when it closes earlier than the lines known
+#: predict by more than this, rad (0.01 arcsec)
+_LINE_TOL = 0.01 / 206264.80624709636
+
+
+def _second_features(flex, rigid, rows, k, idx, rot, shift, drot, dshift, m_all, j, cz, side, rb, rho, reach, r_b):
+    """Contacts on the features a pair touches once the errors move its flexspline tooth radially by up to ``rho``.
+
+    Where the tooth space is locally convex (a tip running from the other's
+    flank into its root fillet), the closing rotation is the smaller of the
+    two features' and each is linear in the errors: the second feature's
+    closing rotation, carried back to the perfect pose along its own
+    sensitivity, is one more candidate of the lattice class, and the KE's
+    minimum over candidates picks it where it is first. Kept only where it is
+    no earlier than the perfect contact at the perfect pose (a lower envelope;
+    where a corner turns the other way the smaller rotation would be wrong).
+    """
+    out = []
+
+    def solve(f, kk):
+        ii = idx[k[kk]]
+        sh = shift[ii] + f * rho * np.stack([np.cos(rot[ii]), np.sin(rot[ii])], -1)
+        with np.errstate(invalid="ignore"):
+            c2 = closing_rotation(flex, rot[ii], sh, rigid, rb[k[kk]], np.zeros((len(kk), 2)), side, reach)
+            c2.delta = np.where(c2.ok, c2.delta, 0.0)
+            r2 = _rows(c2, np.arange(len(kk)), ii, rot, shift, drot[k[kk]], dshift[k[kk]], m_all, j[k[kk]], cz,
+                       side, np.ones(len(kk)))
+        return c2, r2
+
+    # the full reach first, every pair: those whose closing rotation there is off the perfect contact's
+    # line (either way) or not found are the ones whose feature changes within the reach
+    full = {}
+    for f in (-1.0, 1.0):
+        c2, r2 = solve(f, np.arange(len(k)))
+        pred = rows["g"] - f * rho * rows["a_rho"]
+        moved = ~c2.ok | (np.abs(c2.delta - pred) > _LINE_TOL)
+        full[f] = (c2, r2, np.nonzero(moved)[0])
+    kk = np.unique(np.concatenate([full[-1.0][2], full[1.0][2]]))
+    if kk.size == 0:
+        return out
+    # the lines known per moved pair (the perfect contact's, then those added): closing rotation at the
+    # perfect pose and a_rho, NaN where a pair has fewer
+    lines = [(rows["g"][kk], rows["a_rho"][kk])]
+    for f in _RADIAL_STEPS:  # closest first: a line found there is not added again further out
+        if abs(f) == 1.0:
+            c2, r2, _ = full[f]
+            c2 = type(c2)(c2.delta[kk], c2.p[kk], c2.q[kk], c2.nt[kk], c2.ok[kk])
+            r2 = {key: v[kk] for key, v in r2.items()}
+        else:
+            c2, r2 = solve(f, kk)
+        dr = f * rho
+        # back to the perfect pose: the radial move changed the closing rotation by -dr a_rho
+        g0 = c2.delta + dr * r2["a_rho"]
+        # below every line known: another feature is first here
+        off = c2.ok.copy()
+        for g_l, a_l in lines:
+            off &= ~(c2.delta >= g_l - dr * a_l - _LINE_TOL)  # a NaN line (none) does not hold it back
+        new = (off & np.all(np.isfinite(c2.nt), axis=1) & (np.hypot(*c2.nt.T) * r_b <= NT_MAX)
+               & (g0 >= rows["g"][kk] - 1e-12))
+        sel = np.nonzero(new)[0]
+        lines.append((np.where(new, g0, np.nan), np.where(new, r2["a_rho"], np.nan)))
+        if sel.size:
+            r2 = {key: v[sel] for key, v in r2.items()}
+            r2["g"] = g0[sel]
+            out.append(r2)
+    return out
+
+
+#: gap (mm) before the unperturbed contact where the finite-difference solves start (0: from rest)
+_FD_START = 1e-3
+#: translation (mm) of the rigid tooth for the finite-difference sensitivities: 0.1 um, where the
+#: closing rotation (converged to a 1e-8 mm gap) is known to 1e-4 of the difference
+_FD_H = 1e-4
+
+
+def _refine(tab: ContactTable, side: int, imp: Imperfections, flex, rigid, reach: float) -> None:
+    """Sensitivities of the contacts that can be first to touch, by central differences.
+
+    The nearest-point normal is exact on a flank, but where a tooth's corner
+    meets the other outline's vertex (tip corners, interfering teeth) it is
+    not the direction the contact slides in; translating the rigid tooth by
+    +-0.1 um in x and y and solving again gives the true ``nt``.
+    """
+    S = tab.sides[side]
+    lanes = _lanes(tab, side, imp, slack=2.0)
+    e = np.unique(lanes[lanes >= 0])
+    e = e[S["extra"][e] == 0]  # a second feature's solve from the perfect pose would find the first
+    if e.size == 0:
+        return
+    rb = (S["j"][e] + 0.5) * 2 * pi / tab.z_b
+    nt = np.empty((e.size, 2))
+    # started 1 um of gap before the unperturbed contact (apart, ten times the perturbation): a Newton
+    # step or two to the perturbed one instead of five or six from rest
+    start = S["g"][e] - _FD_START * np.hypot(S["nt"][e, 0], S["nt"][e, 1]) if _FD_START else None
+    for ax in (0, 1):
+        dv = np.zeros((e.size, 2))
+        dv[:, ax] = _FD_H
+        cp = closing_rotation(flex, S["rot"][e], S["shift"][e], rigid, rb, dv, side, reach, start=start)
+        cm = closing_rotation(flex, S["rot"][e], S["shift"][e], rigid, rb, -dv, side, reach, start=start)
+        nt[:, ax] = (cp.delta - cm.delta) / (2 * _FD_H)
+    # a difference across a switch of the touching feature is no derivative: keep the nearest-point
+    # normal's value there (within 50 % of it is a slide along one feature; the corner cases differ by ~10 %)
+    good = np.all(np.isfinite(nt), axis=1) & (np.hypot(*(nt - S["nt"][e]).T) <= 0.5 * np.hypot(*S["nt"][e].T))
+    e, nt = e[good], nt[good]
+    S["nt"][e] = nt
+    S["a_phi"][e] = np.einsum("ij,ij->i", S["dP"][e], nt)
+    S["a_rho"][e] = np.cos(S["rr"][e]) * nt[:, 0] + np.sin(S["rr"][e]) * nt[:, 1]
+    S["a_beta"][e] = -S["q"][e, 1] * nt[:, 0] + S["q"][e, 0] * nt[:, 1]
+
+
+def _geometry(tab: ContactTable, side: int, i: np.ndarray, e: np.ndarray) -> dict:
+    """Per (sample, contact): flexspline tooth ``k``, rigid shift ``sb`` and ``R(rho) nt`` in the actual frame."""
+    S = tab.sides[side]
+    N, z_g, z_b = tab.N, tab.z_g, tab.z_b
+    m = S["m"][e]
+    M = z_g * N
+    k = ((m + tab.sigma * i) % M) // N  # the flexspline tooth (material index)
+    # the table frame turned to the actual one by whole rigid pitches: (m' + sigma i) / N, with m'
+    # the lattice index of the folded tooth angle (docs/models.md 7: phi z_g / z_b + phi_h)
+    sb = (((m + M // 2) % M - M // 2) + tab.sigma * i) // N
+    # rho = 2 pi sb / z_b: its cosine and sine looked up per whole rigid pitch (no trigonometry per sample)
+    ang = (2 * pi / z_b) * np.arange(z_b)
+    cr, sr = np.cos(ang)[sb % z_b], np.sin(ang)[sb % z_b]
+    ntx, nty = S["nt"][e, 0], S["nt"][e, 1]
+    return {"k": k, "sb": sb, "nx": cr * ntx - sr * nty, "ny": sr * ntx + cr * nty}
+
+
+def _terms(tab: ContactTable, side: int, imp: Imperfections, i: np.ndarray, e: np.ndarray, which: str, geo=None) -> np.ndarray:
+    """One group of linear error terms of the closing rotation, for samples ``i`` (I, 1) and contacts ``e`` (I, C)."""
+    S = tab.sides[side]
+    z_g, z_b = tab.z_g, tab.z_b
+    geo = _geometry(tab, side, i, e) if geo is None else geo
+    nx, ny = geo["nx"], geo["ny"]
+    if which == "rigid":
+        T = rigid_translation(imp)
+        j = (S["j"][e] + geo["sb"]) % z_b
+        # per-tooth values looked up (the same formula at the same whole tooth numbers): no sine per sample
+        return T[0] * nx + T[1] * ny + rigid_deviations(imp, np.arange(z_b), z_b, tab.r_b)[j] * S["a_beta"][e]
+    if which == "flex":
+        da, dr = flex_deviations(imp, np.arange(z_g), z_g, tab.r_g)
+        k = geo["k"]
+        return -da[k] * S["a_phi"][e] - dr[k] * S["a_rho"][e]
+    phi_h = tab.sigma * i * (2 * pi / (z_b * tab.N))
+    E = cam_offset(imp, phi_h, phi_h / gear_ratios(z_g, z_b)["u_hg"], parts=("flex", "fixed"))
+    return -S["c"][e] * (E[..., 0] * nx + E[..., 1] * ny)
+
+
+def _lanes(tab: ContactTable, side: int, imp: Imperfections, slack: float = 1.05) -> np.ndarray:
+    """Candidate contacts per lattice class (N, C), padded with -1: those that can be the first to touch.
+
+    Within a group (one zone, one section) the errors move neighbouring teeth
+    almost alike: ``|Delta_e - Delta_e*| <= D_e`` (bounded term by term from
+    the amplitudes and the differences of the contacts' sensitivities and of
+    the teeth's positions), so a contact whose perfect closing rotation
+    exceeds the group's smallest, ``g_e*``, by more than ``D_e`` is never first.
+    Across groups the whole error bound ``B`` prunes.
+    """
+    S = tab.sides[side]
+    z_g, z_b, N = tab.z_g, tab.z_b, tab.N
+    ntn = np.hypot(S["nt"][:, 0], S["nt"][:, 1])
+    A_b = 0.5 * imp.rigid_runout / tab.r_b
+    A_a = (0.5 * imp.flex_runout + imp.flex_ecc) / tab.r_g
+    Vmax = imp.rigid_ecc + S["c"] * (imp.cam_flex + imp.cam_fixed)
+    B = Vmax * ntn + A_b * np.abs(S["a_beta"]) + A_a * np.abs(S["a_phi"]) + imp.flex_ecc * np.abs(S["a_rho"])
+    B = B * slack + 1e-12  # 5 % for the linearisation's second order (2x before the sensitivities are refined)
+    M = z_g * N
+    phi = _fold(2 * pi * S["m"] / M)
+    zone = np.where(np.abs(phi) <= 0.5 * pi, 0, 1)  # 0: the zone around +x, 1: around -x (two waves)
+    cls = (-tab.sigma * np.arange(N)) % N  # lattice class of sample residue r
+    mf = (S["m"] + M // 2) % M - M // 2  # folded lattice index
+    cq = np.round(S["c"] * 1e6).astype(int)
+    group = np.unique(np.stack([zone, cq], 1), axis=0, return_inverse=True)[1].ravel()  # (zone, section) of each contact
+    out = []
+    for r in range(N):
+        e = np.nonzero(S["m"] % N == cls[r])[0]
+        if e.size == 0:
+            out.append(e)
+            continue
+        keep = S["g"][e] - B[e] <= np.min(S["g"][e] + B[e])
+        for gk in np.unique(group[e]):
+            sel = group[e] == gk
+            grp = e[sel]
+            es = grp[np.argmin(S["g"][grp])]
+            dk = np.abs(mf[grp] - mf[es]) // N  # teeth apart (same class: a whole number)
+            dj = np.abs(((S["j"][grp] - S["j"][es] + (mf[grp] - mf[es]) // N) + z_b // 2) % z_b - z_b // 2)
+            dnt = np.hypot(*(S["nt"][grp] - S["nt"][es]).T)
+            D = (Vmax[grp] * (dnt + ntn[es] * 2 * pi * dk / z_b)
+                 + A_b * (np.abs(S["a_beta"][grp] - S["a_beta"][es]) + np.abs(S["a_beta"][es]) * 2 * pi * dj / z_b)
+                 + A_a * (np.abs(S["a_phi"][grp] - S["a_phi"][es]) + np.abs(S["a_phi"][es]) * 2 * pi * dk / z_g)
+                 + imp.flex_ecc * (np.abs(S["a_rho"][grp] - S["a_rho"][es]) + np.abs(S["a_rho"][es]) * 2 * pi * dk / z_g))
+            far = S["g"][grp] - S["g"][es] > slack * D + 1e-12
+            keep[np.nonzero(sel)[0][far]] = False
+        out.append(e[keep])
+    C = max(len(x) for x in out)
+    lanes = np.full((N, max(C, 1)), -1, dtype=int)
+    for r, x in enumerate(out):
+        lanes[r, : len(x)] = x
+    return lanes
