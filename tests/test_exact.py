@@ -41,6 +41,20 @@ def _angles(design):
     return np.arange(n) * (2 * pi / z_b) / n
 
 
+def dense_pair(a: np.ndarray, b: np.ndarray) -> float:
+    """Signed clearance of two outlines with shapely: distance apart, minus the deepest vertex of either inside the other."""
+    pa, pb = shapely.Polygon(a), shapely.Polygon(b)
+    d = shapely.distance(pa, pb)
+    if d > 0:
+        return float(d)
+    depth = 0.0
+    for pts, other in ((a, pb), (b, pa)):
+        ins = shapely.contains_xy(other, pts[:, 0], pts[:, 1])
+        if ins.any():
+            depth = max(depth, float(shapely.distance(other.exterior, shapely.points(pts[ins])).max()))
+    return -depth
+
+
 class Reference:
     """Signed clearance of a placed flexspline tooth to its three nearest rigid teeth, dense polygons."""
 
@@ -54,17 +68,7 @@ class Reference:
     def law(self, z):
         return self.drive.law if z is None else self.drive.law_at(z)
 
-    def pair(self, a, b):
-        pa, pb = shapely.Polygon(a), shapely.Polygon(b)
-        d = shapely.distance(pa, pb)
-        if d > 0:
-            return d
-        depth = 0.0
-        for pts, other in ((a, pb), (b, pa)):
-            ins = shapely.contains_xy(other, pts[:, 0], pts[:, 1])
-            if ins.any():
-                depth = max(depth, float(shapely.distance(other.exterior, shapely.points(pts[ins])).max()))
-        return -depth
+    pair = staticmethod(dense_pair)
 
     def at(self, phi, z):
         """Clearance (mm) of the tooth at angle ``phi`` from the major axis, section ``z``."""

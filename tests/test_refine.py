@@ -22,22 +22,10 @@ from wgcad.constants import REFINE_TOL
 from wgcad.design import load_design
 from wgcad.drive import build_drive
 from wgcad.placement import transform
+from test_exact import dense_pair  # the same shapely reference as the audit-level test
 
 #: the dense polygons' own error: 2 x their chord tolerance (one per tooth)
 DENSE_TOL = 1e-7
-
-
-def _dense_pair(a: np.ndarray, b: np.ndarray) -> float:
-    pa, pb = shapely.Polygon(a), shapely.Polygon(b)
-    d = shapely.distance(pa, pb)
-    if d > 0:
-        return float(d)
-    depth = 0.0
-    for pts, other in ((a, pb), (b, pa)):
-        ins = shapely.contains_xy(other, pts[:, 0], pts[:, 1])
-        if ins.any():
-            depth = max(depth, float(shapely.distance(other.exterior, shapely.points(pts[ins])).max()))
-    return -depth
 
 
 def _pairs(name, n_pairs=12):
@@ -75,7 +63,7 @@ def test_refined_pairs_match_dense_polygons(name, n_pairs):
     fa, fb = dense.flex.tooth_polygon(), dense.rigid.tooth_polygon()
     a = transform(fa, rot, shift)
     b = transform(fb, scene.rigid_rot[j], scene.rigid_shift[j])
-    ref = np.array([_dense_pair(a[k], b[k]) for k in range(len(rot))])
+    ref = np.array([dense_pair(a[k], b[k]) for k in range(len(rot))])
     # both signs occur among the checked pairs on most templates: apart and overlapping
     assert np.abs(value - ref).max() <= REFINE_TOL + DENSE_TOL, (1e3 * (value - ref)).round(5)
 

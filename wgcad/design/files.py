@@ -10,7 +10,7 @@ from pathlib import Path
 from ..errors import InputFileError
 from .schema import Design, parse_design
 
-__all__ = ["MAX_DESIGN_BYTES", "read_design_text", "load_design"]
+__all__ = ["MAX_DESIGN_BYTES", "read_design_text", "parse_toml", "load_design"]
 
 #: Largest design file read, bytes. The bundled templates are ~1.5 kB; a
 #: design is a few tables of numbers, so 1 MiB is generous and still refuses
@@ -93,12 +93,15 @@ def load_design(path) -> Design:
         A field rule is broken.
     """
     p = Path(path)
-    text = read_design_text(p)
+    return parse_design(parse_toml(read_design_text(p), p, "a design"), source=str(p))
+
+
+def parse_toml(text: str, path, what: str) -> dict:
+    """TOML text of ``path`` as a dict; a one-line :class:`InputFileError` when it is not valid TOML for ``what``."""
     try:
-        data = tomllib.loads(text)
+        return tomllib.loads(text)
     except tomllib.TOMLDecodeError as e:
-        raise InputFileError(f"{p}: not valid TOML ({e})") from None
+        raise InputFileError(f"{path}: not valid TOML ({e})") from None
     except RecursionError:
         # tomllib parses nested arrays and inline tables recursively
-        raise InputFileError(f"{p}: not valid TOML for a design (arrays or tables nested too deeply)") from None
-    return parse_design(data, source=str(p))
+        raise InputFileError(f"{path}: not valid TOML for {what} (arrays or tables nested too deeply)") from None

@@ -363,18 +363,12 @@ def load_spec(path) -> SweepSpec:
     DesignError
         A rule of the spec or of the base design is broken.
     """
-    from ..design.files import read_design_text
+    from ..design.files import parse_toml, read_design_text
 
     p = Path(path)
     try:
         text = read_design_text(p)
     except InputFileError as e:  # the reader speaks of design files
         raise InputFileError(str(e).replace("design file", "sweep spec file")) from None
-    try:
-        data = tomllib.loads(text)
-    except tomllib.TOMLDecodeError as e:
-        raise InputFileError(f"{p}: not valid TOML ({e})") from None
-    except RecursionError:
-        raise InputFileError(f"{p}: not valid TOML for a sweep spec (nested too deeply)") from None
-    return parse_spec(data, source=str(p), base_dir=p.parent)
+    return parse_spec(parse_toml(text, p, "a sweep spec"), source=str(p), base_dir=p.parent)
 
