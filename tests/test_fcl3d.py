@@ -217,6 +217,67 @@ def test_verify_worst_agrees(name):
     json.dumps(out)
 
 
+@pytest.mark.parametrize("name, errors", [
+    # D4 (prisms) is apart by 1.8 um: half a micrometre of rigid eccentricity keeps it apart
+    ("d4_discrete", (("rigid_eccentricity_um", "0.5"), ("rigid_eccentricity_phase_deg", "30.0"))),
+    # D1 (coned) interferes at the tips far from the major axis; errors of [S4]'s order move it by ~10 um
+    ("d1_involute", (("rigid_eccentricity_um", "15.0"), ("rigid_eccentricity_phase_deg", "40.0"),
+                     ("cam_offset_fixed_um", "10.0"), ("flex_runout_um", "20.0"))),
+])
+def test_verify_worst_places_the_imperfect_parts(name, errors, tmp_path):
+    # the 3D check of an imperfect audit builds the tooth the audit names (its tooth at its generator
+    # angle, with the errors) and the rigid teeth with theirs: its 2D figure at the audit's section is the
+    # audit's own polygon figure, while the perfect drive's tooth at the same tooth angle is elsewhere
+    from conftest import edit_toml
+    from wgcad.accuracy.imperfect import Imperfections, flex_poses, rigid_poses
+
+    text = (TEMPLATES / f"{name}.toml").read_text() + "\n[imperfections]\n"
+    for key, val in errors:
+        text = edit_toml(text, "imperfections", key, val)
+    p = tmp_path / f"{name}_imp.toml"
+    p.write_text(text)
+    drive, result = run_audit(p, RunSettings(step_deg=1.0))
+    imp = Imperfections.from_spec(drive.design.imperfections)
+    w = result.findings["min_clearance"]
+    out = fcl3d.verify_worst(drive, result, imp=imp)
+    assert out["agree"] and out["summary"].startswith("agree")
+    pair = out["pairs"][0]
+    assert pair["tooth"] == w.tooth and pair["generator_angle_deg"] == pytest.approx(np.rad2deg(w.generator_angle))
+    rows = {r["rigid_tooth"]: r for r in pair["per_tooth"]}
+    j = w.details["rigid_tooth"]
+    # the reference: the two posed polygons from the drive's own poses (accuracy.imperfect, no scene), in shapely
+    rot, shift = flex_poses(drive, imp, w.generator_angle, teeth=np.array([w.tooth]), z=w.section_z if drive.coned else None)
+    rr, rs = rigid_poses(drive, imp, teeth=np.array([j]))
+    a = shapely.Polygon(transform(drive.flex.tooth_polygon(), rot, shift)[0])
+    b = shapely.Polygon(transform(drive.rigid.tooth_polygon(), rr, rs)[0])
+    if a.intersects(b):
+        assert rows[j]["fcl_overlap"] and rows[j]["clearance_2d_um"] < 0
+    else:
+        ref_um = 1e3 * a.distance(b)
+        # the loft's sections include the audit's: their minimum is at most that section's (1e-6 um: transforms)
+        assert rows[j]["clearance_2d_um"] <= ref_um + 1e-6
+        if not drive.coned:
+            assert rows[j]["clearance_2d_um"] == pytest.approx(ref_um, abs=1e-6)
+            # prisms: the 3D distance is the 2D one (FCL_TOL)
+            assert rows[j]["fcl_distance_um"] == pytest.approx(ref_um, abs=1e3 * fcl3d.FCL_TOL)
+    # the solid itself: its slice at the audit's section is the tooth placed with its errors (in the frame of
+    # the rigid gear's centre, where the imperfect scene holds the rigid teeth)
+    from wgcad.accuracy.imperfect import rigid_translation
+    from wgcad.clearance.imperfect import ImperfectScene
+
+    isc = ImperfectScene.from_scene(Scene(drive), imp)
+    z_w = w.section_z if drive.coned else 0.0
+    zs = np.unique([0.0, z_w, float(drive.design.drive.face_width)])
+    V, _ = fcl3d.flex_tooth_solid(isc, 0.0, sections=zs, track=fcl3d.imperfect_track(drive, imp, w.generator_angle, w.tooth))
+    slice_ = V[np.abs(V[:, 2] - z_w) < 1e-12, :2]
+    ref = transform(drive.flex.tooth_polygon(), rot, shift)[0] - rigid_translation(imp)
+    gap = np.hypot(*(ref[:, None, :] - slice_[None, :, :]).transpose(2, 0, 1)).min(axis=1)
+    assert gap.max() < 1e-9
+    perfect = fcl3d.verify_worst(drive, result)["pairs"][0]
+    assert abs(perfect["clearance_2d_um"] - pair["clearance_2d_um"]) > 0.2  # the errors moved the pair
+    json.dumps(out)
+
+
 def test_core_does_not_import_fcl():
     code = ("import sys, wgcad.clearance.engine, wgcad.audit, wgcad.clearance;"
             "bad = [m for m in ('fcl', 'manifold3d', 'trimesh') if m in sys.modules]; print(bad); sys.exit(bool(bad))")

@@ -9,7 +9,8 @@ import manifold3d
 import numpy as np
 
 from ..placement import transform
-from .engine import Scene, tooth_clearance
+from .engine import Scene
+from .scene import clearance_at_poses
 
 __all__ = [
     "FCL_TOL",
@@ -20,6 +21,7 @@ __all__ = [
     "fcl_distance",
     "check_tooth",
     "verify_worst",
+    "imperfect_track",
 ]
 
 #: Agreement tolerance of an exact comparison, mm. FCL's mesh distance is
@@ -102,8 +104,17 @@ def _heights(scene: Scene, n_sections: int, sections=None) -> np.ndarray:
     return np.linspace(0.0, bw, n_sections)
 
 
-def _flex_poses(scene: Scene, phi: float, zs: np.ndarray):
-    """Poses ``(rot (K,), shift (K, 2))`` of the tooth at ``phi`` in sections ``zs`` (``z=None`` for every one without coning)."""
+def _flex_poses(scene: Scene, phi: float, zs: np.ndarray, track=None):
+    """Poses ``(rot (K,), shift (K, 2))`` of the tooth at ``phi`` in sections ``zs`` (``z=None`` for every one without coning).
+
+    ``track(z)``, if given, places the tooth instead (``z`` a float, or None
+    without coning; returns ``rot (1,)``, ``shift (1, 2)`` in the scene's
+    frame): a tooth of an imperfect drive, whose pose is not a function of
+    its tooth angle (:func:`imperfect_track`).
+    """
+    if track is not None:
+        poses = [track(None)] * len(zs) if not scene.drive.coned else [track(float(z)) for z in zs]
+        return np.array([r[0] for r, _ in poses]), np.array([s_[0] for _, s_ in poses])
     if not scene.drive.coned:
         rot, shift = scene.pose(np.array([phi]), None)
         return np.repeat(rot, len(zs)), np.repeat(shift, len(zs), axis=0)
@@ -111,7 +122,7 @@ def _flex_poses(scene: Scene, phi: float, zs: np.ndarray):
     return np.array([r[0] for r, _ in poses]), np.array([s[0] for _, s in poses])
 
 
-def flex_tooth_solid(scene: Scene, phi: float, n_sections: int = 9, sections=None) -> tuple[np.ndarray, np.ndarray]:
+def flex_tooth_solid(scene: Scene, phi: float, n_sections: int = 9, sections=None, track=None) -> tuple[np.ndarray, np.ndarray]:
     """The flexspline tooth at tooth angle ``phi`` as a closed mesh lofted through its deformed cross-sections.
 
     Parameters
@@ -127,6 +138,8 @@ def flex_tooth_solid(scene: Scene, phi: float, n_sections: int = 9, sections=Non
     sections : array_like, optional
         Explicit axial positions (mm from the open end) instead of the
         linspace; sorted, duplicates dropped.
+    track : callable, optional
+        Places the tooth instead of ``scene.pose`` (see :func:`_flex_poses`).
 
     Returns
     -------
@@ -137,7 +150,7 @@ def flex_tooth_solid(scene: Scene, phi: float, n_sections: int = 9, sections=Non
     zs = _heights(scene, n_sections, sections)
     if not scene.drive.coned:
         zs = zs[[0, -1]]
-    rot, shift = _flex_poses(scene, float(phi), zs)
+    rot, shift = _flex_poses(scene, float(phi), zs, track)
     return loft(scene.flex_local, rot, shift, zs)
 
 
@@ -150,7 +163,7 @@ def rigid_tooth_solid(scene: Scene, j: int) -> tuple[np.ndarray, np.ndarray]:
     return loft(scene.rigid.local, rot, shift, np.array([0.0, bw]))
 
 
-def loft_error(scene: Scene, phi: float, zs: np.ndarray) -> dict:
+def loft_error(scene: Scene, phi: float, zs: np.ndarray, track=None) -> dict:
     """How far the loft through sections ``zs`` can be from the true coned tooth, and how fast the tooth moves along z.
 
     Between two sections the loft moves each vertex along the chord while
@@ -175,10 +188,10 @@ def loft_error(scene: Scene, phi: float, zs: np.ndarray) -> dict:
     """
     zs = np.asarray(zs, dtype=float)
     local = _clean_ccw(scene.flex_local)
-    rot, shift = _flex_poses(scene, float(phi), zs)
+    rot, shift = _flex_poses(scene, float(phi), zs, track)
     P = transform(local, rot, shift)  # (K, N, 2)
     zm = 0.5 * (zs[:-1] + zs[1:])
-    rm, sm = _flex_poses(scene, float(phi), zm)
+    rm, sm = _flex_poses(scene, float(phi), zm, track)
     Q = transform(local, rm, sm)
     h = np.diff(zs)
     chord = 2.0 * np.hypot(*(Q - 0.5 * (P[:-1] + P[1:])).transpose(2, 0, 1)).max(axis=1)
@@ -246,7 +259,7 @@ def _agrees(c2d: float, fcl_d: float, overlap: bool, lower: float, exact: bool) 
     return lower - FCL_TOL <= fcl_d <= c2d + FCL_TOL
 
 
-def check_tooth(scene: Scene, phi: float, n_sections: int = 9, sections=None) -> dict:
+def check_tooth(scene: Scene, phi: float, n_sections: int = 9, sections=None, track=None) -> dict:
     """FCL distance of the flexspline tooth at ``phi`` to the rigid teeth it can touch, against the 2D engine over the same sections.
 
     Rigid teeth: :meth:`Scene.neighbours` (lower, upper, third) at every
@@ -287,12 +300,17 @@ def check_tooth(scene: Scene, phi: float, n_sections: int = 9, sections=None) ->
     ``loft_error_um``, ``agree``, ``per_tooth`` (the same per rigid tooth,
     with the witness section), ``fcl_witness_z_mm`` and
     ``clearance_2d_at_witness_um`` (coning, apart), ``timing_ms``.
+
+    With ``track`` (a tooth of an imperfect drive, :func:`imperfect_track`)
+    the tooth is placed by it in every section, and ``scene`` is the
+    :class:`~wgcad.clearance.imperfect.ImperfectScene` that holds the rigid
+    teeth with their errors; ``phi`` only labels the result.
     """
     t0 = time.perf_counter()
     coned = scene.drive.coned
     zs = _heights(scene, n_sections, sections)
     zl = [float(z) for z in zs] if coned else [None]
-    rot, shift = _flex_poses(scene, float(phi), zs if coned else zs[:1])
+    rot, shift = _flex_poses(scene, float(phi), zs if coned else zs[:1], track)
     # rigid teeth the tooth can touch: neighbours at the middle section, then any other section's
     order = [len(zl) // 2] + [k for k in range(len(zl)) if k != len(zl) // 2]
     teeth = []
@@ -303,11 +321,12 @@ def check_tooth(scene: Scene, phi: float, n_sections: int = 9, sections=None) ->
     # 2D: per section, per rigid tooth; and the engine's own figure
     c = np.array([[float(scene.clearance_to(rot[k : k + 1], shift[k : k + 1], np.array([j]))[0]) for j in teeth]
                   for k in range(len(zl))])  # (K, T)
-    c_engine = np.array([float(tooth_clearance(scene, np.array([phi]), z)["min"][0]) for z in zl])
+    # the engine's own figure of each section (its neighbour search and third-tooth bound)
+    c_engine = np.array([float(clearance_at_poses(scene, rot[k : k + 1], shift[k : k + 1])["min"][0]) for k in range(len(zl))])
     t_2d = time.perf_counter() - t0
     # bounds (coning only)
     if coned:
-        err = loft_error(scene, float(phi), zs)
+        err = loft_error(scene, float(phi), zs, track)
         geom = float(np.max(err["chord"] + err["twist"]))
         vh = err["speed"] * err["h"]
         lo_int = np.minimum(np.minimum(c[:-1], c[1:]), 0.5 * (c[:-1] + c[1:] - vh[:, None]))  # (K-1, T)
@@ -317,7 +336,7 @@ def check_tooth(scene: Scene, phi: float, n_sections: int = 9, sections=None) ->
         lower_t = c.min(axis=0)
     # FCL
     t1 = time.perf_counter()
-    flex = flex_tooth_solid(scene, float(phi), sections=zs)
+    flex = flex_tooth_solid(scene, float(phi), sections=zs, track=track)
     per, query_ms = [], []
     for ti, j in enumerate(teeth):
         tq = time.perf_counter()
@@ -337,7 +356,7 @@ def check_tooth(scene: Scene, phi: float, n_sections: int = 9, sections=None) ->
             # loft's slice there is within `geom` of the true section, so the 2D
             # clearance of that section must match FCL to `geom`
             zw = float(np.clip(pts[0][2], zs[0], zs[-1]))
-            r, s = scene.pose(np.array([phi]), zw)
+            r, s = track(zw) if track is not None else scene.pose(np.array([phi]), zw)
             cw = float(scene.clearance_to(r, s, np.array([j]))[0])
             row["fcl_witness_z_mm"] = round(zw, 6)
             row["clearance_2d_at_witness_um"] = round(1e3 * cw, 6)
@@ -371,7 +390,25 @@ def check_tooth(scene: Scene, phi: float, n_sections: int = 9, sections=None) ->
     return out
 
 
-def verify_worst(drive, result, n_sections: int = 9) -> dict:
+def imperfect_track(drive, imp, phi_h: float, tooth: int):
+    """The pose of flexspline tooth ``tooth`` of an imperfect drive at generator angle ``phi_h``, section by section.
+
+    Returns ``track(z) -> (rot (1,), shift (1, 2))``, relative to the rigid
+    gear's own centre as :class:`~wgcad.clearance.imperfect.ImperfectScene`
+    holds the rigid teeth (:func:`wgcad.accuracy.imperfect.flex_poses`).
+    """
+    from ..accuracy.imperfect import flex_poses, rigid_translation
+
+    centre = rigid_translation(imp)
+
+    def track(z):
+        rot, shift = flex_poses(drive, imp, float(phi_h), teeth=np.array([int(tooth)]), z=z)
+        return rot, shift - centre
+
+    return track
+
+
+def verify_worst(drive, result, n_sections: int = 9, imp=None) -> dict:
     """3D check (FCL) of the pairs the 2D audit singles out: the tightest tooth and the entry pinch.
 
     Parameters
@@ -384,6 +421,12 @@ def verify_worst(drive, result, n_sections: int = 9) -> dict:
         Loft sections over the face width (coning); the audit's own
         sections are added, so the 2D figure covers the section the audit
         found the minimum in.
+    imp : wgcad.accuracy.imperfect.Imperfections, optional
+        The errors of an imperfect drive's audit
+        (:func:`wgcad.clearance.imperfect.audit_imperfect`): each pair is
+        then the tooth and generator angle the audit names, every part
+        placed with its errors (the perfect drive's tooth angle does not
+        say where an imperfect tooth is).
 
     Returns
     -------
@@ -391,11 +434,18 @@ def verify_worst(drive, result, n_sections: int = 9) -> dict:
     ``"tightest"`` or ``"entry pinch"``) and a one-line ``summary``.
     """
     scene = Scene(drive)
+    if imp is not None:
+        from .imperfect import ImperfectScene
+
+        scene = ImperfectScene.from_scene(scene, imp)
     bw = float(drive.design.drive.face_width)
     zs = np.linspace(0.0, bw, max(int(n_sections), 2))
     if drive.coned:
         extra = [z for z in result.settings.get("sections_z_mm", []) if z is not None]
         zs = np.unique(np.round(np.concatenate([zs, np.asarray(extra, dtype=float)]), 12))
+    if imp is not None:
+        return _summarise(drive, zs, [{"what": what, **_check_sample(scene, drive, imp, f, zs)}
+                                      for what, f in _imperfect_targets(result)])
     raw = getattr(result, "raw", {}) or {}
     # unrounded angles where the engine kept them (degrees in the JSON are rounded to 1e-6)
     targets = [("tightest", np.rad2deg(raw["worst_phi"]) if raw.get("worst_phi") is not None else result.worst["tooth_angle_deg"])]
@@ -405,11 +455,34 @@ def verify_worst(drive, result, n_sections: int = 9) -> dict:
     pairs = []
     for what, deg in targets:
         pairs.append({"what": what, **check_tooth(scene, float(np.deg2rad(deg)), sections=zs)})
+    return _summarise(drive, zs, pairs)
+
+
+def _imperfect_targets(result):
+    """The findings of an imperfect audit that name a sample (tooth and generator angle), with what they are."""
+    out = [("tightest", result.findings["min_clearance"])]
+    pin = result.findings.get("entry_pinch")
+    if pin is not None and pin.tooth is not None and pin.generator_angle is not None and np.isfinite(pin.value):
+        out.append(("entry pinch", pin))
+    return out
+
+
+def _check_sample(scene, drive, imp, finding, zs) -> dict:
+    """:func:`check_tooth` of the sample a finding names (its tooth at its generator angle), with its generator angle and tooth."""
+    track = imperfect_track(drive, imp, finding.generator_angle, finding.tooth)
+    out = check_tooth(scene, float(finding.tooth_angle or 0.0), sections=zs, track=track)
+    out["generator_angle_deg"] = round(float(np.rad2deg(finding.generator_angle)), 6)
+    out["tooth"] = int(finding.tooth)
+    return out
+
+
+def _summarise(drive, zs, pairs) -> dict:
     parts = []
     for p in pairs:
         f = "overlap" if p["fcl_overlap"] else f"{p['fcl_distance_um']:.4f} um"
         b = f" (bound {p['bound_um']:.3g} um)" if drive.coned and not p["fcl_overlap"] else ""
-        parts.append(f"{p['what']} at {p['tooth_angle_deg']:.3f} deg: FCL {f} vs 2D {p['clearance_2d_um']:.4f} um{b}")
+        who = f" (tooth {p['tooth']} at generator angle {p['generator_angle_deg']:.3f} deg, parts with their errors)" if "tooth" in p else ""
+        parts.append(f"{p['what']} at {p['tooth_angle_deg']:.3f} deg{who}: FCL {f} vs 2D {p['clearance_2d_um']:.4f} um{b}")
     ok = all(p["agree"] for p in pairs)
     secs = f"{len(zs)} sections" if drive.coned else "prisms (no coning)"
     summary = ("agree" if ok else "DISAGREE") + f", {secs}: " + "; ".join(parts)

@@ -94,11 +94,16 @@ def cmd_audit(args) -> int:
     res["not_checked"] = not_modelled(drive.design, "this audit", imperfections=imperfect)
     if imperfect:
         res["not_checked"] += _imperfect_not_checked(args)
-    if args.engine in ("fcl", "both") and not imperfect:
+    if args.engine in ("fcl", "both"):
         bar.set(work_end, "3D check (fcl)")
         from ..clearance.fcl3d import verify_worst
 
-        res["fcl"] = verify_worst(drive, result)
+        imp = None
+        if imperfect:
+            from ..accuracy.imperfect import Imperfections
+
+            imp = Imperfections.from_spec(drive.design.imperfections)
+        res["fcl"] = verify_worst(drive, result, imp=imp)
         if args.engine == "fcl":
             res["settings"]["engine"] = "fcl (3D check of the pairs the 2D engine singles out)"
         else:
@@ -159,8 +164,6 @@ def cmd_audit(args) -> int:
 def _imperfect_not_checked(args) -> list[str]:
     """What the audit of an imperfect drive (wgcad.clearance.imperfect) leaves to the perfect drive, said in the summary."""
     notes = ["entry gap and pinch with [imperfections]: not computed (run the audit without the table for the perfect drive's)"]
-    if args.engine in ("fcl", "both"):
-        notes.append("--engine fcl/both with [imperfections]: the 3D check places perfect parts, so it was not run")
     if args.plot:
         notes.append("--plot with [imperfections]: the profile and clearance-against-angle pictures show the perfect drive "
                      "(the tightest-spot picture shows the imperfect one)")
