@@ -50,7 +50,8 @@ def run_sector(design, heights_mode: str | None = None, assign: str | None = Non
         if sp.heights_mm is None:
             raise _UsageError('sectors.heights_mm: --heights list needs heights_mm in the design file')
         built = listed_heights(layout, sp.heights_mm, H)
-    outline = sectored_outline(layout, teeth, built)
+    # the exported outline: every curve in a symmetric chord band (docs/models.md appendix A), as generate's
+    outline = sectored_outline(layout, teeth, built, band=True)
     law = motion_law(layout, d.z_flex)
     scene_full = SectoredScene(drive, layout, teeth, np.full(layout.n_teeth, H))
     audit_full = sectored_audit(scene_full, step)

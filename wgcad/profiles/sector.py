@@ -10,6 +10,8 @@ import numpy as np
 from .. import constants
 from ..design.sectors import SectorsSpec, sector_pitch_z
 from ..errors import DesignError
+from . import pieces as pc
+from .band import band_points
 from .gear import Gear, ToothSpec, make_gear, rotate
 from .sampling import arc_points
 
@@ -167,12 +169,31 @@ def _core(g: Gear) -> np.ndarray:
     return np.concatenate([mirror[:-1], half])
 
 
-def sectored_outline(layout: SectorLayout, teeth: TeethByHeight, heights: np.ndarray) -> np.ndarray:
+def _core_band(g: Gear, tol: float) -> np.ndarray:
+    """As :func:`_core`, in a symmetric chord band of ``tol`` (docs/models.md appendix A): the exact pieces of one pitch less its root arcs."""
+    ps = list(g.pieces)
+
+    def on_root(p):
+        return p.kind == "arc" and abs(p.radius - g.r_f) <= 1e-9 * g.r_f and float(np.hypot(*p.center)) <= 1e-9 * g.r_f
+
+    while ps and on_root(ps[0]):
+        ps.pop(0)
+    while ps and on_root(ps[-1]):
+        ps.pop()
+    pts = [band_points(p, tol) for p in ps]
+    return np.concatenate([x[:-1] for x in pts] + [pts[-1][-1:]])
+
+
+def sectored_outline(layout: SectorLayout, teeth: TeethByHeight, heights: np.ndarray, band: bool = False) -> np.ndarray:
     """The toothed boundary of the whole sectored rigid gear, ``(M, 2)``, counter-clockwise, closed implicitly.
 
     Tooth ``i`` (its flanks, fillets and tip at height ``heights[i]``) is
     turned to ``layout.centres[i]``; neighbouring teeth are joined by root
     arcs. A height below :data:`MIN_HEIGHT_COEF` m leaves the tooth out.
+    With ``band`` (the exports) every curve is drawn in the symmetric chord
+    band of the teeth's tolerance (:mod:`wgcad.profiles.band`: the error
+    split either side of the curve) instead of chords through points of it
+    (one-sided: the polygons the clearance engine's bounds assume).
 
     Raises
     ------
@@ -182,7 +203,8 @@ def sectored_outline(layout: SectorLayout, teeth: TeethByHeight, heights: np.nda
     r_f = teeth.full.r_f
     m = teeth.base.module
     keep = np.nonzero(np.asarray(heights) >= MIN_HEIGHT_COEF * m)[0]
-    cores = [(layout.centres[i], _core(teeth.gear(heights[i]))) for i in keep]
+    cores = [(layout.centres[i], _core_band(teeth.gear(heights[i]), teeth.tol) if band else _core(teeth.gear(heights[i])))
+             for i in keep]
     pieces = []
     for j, (c, core) in enumerate(cores):
         pts = rotate(core, c)
@@ -194,7 +216,7 @@ def sectored_outline(layout: SectorLayout, teeth: TeethByHeight, heights: np.nda
             a1 += 2.0 * pi
         if not a1 > a0:
             raise DesignError("sectors.pitch_z", f"teeth at {np.rad2deg(c):.3f} and {np.rad2deg(c_next):.3f} deg overlap at the root circle")
-        arc = arc_points((0.0, 0.0), r_f, a0, a1, teeth.tol)
+        arc = band_points(pc.arc((0.0, 0.0), r_f, a0, a1), teeth.tol) if band else arc_points((0.0, 0.0), r_f, a0, a1, teeth.tol)
         pieces.append(arc[1:-1])
     out = np.concatenate(pieces)
     keep_pt = np.ones(len(out), dtype=bool)
