@@ -66,7 +66,8 @@ def _check(drive):
         raise DesignError("drive.fixed", f"wgcad ke models a fixed rigid gear, flexspline output (docs/models.md 6.2); got '{d.fixed}'")
 
 
-def contact_table(drive, imp: Imperfections, n_per_mesh: int = DEFAULT_N, sections=None, reach_pitches: float = 0.5) -> ContactTable:
+def contact_table(drive, imp: Imperfections, n_per_mesh: int = DEFAULT_N, sections=None, reach_pitches: float = 0.5,
+                  exhaustive: bool = False) -> ContactTable:
     """Tabulate every tooth's contact on both sides at the ``N z_g`` lattice angles (module docstring).
 
     Parameters
@@ -81,6 +82,11 @@ def contact_table(drive, imp: Imperfections, n_per_mesh: int = DEFAULT_N, sectio
         (ends and middle) with coning, one without.
     reach_pitches : float
         Contacts that need a rotation beyond this many flexspline pitches are dropped.
+    exhaustive : bool
+        Search every solved pair for second features, each search from rest
+        (the reference tests/test_ke.py compares with); by default only the
+        pairs that can be first (:func:`_can_be_first`), each search started
+        where the pair's own line puts the moved contact.
     """
     _check(drive)
     if not isinstance(n_per_mesh, int) or n_per_mesh < 1:
@@ -103,6 +109,7 @@ def contact_table(drive, imp: Imperfections, n_per_mesh: int = DEFAULT_N, sectio
     tab = ContactTable(z_g, z_b, n_per_mesh, list(sections), side_w, sigma, drive.flex.r, drive.rigid.r,
                        (imp.cam_cam, imp.cam_cam_phase))
     parts = {s: [] for s in (1, -1)}
+    pending = {s: [] for s in (1, -1)}  # each section's solved pairs, for the second features
     h = 1e-6
     for si, z in enumerate(sections):
         law = drive.law if z is None else drive.law_at(z)
@@ -137,15 +144,24 @@ def contact_table(drive, imp: Imperfections, n_per_mesh: int = DEFAULT_N, sectio
             k = np.nonzero(good)[0]
             rows = _rows(con, k, idx, rot, shift, drot, dshift, m_all, j, cz, side, np.zeros(len(k)))
             parts[side].append(rows)
-            # the touching feature can change within the errors' radial reach (a tip reaching past the
-            # end of the other's involute into its root fillet): each pair solved again with its
-            # flexspline tooth moved radially, and the contact found there, carried back to the
-            # perfect pose along its own sensitivity, added as a further candidate (_second_features)
-            rho = cz * (imp.cam_flex + imp.cam_fixed) + imp.flex_ecc + imp.rigid_ecc
-            if rho > 0.0 and k.size:
-                parts[side].extend(_second_features(flex, rigid, rows, k, idx, rot, shift, drot, dshift, m_all,
-                                                    j, cz, side, rb, rho, reach_pitches * 2 * pi / z_g,
-                                                    drive.rigid.r))
+            pending[side].append((rows, k, idx, rot, shift, drot, dshift, j, cz, rb))
+    # the touching feature can change within the errors' radial reach (a tip reaching past the end of the
+    # other's involute into its root fillet): each pair that can be first is solved again with its
+    # flexspline tooth moved radially, and the contact found there, carried back to the perfect pose along
+    # its own sensitivity, added as a further candidate (_second_features)
+    if imp.cam_flex + imp.cam_fixed + imp.flex_ecc + imp.rigid_ecc > 0.0:
+        for side in (1, -1):
+            keep = (np.ones(sum(len(x[1]) for x in pending[side]), dtype=bool) if exhaustive else
+                    _can_be_first(tab, side, imp, pending[side], flex, rigid))
+            at = 0
+            for rows, k, idx, rot, shift, drot, dshift, j, cz, rb in pending[side]:
+                sub = np.nonzero(keep[at : at + len(k)])[0]
+                at += len(k)
+                rho = cz * (imp.cam_flex + imp.cam_fixed) + imp.flex_ecc + imp.rigid_ecc
+                if rho > 0.0 and sub.size:
+                    parts[side].extend(_second_features(flex, rigid, {key: v[sub] for key, v in rows.items()}, k[sub],
+                                                        idx, rot, shift, drot, dshift, m_all, j, cz, side, rb, rho,
+                                                        reach_pitches * 2 * pi / z_g, drive.rigid.r, warm=not exhaustive))
     for side in (1, -1):
         tab.sides[side] = {key: np.concatenate([p[key] for p in parts[side]]) for key in parts[side][0]}
         _refine(tab, side, imp, flex, rigid, reach_pitches * 2 * pi / z_g)
@@ -171,6 +187,53 @@ def _rows(con, k, idx, rot, shift, drot, dshift, m_all, j, cz, side, extra):
     }
 
 
+#: the finite-difference sensitivities (_refine) replace a nearest-point normal only within 50 % of it
+_REFINED_NT = 1.5
+
+
+def _can_be_first(tab: ContactTable, side: int, imp: Imperfections, pending, flex, rigid) -> np.ndarray:
+    """Which solved pairs (in the order of ``pending``) can be the first contact of their lattice class under some errors.
+
+    Only those are searched for second features: any other pair's lines,
+    found or not, stay above the class's first contact for every error
+    within the amplitudes, so the KE is the same with or without them
+    (tests/test_ke.py compares against every pair searched).
+
+    Every line of the table changes with the errors by at most
+    ``|nt| (V + A_b |q| + A_a |dP| + e_g)`` (the terms of :func:`_terms`, with
+    ``|a_beta| <= |q| |nt|``, ``|a_phi| <= |dP| |nt|``, ``|a_rho| <= |nt|``).
+    A pair's own line has ``|nt|`` within ``_REFINED_NT`` times its
+    nearest-point one (the refined normal is kept only within 50 % of it);
+    a second feature's is within ``NT_MAX / r_b`` and starts no lower than
+    the pair's own line at the perfect pose (:func:`_second_features` keeps it so);
+    ``|q|`` is at most the rigid tooth's largest radius and ``|dP|`` at most
+    the tooth's speed along the rim plus its turn times its largest radius.
+    So every line of pair ``e`` stays above ``g_e - L_e``. The class's first
+    contact is never above ``g_e' + B_e'`` for any of its pairs (``B`` the same
+    bound with the pair's own ``|nt|`` times ``_REFINED_NT``): a pair with
+    ``g_e - L_e`` above the smallest of those is never first.
+    """
+    if not pending:
+        return np.zeros(0, dtype=bool)
+    g = np.concatenate([r["g"] for r, *_ in pending])
+    m = np.concatenate([r["m"] for r, *_ in pending])
+    c = np.concatenate([r["c"] for r, *_ in pending])
+    ntn = np.concatenate([np.hypot(*r["nt"].T) for r, *_ in pending])
+    # a second feature's contact point is on the tooth moved radially by up to the reach
+    arm = float(np.hypot(*flex.local.T).max()) + imp.flex_ecc + imp.rigid_ecc + imp.cam_flex + imp.cam_fixed
+    speed = np.concatenate([np.hypot(*dshift[k].T) + np.abs(drot[k]) * arm for _, k, _, _, _, drot, dshift, *_ in pending])
+    q_max = float(np.hypot(*rigid.local.T).max())
+    A_b = 0.5 * imp.rigid_runout / tab.r_b
+    A_a = (0.5 * imp.flex_runout + imp.flex_ecc) / tab.r_g
+    reach = imp.rigid_ecc + c * (imp.cam_flex + imp.cam_fixed) + A_b * q_max + A_a * speed + imp.flex_ecc
+    L = np.maximum(_REFINED_NT * ntn, NT_MAX / tab.r_b) * reach
+    B = _REFINED_NT * ntn * reach
+    cls = m % tab.N
+    top = np.full(tab.N, np.inf)
+    np.minimum.at(top, cls, g + B)
+    return g - L <= top[cls] + 1e-12
+
+
 #: radial moves of a flexspline tooth, in units of the errors' radial reach, at which each pair is solved
 #: again for the feature it touches there
 _RADIAL_STEPS = (-0.25, 0.25, -0.5, 0.5, -1.0, 1.0)
@@ -179,7 +242,7 @@ _RADIAL_STEPS = (-0.25, 0.25, -0.5, 0.5, -1.0, 1.0)
 _LINE_TOL = 0.01 / 206264.80624709636
 
 
-def _second_features(flex, rigid, rows, k, idx, rot, shift, drot, dshift, m_all, j, cz, side, rb, rho, reach, r_b):
+def _second_features(flex, rigid, rows, k, idx, rot, shift, drot, dshift, m_all, j, cz, side, rb, rho, reach, r_b, warm=True):
     """Contacts on the features a pair touches once the errors move its flexspline tooth radially by up to ``rho``.
 
     Where the tooth space is locally convex (a tip running from the other's
@@ -196,8 +259,11 @@ def _second_features(flex, rigid, rows, k, idx, rot, shift, drot, dshift, m_all,
     def solve(f, kk):
         ii = idx[k[kk]]
         sh = shift[ii] + f * rho * np.stack([np.cos(rot[ii]), np.sin(rot[ii])], -1)
+        # started 1 um of gap before where the pair's own line puts the moved contact (as _refine): a Newton
+        # step or two when the feature stays, a bracket and a few steps when it changes
+        start = rows["g"][kk] - f * rho * rows["a_rho"][kk] - _FD_START * np.hypot(*rows["nt"][kk].T) if warm else None
         with np.errstate(invalid="ignore"):
-            c2 = closing_rotation(flex, rot[ii], sh, rigid, rb[k[kk]], np.zeros((len(kk), 2)), side, reach)
+            c2 = closing_rotation(flex, rot[ii], sh, rigid, rb[k[kk]], np.zeros((len(kk), 2)), side, reach, start=start)
             c2.delta = np.where(c2.ok, c2.delta, 0.0)
             r2 = _rows(c2, np.arange(len(kk)), ii, rot, shift, drot[k[kk]], dshift[k[kk]], m_all, j[k[kk]], cz,
                        side, np.ones(len(kk)))
