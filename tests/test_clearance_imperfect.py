@@ -194,3 +194,78 @@ def test_bounds_hold_on_other_geometries(name, tmp_path):
     b = IM.audit_imperfect(d, _settings(d, 8.0, refine=False, bound=False), imp)
     assert a.min_clearance == b.min_clearance and a.worst == b.worst
     assert abs(IM.audit_imperfect(d, st, Imperfections()).min_clearance - audit(d, st).min_clearance) <= 1e-9
+
+
+def test_full_cycle_is_every_turn_of_the_flexspline_errors(tmp_path):
+    # With errors tied to the flexspline (here its eccentricity), generator turn n meets them turned by the
+    # flexspline's rotation 2 pi n / u_hg: its states are those of turn 0 of a drive whose flexspline
+    # errors are installed that much further round (the perfect teeth are alike, so the teeth relabel).
+    # So the whole cycle's minimum (--turns full: 43 turns for D4's 86/88 teeth) must equal the smallest
+    # of 43 one-turn audits with those installation angles - computed independently, each its own sweep.
+    # The phase is chosen so that turn 0 is not the worst (measured: -1.61 um in turn 0, -2.34 um in turn 10).
+    from wgcad.accuracy.imperfect import full_cycle_turns
+    from wgcad.audit import RunSettings, run_audit
+    from wgcad.kinematics import gear_ratios
+
+    base = (TEMPLATES / "d4_discrete.toml").read_text() + "\n[imperfections]\n"
+    errs = (("flex_eccentricity_um", "3.0"), ("flex_eccentricity_phase_deg", "270.0"), ("rigid_eccentricity_um", "3.0"),
+            ("cam_offset_fixed_um", "2.0"))
+
+    def design(install_deg=None):
+        text = base
+        for key, val in errs + ((("flex_install_angle_deg", f"{install_deg:.12f}"),) if install_deg is not None else ()):
+            text = edit_toml(text, "imperfections", key, val)
+        p = tmp_path / f"d4_{install_deg}.toml"
+        p.write_text(text)
+        return p
+
+    assert full_cycle_turns(86, 88) == 43 and full_cycle_turns(200, 202) == 100
+    # polygon figures (no refinement): the same polygons at the same poses either way
+    _, full = run_audit(design(), RunSettings(step_deg=2.0, turns=None, refine=False))
+    assert full.settings["generator_turns"] == 43 and full.settings["shortcuts_that_hold"]["one_generator_turn"] is False
+    u = gear_ratios(86, 88)["u_hg"]
+    per_turn = [run_audit(design(math.degrees(2 * math.pi * n / u) % 360.0), RunSettings(step_deg=2.0, refine=False))[1].min_clearance
+                for n in range(43)]
+    assert full.min_clearance == pytest.approx(min(per_turn), abs=1e-9)
+    assert per_turn[0] > min(per_turn) + 0.5e-3  # one turn alone misses it
+
+
+def test_one_turn_holds_every_state_without_flexspline_errors(tmp_path):
+    # housing- and cam-tied errors only: a generator turn later every tooth meets what its neighbour met
+    from wgcad.audit import RunSettings, run_audit
+
+    text = (TEMPLATES / "d4_discrete.toml").read_text() + "\n[imperfections]\n"
+    for key, val in (("rigid_eccentricity_um", "3.0"), ("rigid_runout_um", "4.0"), ("cam_offset_fixed_um", "2.0"),
+                     ("cam_offset_cam_um", "2.0")):
+        text = edit_toml(text, "imperfections", key, val)
+    p = tmp_path / "d4_housing.toml"
+    p.write_text(text)
+    _, one = run_audit(p, RunSettings(step_deg=2.0, refine=False))
+    _, three = run_audit(p, RunSettings(step_deg=2.0, refine=False, turns=3))
+    assert one.settings["shortcuts_that_hold"]["one_generator_turn"] is True
+    assert three.min_clearance == pytest.approx(one.min_clearance, abs=1e-9)
+
+
+def test_turns_flag(tmp_path, capsys):
+    text = (TEMPLATES / "d1_involute.toml").read_text() + "\n[imperfections]\n"
+    text = edit_toml(text, "imperfections", "flex_runout_um", "20.0")
+    p = tmp_path / "d1_flex.toml"
+    p.write_text(text)
+    out = tmp_path / "a.json"
+    rc = main(["audit", str(p), "--step-deg", "4", "--no-refine", "--json", str(out)])
+    assert rc == 1  # D1 interferes
+    res = json.loads(out.read_text())
+    assert res["settings"]["generator_turns"] == 1 and res["settings"]["full_cycle_turns"] == 100
+    assert any("generator turns beyond the first 1 of the 100-turn cycle" in n for n in res["not_checked"])
+    rc = main(["audit", str(p), "--step-deg", "4", "--no-refine", "--turns", "2", "--json", str(out)])
+    assert json.loads(out.read_text())["settings"]["generator_turns"] == 2
+    capsys.readouterr()
+    for bad in ("0", "x", "1.5"):
+        with pytest.raises(SystemExit) as e:
+            main(["audit", str(p), "--turns", bad])
+        assert e.value.code == 2
+    assert "--turns" in capsys.readouterr().err
+    # a perfect drive repeats every mesh period: more turns are refused, one line, exit 2
+    assert main(["audit", str(TEMPLATES / "d1_involute.toml"), "--turns", "2"]) == 2
+    err = capsys.readouterr().err
+    assert "--turns" in err and "Traceback" not in err and err.count("\n") == 1

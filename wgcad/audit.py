@@ -30,6 +30,9 @@ class RunSettings:
     bound: bool = True
     max_memory_mb: float | None = DEFAULT_MAX_MEMORY_MB  # refuse runs estimated above this (None: no limit)
     refine: bool = True  # figures on the exact tooth curves (issue 8)
+    #: generator turns swept for an imperfect drive (None: the whole cycle,
+    #: accuracy.imperfect.full_cycle_turns); a perfect drive repeats every mesh period
+    turns: int | None = 1
 
     def as_dict(self) -> dict:
         return dict(self.__dict__)
@@ -41,6 +44,8 @@ class RunSettings:
             raise DesignError("--sections", f"must be 1..200, got {self.sections}")
         if not 0.0 < self.chord_tol_um <= 100.0:
             raise DesignError("--chord-tol-um", f"must be in (0, 100] um, got {self.chord_tol_um:g}")
+        if self.turns is not None and not 1 <= self.turns <= 10_000:
+            raise DesignError("--turns", f"must be 1..10000 generator turns or 'full', got {self.turns}")
         if not 0.0 <= self.interference_tol_um <= 1000.0:
             raise DesignError("--interference-tol-um", f"must be in [0, 1000] um, got {self.interference_tol_um:g}")
         return self
@@ -54,7 +59,7 @@ def _sections(drive, k: int) -> np.ndarray:
 
 
 def run_audit(design_path, rs: RunSettings, progress=None):
-    """Load, build and audit a design over a full generator revolution.
+    """Load, build and audit a design over a full generator revolution (an imperfect drive: ``rs.turns`` of them).
 
     Returns
     -------
@@ -76,8 +81,16 @@ def run_audit(design_path, rs: RunSettings, progress=None):
         from .clearance.imperfect import chunk_angles
 
         run.update(angles=min(n, chunk_angles(design.drive.z_flex, rs.sections)), use_period=False)
+    turns = 1
+    if imperfect:
+        from .accuracy.imperfect import full_cycle_turns
+
+        turns = full_cycle_turns(design.drive.z_flex, design.drive.z_rigid) if rs.turns is None else rs.turns
+    elif rs.turns != 1:
+        raise DesignError("--turns", "sweeps more generator turns only for an imperfect drive (an [imperfections] table, "
+                          "rigid gear fixed): a perfect drive repeats every mesh period")
     drive = build_drive(design, tol=rs.chord_tol_um * 1e-3, max_memory_mb=rs.max_memory_mb, run=run)
-    angles = np.deg2rad(np.arange(n) * (360.0 / n))
+    angles = np.deg2rad(np.arange(n * turns) * (360.0 / n))
     settings = AuditSettings(
         angles=angles,
         sections=_sections(drive, rs.sections),

@@ -38,6 +38,7 @@ from ..placement import tooth_pose
 __all__ = [
     "Imperfections",
     "shortcuts",
+    "full_cycle_turns",
     "flex_deviations",
     "rigid_deviations",
     "rigid_translation",
@@ -122,6 +123,7 @@ def shortcuts(imp: Imperfections) -> dict:
       in every section (the cam offset scales with coning like W0).
     """
     others = imp.gear_errors or imp.cam_flex != 0.0 or imp.cam_fixed != 0.0
+    flex_borne = imp.flex_runout != 0.0 or imp.flex_ecc != 0.0 or imp.cam_flex != 0.0
     cam_only = not others and imp.cam_cam != 0.0
     on_axis = cam_only and abs(np.sin(imp.cam_cam_phase)) < 1e-12
     perfect = not others and imp.cam_cam == 0.0
@@ -129,10 +131,28 @@ def shortcuts(imp: Imperfections) -> dict:
         "mesh_period": bool(not others),
         "identical_waves": bool(perfect),
         "mirror_symmetry": bool(perfect or on_axis),
+        # errors tied to the flexspline meet those tied to the housing and the cam in a new phase every
+        # generator turn (the flexspline turns by 1/u_hg): the cycle is then the whole of full_cycle_turns;
+        # without them a generator turn later every tooth meets what its neighbour met (the perfect
+        # teeth are alike), so one turn holds every state
+        "one_generator_turn": bool(not flex_borne),
         "why": ("no errors" if perfect else
                 "only the cam-borne offset: constant in the generator frame" if cam_only else
                 "gear run-out/eccentricity or a flexspline-borne/stationary cam offset: the full cycle is needed"),
     }
+
+
+def full_cycle_turns(z_flex: int, z_rigid: int) -> int:
+    """Generator turns after which an imperfect drive's state repeats: the numerator of ``|u_hg|`` in lowest terms.
+
+    Every error is tied to the cam (a function of the generator angle mod
+    2 pi), the housing or the flexspline (of its angle mod 2 pi); both come
+    back together after ``p`` generator turns when ``|u_hg| = p / q``
+    (``q`` flexspline turns): 100 for 200/202 teeth.
+    """
+    from fractions import Fraction
+
+    return Fraction(abs(z_flex), abs(z_rigid - z_flex)).numerator
 
 
 def flex_deviations(imp: Imperfections, k, z_flex: int, r_flex: float):

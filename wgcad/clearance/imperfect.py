@@ -29,7 +29,7 @@ from math import pi
 import numpy as np
 import shapely
 
-from ..accuracy.imperfect import (Imperfections, cam_offset, coning_factor, flex_deviations, rigid_poses,
+from ..accuracy.imperfect import (Imperfections, cam_offset, coning_factor, flex_deviations, full_cycle_turns, rigid_poses,
                                   rigid_translation, shortcuts)
 from ..placement import pose_from_displacements, transform
 from .imperfect_bounds import ErrorBound, PerfectBound, PerfectBounds, chunk_bounds
@@ -378,7 +378,9 @@ def audit_imperfect(drive, settings, imp: Imperfections, progress=None, chunk_sa
         "culling": bool(settings.cull),
         "branch_and_bound": bool(settings.bound),
         "imperfections": True,
-        "shortcuts_that_hold": {k2: sc[k2] for k2 in ("mesh_period", "identical_waves", "mirror_symmetry")},
+        "generator_turns": round(float((angles[-1] - angles[0]) / (2 * pi) + (np.median(np.diff(angles)) / (2 * pi) if A > 1 else 0.0)), 6),
+        "full_cycle_turns": int(full_cycle_turns(drive.design.drive.z_flex, drive.design.drive.z_rigid)),
+        "shortcuts_that_hold": {k2: sc[k2] for k2 in ("mesh_period", "identical_waves", "mirror_symmetry", "one_generator_turn")},
         "shortcuts_note": ("imperfect parts: every (generator angle, tooth, section) sample posed with its errors, "
                            f"in chunks of {B} generator angles; bounds only along a tooth's track ({sc['why']})"),
         **accuracy_settings(drive, settings.refine),

@@ -80,7 +80,7 @@ def cmd_audit(args) -> int:
                          use_period=not (off or args.no_mesh_period), use_waves=not (off or args.no_wave_symmetry),
                          use_mirror=not (off or args.no_mirror), cull=not (off or args.no_culling),
                          bound=not (off or args.no_bound), max_memory_mb=args.max_memory_mb,
-                         refine=not args.no_refine)
+                         refine=not args.no_refine, turns=args.turns)
     rs.check()
     # the engine reports (done, total, stage); it fills the bar up to 90 % (95 % without pictures)
     work_end = 0.6 if args.plot else (0.9 if args.engine == "2d" else 0.8)
@@ -93,7 +93,7 @@ def cmd_audit(args) -> int:
     imperfect = bool(res["settings"].get("imperfections"))
     res["not_checked"] = not_modelled(drive.design, "this audit", imperfections=imperfect)
     if imperfect:
-        res["not_checked"] += _imperfect_not_checked(args)
+        res["not_checked"] += _imperfect_not_checked(args, res["settings"])
     if args.engine in ("fcl", "both"):
         bar.set(work_end, "3D check (fcl)")
         from ..clearance.fcl3d import verify_worst
@@ -161,9 +161,15 @@ def cmd_audit(args) -> int:
     return EXIT_INTERFERENCE if res["interference"] else EXIT_OK
 
 
-def _imperfect_not_checked(args) -> list[str]:
+def _imperfect_not_checked(args, settings: dict) -> list[str]:
     """What the audit of an imperfect drive (wgcad.clearance.imperfect) leaves to the perfect drive, said in the summary."""
     notes = ["entry gap and pinch with [imperfections]: not computed (run the audit without the table for the perfect drive's)"]
+    full = settings.get("full_cycle_turns")
+    done = settings.get("generator_turns", 1.0)
+    if not settings.get("shortcuts_that_hold", {}).get("one_generator_turn", True) and full and done < full - 1e-9:
+        notes.append(f"generator turns beyond the first {done:g} of the {full}-turn cycle: the flexspline-borne errors "
+                     f"(run-out, eccentricity, e_h^g) meet the housing's and the cam's in other phases there "
+                     f"(--turns full sweeps all {full}, {full / max(done, 1e-9):g}x the samples)")
     if args.plot:
         notes.append("--plot with [imperfections]: the profile and clearance-against-angle pictures show the perfect drive "
                      "(the tightest-spot picture shows the imperfect one)")
@@ -237,6 +243,20 @@ def _audit_pngs(drive, result):
 
 
 
+def _turns(text: str):
+    import argparse
+
+    if text == "full":
+        return None
+    try:
+        n = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"'{text}' is neither a whole number nor 'full'") from None
+    if not 1 <= n <= 10_000:
+        raise argparse.ArgumentTypeError(f"must be 1..10000 generator turns or 'full', got {n}")
+    return n
+
+
 def register(sub) -> None:
     """Add the subcommand to the ``wgcad`` parser's subparsers."""
     import argparse
@@ -255,6 +275,9 @@ def register(sub) -> None:
     grp = a.add_mutually_exclusive_group()
     grp.add_argument("--angles", type=angle_count, metavar="N", help="N generator angles over a full revolution")
     grp.add_argument("--step-deg", type=positive_float(0.0, 90.0, "deg"), default=0.5, help="generator-angle step, deg (default 0.5)")
+    a.add_argument("--turns", type=_turns, default=1, metavar="N|full",
+                   help="generator turns swept for an imperfect drive ([imperfections]), or 'full' for the whole cycle "
+                        "(the numerator of |u_hg|: 100 for 200/202 teeth; default 1)")
     a.add_argument("--sections", type=int, default=3, metavar="N",
                    help="cross-sections over the face width when the flexspline is coned, 1..200 (default 3)")
     a.add_argument("--engine", choices=("2d", "fcl", "both"), default="2d",

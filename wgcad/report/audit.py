@@ -116,9 +116,15 @@ def audit_summary(name: str, res: dict) -> str:
         lines.append("  no interference")
     e = res["entry"]
     if st.get("imperfections"):
-        held = [k.replace("_", " ") for k, v in st["shortcuts_that_hold"].items() if v]
-        lines.append("  imperfect parts ([imperfections]): every tooth posed with its errors; shortcuts that still hold: "
-                     + (", ".join(held) if held else "none") + " (none used)")
+        sh = st["shortcuts_that_hold"]
+        held = [k.replace("_", " ") for k, v in sh.items() if v and k != "one_generator_turn"]
+        turns = st.get("generator_turns", 1.0)
+        cyc = (f"{turns:g} generator turn{'s' if turns != 1 else ''} of the {st['full_cycle_turns']}-turn cycle swept"
+               if st.get("full_cycle_turns") else "")
+        if sh.get("one_generator_turn") and cyc:
+            cyc += " (no flexspline-borne errors: one turn holds every state)"
+        lines.append("  imperfect parts ([imperfections]): every tooth posed with its errors" + (f", {cyc}" if cyc else "")
+                     + "; shortcuts that still hold: " + (", ".join(held) if held else "none") + " (none used)")
     if e.get("note"):
         pass  # not computed (imperfect parts): the caller's NOT CHECKED lines say so
     elif res["entry_gap_um"] is not None:
