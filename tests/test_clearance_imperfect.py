@@ -94,6 +94,10 @@ def test_zero_imperfections_give_the_perfect_audit(d1):
     assert abs(abs(got.worst["tooth_angle_deg"]) - ref.worst["tooth_angle_deg"]) <= 1e-6
     assert got.worst["section_z_mm"] == ref.worst["section_z_mm"]
     assert got.interference == ref.interference
+    # entry gap and pinch: every passage is the perfect one (the mesh period holds: one per section measured)
+    assert abs(got.entry_gap - ref.entry_gap) <= REFINE_TOL
+    assert abs(got.findings["entry_pinch"].value - ref.findings["entry_pinch"].value) <= REFINE_TOL
+    assert got.entry["section_z_mm"] == ref.entry["section_z_mm"]
 
 
 def test_rigid_eccentricity_deepens_by_its_amplitude(d1):
@@ -154,11 +158,13 @@ def test_audit_cli_honours_imperfections(tmp_path, capsys):
     assert res["settings"]["imperfections"] is True
     assert res["settings"]["mesh_period"] is False
     assert not any("uses perfect parts" in n for n in res["not_checked"])
-    assert any("entry gap" in n for n in res["not_checked"])
+    assert not any("entry gap" in n for n in res["not_checked"])
+    # the entry of the imperfect drive: the passage it happens in
+    assert res["entry_gap_um"] is not None and res["entry"]["tooth"] is not None and res["entry"]["generator_angle_deg"] is not None
     for suffix in ("profile", "vs_angle", "tightest"):
         assert (tmp_path / f"pic_{suffix}.png").stat().st_size > 10_000
     text_out = capsys.readouterr().out
-    assert "imperfect parts" in text_out and "NOT CHECKED: entry gap" in text_out
+    assert "imperfect parts" in text_out and "entry gap:" in text_out and "NOT CHECKED: entry gap" not in text_out
 
 
 def test_fixed_flexspline_keeps_the_perfect_audit_and_says_so(tmp_path):
@@ -269,3 +275,83 @@ def test_turns_flag(tmp_path, capsys):
     assert main(["audit", str(TEMPLATES / "d1_involute.toml"), "--turns", "2"]) == 2
     err = capsys.readouterr().err
     assert "--turns" in err and "Traceback" not in err and err.count("\n") == 1
+
+
+def _reference_crossing(drive, imp, phi_lo, phi_hi, k, z, r_tip_b, arc):
+    """Bisection on the generator angle for the tooth's exact tip arc (sampled at 0.02 deg) reaching the rigid tip circle."""
+    t = np.linspace(arc.t0, arc.t1, 2001)
+
+    def radial(ph):
+        rot, shift = flex_poses(drive, imp, ph, teeth=np.array([k]), z=z)
+        shift = shift[0] - IM.rigid_translation(imp)
+        pts = shift + arc.radius * np.stack([np.cos(rot[0] + t), np.sin(rot[0] + t)], -1)
+        return r_tip_b - float(np.hypot(*pts.T).max())
+
+    a, b = phi_lo, phi_hi
+    fa = radial(a)
+    assert fa * radial(b) < 0
+    for _ in range(60):
+        m = 0.5 * (a + b)
+        fm = radial(m)
+        if (fm <= 0) == (fa <= 0):
+            a, fa = m, fm
+        else:
+            b = m
+    return 0.5 * (a + b)
+
+
+def test_entry_gap_of_every_passage_against_a_dense_reference(d1):
+    # Each passage's crossing and gap from an independent route: the tooth's exact tip arc sampled at 0.02 deg
+    # (its radial error 1e-8 mm), bisection on the generator angle, and the gap there between the two posed
+    # outlines built at 0.001 um chords (shapely). The audit's smallest entry gap must be that of its passage
+    # (to the refinement's 0.001 um plus the reference's 0.001 um) and no sampled passage may be smaller.
+    from wgcad.clearance.imperfect_entry import passages
+
+    st = _settings(d1, 1.0)
+    got = IM.audit_imperfect(d1, st, S4)
+    e = got.findings["entry_gap"]
+    assert np.isfinite(e.value) and e.details["passages"] == 3 * len(passages(Scene(d1), 1.0, 0.0, 2 * np.pi)[0])
+    sc = Scene(d1)
+    fine = build_drive(d1.design, tol=1e-6)
+    rr, rs = rigid_poses(d1, S4)
+    rigid_fine = [transform(fine.rigid.tooth_polygon(), rr[j : j + 1], rs[j : j + 1])[0] for j in range(d1.design.drive.z_rigid)]
+    c = 1.0 / sc.ratios["u_hg"] - 1.0
+
+    import shapely
+
+    def ref_gap(ph, k, z):
+        rot, shift = flex_poses(d1, S4, ph, teeth=np.array([k]), z=z)
+        tooth = shapely.Polygon(transform(fine.flex.tooth_polygon(), rot, shift)[0])
+        return min(tooth.distance(shapely.Polygon(p)) for p in rigid_fine)
+
+    # the reported passage: crossing bracketed around the audit's own angle
+    span = np.deg2rad(0.5)
+    ph = _reference_crossing(d1, S4, e.generator_angle - span, e.generator_angle + span, e.tooth, e.section_z, sc.r_tip_b, sc.tip_arc)
+    assert abs(ph - e.generator_angle) < 1e-7
+    assert abs(e.value - ref_gap(ph, e.tooth, e.section_z)) <= REFINE_TOL + 1e-6
+    # other passages (a sample of each section's): none below the reported gap
+    from wgcad.clearance.entry import entry_crossings
+
+    p_star = [g[1] for g in entry_crossings(sc, list(got.settings["sections_z_mm"]), exact=False)]
+    t = np.linspace(sc.tip_arc.t0, sc.tip_arc.t1, 401)
+    rng = np.random.default_rng(3)
+    checked = 0
+    for z, p0 in zip(got.settings["sections_z_mm"], p_star):
+        ph0, ks = passages(sc, p0, 0.0, 2 * np.pi)
+        for i in rng.choice(len(ph0), 6, replace=False):
+            # the crossing nearest the perfect one on a 0.05 deg grid, then bisection
+            grid = ph0[i] + np.deg2rad(np.arange(-8.0, 8.01, 0.05)) / abs(c)
+            f = []
+            for g in grid:
+                r_, s_ = flex_poses(d1, S4, g, teeth=np.array([ks[i]]), z=z)
+                s_ = s_[0] - IM.rigid_translation(S4)
+                arc = s_ + sc.tip_arc.radius * np.stack([np.cos(r_[0] + t), np.sin(r_[0] + t)], -1)
+                f.append(sc.r_tip_b - float(np.hypot(*arc.T).max()))
+            f = np.array(f)
+            ch = np.nonzero((f[:-1] <= 0) != (f[1:] <= 0))[0]
+            assert ch.size
+            j = ch[np.argmin(np.abs(ch - len(grid) // 2))]
+            ph = _reference_crossing(d1, S4, grid[j], grid[j + 1], ks[i], z, sc.r_tip_b, sc.tip_arc)
+            assert ref_gap(ph, ks[i], z) >= e.value - REFINE_TOL - 1e-6
+            checked += 1
+    assert checked == 18

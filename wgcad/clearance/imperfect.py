@@ -201,8 +201,9 @@ def audit_imperfect(drive, settings, imp: Imperfections, progress=None, chunk_sa
     Returns
     -------
     wgcad.clearance.engine.AuditResult
-        Entry gap and pinch are not computed (NaN, ``entry`` says why); the
-        backlash is the imperfect drive's at the first generator angle.
+        Entry gap and pinch over every passage of a tooth through the entry
+        (:mod:`wgcad.clearance.imperfect_entry`); the backlash is the
+        imperfect drive's at the first generator angle.
     """
     from .engine import AuditResult, accuracy_settings
     from .findings import Finding
@@ -355,6 +356,21 @@ def audit_imperfect(drive, settings, imp: Imperfections, progress=None, chunk_sa
                     generator_angle=float(angles[ai]), tooth=k, polygon_value=float(best_poly),
                     details={"mirror": None,  # the errors break the mirror symmetry
                              "sample_tooth_angle": phi_tooth, "rigid_tooth": j, "overlap_area": float(area)})
+    # entry gap and pinch: every passage of a tooth through the entry in the swept angles, each with its
+    # own crossing (wgcad.clearance.imperfect_entry), found from the perfect drive's (polygons suffice there:
+    # they only say where to look)
+    from .entry import entry_crossings, entry_pinch
+    from .imperfect_entry import imperfect_entry
+
+    if progress is not None:
+        progress(920, 1000, "entry gap")
+    gaps = list(zip(entry_crossings(scene, sections, exact=False), sections))
+    crossed = any(np.isfinite(g[0]) for g, _ in gaps)
+    p_pinch = entry_pinch(scene, [(g[1], z) for g, z in gaps if np.isfinite(g[0])], exact=False) if crossed else None
+    # with the cam-borne offset alone (or no errors) every passage of a section is congruent (the mesh period
+    # holds, docs/models.md 7): one passage per section stands for all
+    span = np.array([angles[0], angles[0] + 2 * pi / scene.z_b]) if shortcuts(imp)["mesh_period"] else angles
+    ent = imperfect_entry(drive, imp, isc, scene, gaps, p_pinch, span, sections, settings.refine) if crossed else {}
     # backlash of the imperfect drive at the first generator angle, middle section: the rigid turn of the
     # flexspline between contact either way, from the exact poses (wgcad.accuracy.ke.closing_direct)
     z_mid = sections[len(sections) // 2]
@@ -389,13 +405,27 @@ def audit_imperfect(drive, settings, imp: Imperfections, progress=None, chunk_sa
     }
     counts = {"samples": int(A * z_g * S), "unique_tooth_angles": int(A * z_g), "sections": S, "evaluated": int(n_ev),
               "culled": int(n_pruned), "perfect_evaluated": perfect.evaluated, "refined": int(n_refined), "fine_polygon": int(n_fine), "chunks": -(-A // B)}
-    note = "not computed for imperfect parts (the entry gap and pinch are figures of the perfect drive's c(phi))"
     exact = "exact" if settings.refine else "polygon"
     rs["entry_side"] = "entry (+phi)" if scene.entry_sign > 0 else "entry (-phi)"
+    fold = lambda a: float((a + pi / scene.n_w) % (2 * pi / scene.n_w) - pi / scene.n_w)  # noqa: E731  (nearest major axis)
+    if np.isfinite(ent.get("gap", np.nan)):
+        gap_f = Finding("entry_gap", ent["gap"], exact, tooth_angle=fold(ent["gap_tooth_angle"]), section_z=ent["gap_z"],
+                        generator_angle=ent["gap_phi_h"], tooth=ent["gap_tooth"],
+                        details={"crossing": "flexspline tip arc crossing the rigid tip circle",
+                                 "passages": ent["passages"], "spread": ent["spread"]})
+    else:
+        gap_f = Finding("entry_gap", float("nan"), exact, details={"passages": ent.get("passages", 0)})
+    if np.isfinite(ent.get("pinch", np.nan)):
+        ploc = _classify(isc, ent["pinch_rot"], ent["pinch_shift"], ent["pinch_rigid"])
+        pinch_f = Finding("entry_pinch", ent["pinch"], exact, tooth_angle=fold(ent["pinch_tooth_angle"]),
+                          section_z=ent["pinch_z"], location=ploc, generator_angle=ent["pinch_phi_h"], tooth=ent["pinch_tooth"],
+                          details={"tip_to_tip_risk": bool(ent["pinch"] < settings.interference_tol and ploc == "tip")})
+    else:
+        pinch_f = Finding("entry_pinch", float("nan"), exact, details={"tip_to_tip_risk": False})
     findings = {
         "min_clearance": worst,
-        "entry_gap": Finding("entry_gap", float("nan"), exact, details={"note": note}),
-        "entry_pinch": Finding("entry_pinch", float("nan"), exact, details={"tip_to_tip_risk": False}),
+        "entry_gap": gap_f,
+        "entry_pinch": pinch_f,
         "backlash": Finding("backlash", float(bl), "brent", generator_angle=float(angles[0]), section_z=z_mid),
     }
     res = AuditResult(settings=rs, findings=findings, interference=best < -settings.interference_tol,

@@ -163,7 +163,7 @@ def cmd_audit(args) -> int:
 
 def _imperfect_not_checked(args, settings: dict) -> list[str]:
     """What the audit of an imperfect drive (wgcad.clearance.imperfect) leaves to the perfect drive, said in the summary."""
-    notes = ["entry gap and pinch with [imperfections]: not computed (run the audit without the table for the perfect drive's)"]
+    notes = []
     full = settings.get("full_cycle_turns")
     done = settings.get("generator_turns", 1.0)
     if not settings.get("shortcuts_that_hold", {}).get("one_generator_turn", True) and full and done < full - 1e-9:

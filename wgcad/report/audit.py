@@ -59,6 +59,14 @@ def entry_json(gap, pinch, side: str) -> dict:
                     "pinch_location": None, "tip_to_tip_risk": False})
     if gap.details.get("note"):
         out["note"] = gap.details["note"]
+    if gap.tooth is not None:  # an imperfect drive: the passage the figures happen in
+        out["tooth"] = int(gap.tooth)
+        out["generator_angle_deg"] = _deg(gap.generator_angle)
+        out["passages"] = int(gap.details.get("passages", 0))
+        out["spread_um"] = round(1e3 * gap.details["spread"], 4) if "spread" in gap.details else None
+        if np.isfinite(pinch.value):
+            out["pinch_tooth"] = int(pinch.tooth)
+            out["pinch_generator_angle_deg"] = _deg(pinch.generator_angle)
     out["method"] = gap.method
     return out
 
@@ -130,12 +138,16 @@ def audit_summary(name: str, res: dict) -> str:
     elif res["entry_gap_um"] is not None:
         sec = "" if e["section_z_mm"] is None else f", section z = {e['section_z_mm']:g} mm"
         lines.append(f"  entry gap: {res['entry_gap_um']:.3f} um at tooth angle {e['tooth_angle_deg']:+.3f} deg{sec} "
-                     "(flexspline tip crossing the rigid tip circle)")
+                     "(flexspline tip crossing the rigid tip circle)"
+                     + (f"; tooth {e['tooth']} at generator angle {e['generator_angle_deg']:.3f} deg, the smallest of "
+                        f"{e['passages']} passages (they spread over {e['spread_um']:.3f} um)" if "tooth" in e else ""))
         if e["pinch_um"] is None:
             lines.append("  entry pinch: none (from the crossing to the major axis the clearance never rises again from a minimum)")
         else:
             psec = "" if e["pinch_section_z_mm"] is None else f", section z = {e['pinch_section_z_mm']:g} mm"
             lines.append(f"  entry pinch: {e['pinch_um']:.3f} um at tooth angle {e['pinch_tooth_angle_deg']:+.3f} deg{psec}, {e['pinch_location']}"
+                         + (f"; tooth {e['pinch_tooth']} at generator angle {e['pinch_generator_angle_deg']:.3f} deg"
+                            if "pinch_tooth" in e else "")
                          + ("  TIP-TO-TIP RISK" if e["tip_to_tip_risk"] else ""))
     else:
         lines.append("  entry gap: none (the tips never cross the rigid tip circle)")
