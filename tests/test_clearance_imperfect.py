@@ -355,3 +355,52 @@ def test_entry_gap_of_every_passage_against_a_dense_reference(d1):
             assert ref_gap(ph, ks[i], z) >= e.value - REFINE_TOL - 1e-6
             checked += 1
     assert checked == 18
+
+
+def test_generate_places_the_deformed_assembly_with_its_errors(tmp_path):
+    # generate --generator-angle with [imperfections]: read back from the DXF, the rigid gear's outline has
+    # moved by its eccentricity, the flexspline's by the cam offset plus its own eccentricity (a first harmonic
+    # of its teeth's positions); the gears' own DXF stays nominal. (Run-out would move the outlines' centroids
+    # too, by a fraction of it: the teeth are a fraction of the area. Left out here.)
+    import shapely
+
+    from wgcad.accuracy.imperfect import cam_offset, rigid_translation
+    from wgcad.export.dxf import read_dxf
+    from wgcad.kinematics import gear_ratios
+
+    errs = (("rigid_eccentricity_um", "20.0"), ("rigid_eccentricity_phase_deg", "30.0"),
+            ("flex_eccentricity_um", "12.0"), ("flex_eccentricity_phase_deg", "200.0"), ("cam_offset_fixed_um", "25.0"),
+            ("cam_offset_fixed_phase_deg", "100.0"), ("cam_offset_cam_um", "10.0"))
+    text = (TEMPLATES / "d1_involute.toml").read_text() + "\n[imperfections]\n"
+    for key, val in errs:
+        text = edit_toml(text, "imperfections", key, val)
+    p = tmp_path / "d1_imp.toml"
+    p.write_text(text)
+    assert main(["generate", str(p), "--out", str(tmp_path / "imp"), "--generator-angle", "40", "--no-stl", "--quiet"]) == 0
+    assert main(["generate", str(TEMPLATES / "d1_involute.toml"), "--out", str(tmp_path / "nom"), "--generator-angle", "40",
+                 "--no-stl", "--quiet"]) == 0
+    got = read_dxf(tmp_path / "imp" / "d1_imp_phip040_000.dxf")
+    nom = read_dxf(tmp_path / "nom" / "d1_involute_phip040_000.dxf")
+    imp = Imperfections.from_spec(load_design(p).imperfections)
+    phi_h = math.radians(40.0)
+
+    def centroid(layers, name):
+        c = shapely.Polygon(layers[name]["outlines"][0]).centroid
+        return np.array([c.x, c.y])
+
+    T = rigid_translation(imp)
+    # the outlines are polygons at 1 um chords: their centroids agree to far below that (1e-4 mm)
+    assert np.allclose(centroid(got, "RIGID") - centroid(nom, "RIGID"), T, atol=1e-4)
+    phi_g = phi_h / gear_ratios(200, 202)["u_hg"]
+    ecc = imp.flex_ecc * np.array([math.cos(imp.flex_ecc_phase + phi_g), math.sin(imp.flex_ecc_phase + phi_g)])
+    # the flexspline's teeth: the cam offset and its eccentricity (to first order: a tooth shifted along the
+    # deformed rim by e sin(...) is not exactly translated; 1 um covers it at W0/r_m ~ 1 %)
+    assert np.allclose(centroid(got, "FLEXSPLINE_DEFORMED") - centroid(nom, "FLEXSPLINE_DEFORMED"),
+                       cam_offset(imp, phi_h, phi_g) + ecc, atol=1e-3)
+    assert np.allclose(centroid(got, "NEUTRAL_LINE") - centroid(nom, "NEUTRAL_LINE"), cam_offset(imp, phi_h, phi_g), atol=1e-6)
+    # the nominal parts: the gears' own DXF is the perfect one
+    a = read_dxf(tmp_path / "imp" / "d1_imp.dxf")["RIGID"]["outlines"][0]
+    b = read_dxf(tmp_path / "nom" / "d1_involute.dxf")["RIGID"]["outlines"][0]
+    assert np.array_equal(a, b)
+    rep = json.loads((tmp_path / "imp" / "d1_imp.report.json").read_text())
+    assert "nominal" in rep["imperfections"] and not any("[imperfections]" in n for n in rep["not_modelled"])

@@ -13,12 +13,18 @@ from .common import EPILOG, EXIT_OK, add_memory_flag, angles_deg, circle, out_di
 __all__ = ["register", "cmd_generate", "deformed_scene", "report_name"]
 
 
-def deformed_scene(drive, phi_h_abs: float) -> dict:
-    """Geometry of the deformed drive at generator angle ``phi_h_abs`` (rad, relative to the fixed member)."""
+def deformed_scene(drive, phi_h_abs: float, imp=None) -> dict:
+    """Geometry of the deformed drive at generator angle ``phi_h_abs`` (rad, relative to the fixed member).
+
+    With ``imp`` (:class:`wgcad.accuracy.imperfect.Imperfections`, rigid gear
+    fixed) every tooth of both gears sits where its errors put it
+    (``flex_poses``, ``rigid_poses``), and the rim and neutral line move with
+    the cam offset (docs/models.md 6.2).
+    """
     import numpy as np
 
     from ..kinematics import gear_ratios
-    from ..placement import deformed_curve, join_teeth, place_flex_teeth, tooth_angles
+    from ..placement import deformed_curve, join_teeth, place_flex_teeth, tooth_angles, transform
 
     d = drive.design.drive
     ratios = gear_ratios(d.z_flex, d.z_rigid)
@@ -27,8 +33,16 @@ def deformed_scene(drive, phi_h_abs: float) -> dict:
     else:  # flexspline fixed: the rigid gear turns by phi_h / u_hb; draw in the flexspline's frame
         phi_b = phi_h_abs / ratios["u_hb"]
         phi_h, frame = phi_h_abs - phi_b, phi_b
-    teeth = place_flex_teeth(drive, phi_h, local=drive.flex.period)
     _, phi = tooth_angles(d.z_flex, d.z_rigid, phi_h)
+    if imp is not None:
+        from ..accuracy.imperfect import cam_offset, flex_poses, rigid_poses
+
+        teeth = transform(drive.flex.period, *flex_poses(drive, imp, phi_h))
+        rigid_outline = join_teeth(transform(drive.rigid.period, *rigid_poses(drive, imp)))
+        E = cam_offset(imp, phi_h, phi_h / ratios["u_hg"])  # the rim and its neutral line move with the cam
+    else:
+        teeth = place_flex_teeth(drive, phi_h, local=drive.flex.period)
+        rigid_outline, E = drive.rigid.outline, np.zeros(2)
     n_rim = max(720, int(np.ceil(2 * np.pi / np.sqrt(8 * drive.tol / drive.r_m))))
     ph = np.linspace(0.0, 2 * np.pi, n_rim, endpoint=False)
     rim = deformed_curve(drive.law, drive.r_m, drive.flex_rim_radius - drive.r_m, ph)
@@ -64,9 +78,10 @@ def deformed_scene(drive, phi_h_abs: float) -> dict:
         "r_m": drive.r_m,
         "waves": d.waves,
         "w0": drive.law.w0,
-        "flex_rim": rot(rot(rim, phi_h), frame),
-        "neutral": rot(rot(neutral, phi_h), frame),
-        "rigid_outline": rot(drive.rigid.outline, frame),
+        "flex_rim": rot(rot(rim, phi_h), frame) + E,
+        "neutral": rot(rot(neutral, phi_h), frame) + E,
+        "rigid_outline": rot(rigid_outline, frame),
+        "imperfect": imp is not None,
         "rigid_rim_radius": drive.rigid_rim_radius,
         "major_axis": phi_h + frame,
         "entry_sign": 1.0 if d.rotation == "ccw" else -1.0,
@@ -156,7 +171,17 @@ def cmd_generate(args) -> int:
     rep = drive_report(drive)
     from .common import not_modelled
 
-    rep["not_modelled"] = not_modelled(design, "generate")
+    # the deformed assembly places the parts with their errors (rigid gear fixed: docs/models.md 6.2); the
+    # gears' own DXF and STL stay nominal, the part a shop makes
+    imp = None
+    if design.imperfections.any and design.drive.fixed == "rigid":
+        from ..accuracy.imperfect import Imperfections
+
+        imp = Imperfections.from_spec(design.imperfections)
+    rep["not_modelled"] = not_modelled(design, "generate", imperfections=imp is not None)
+    if imp is not None:
+        rep["imperfections"] = ("the deformed-assembly DXF/PNG (--generator-angle) place every tooth with its [imperfections]; "
+                                "the gears' DXF and STL are the nominal parts")
     files = []
     with atomic_batch() as batch:
         path = out / f"{stem}.dxf"
@@ -185,7 +210,7 @@ def cmd_generate(args) -> int:
             from ..export.figures import assembly_png
         for deg in angles:
             bar.set(done / total, f"{deg:g} deg: DXF")
-            scene = deformed_scene(drive, np.deg2rad(deg))
+            scene = deformed_scene(drive, np.deg2rad(deg), imp)
             tag = angle_tag(deg)
             dl = [
                 DxfLayer("RIGID", outlines=(scene["rigid_outline"],), color=1),
@@ -200,7 +225,8 @@ def cmd_generate(args) -> int:
             step(_COST["angle_dxf"], f"{deg:g} deg: picture")
             png = assembly_png(scene, f"{design.drive.name}: generator at {deg:g} deg counter-clockwise from +x "
                                       f"({design.generator.law} law, W0 = {design.w0:.3f} mm"
-                                      + (", generator's centre section)" if drive.coned else ")"),
+                                      + (", generator's centre section" if drive.coned else "")
+                                      + (", parts with their [imperfections])" if imp is not None else ")"),
                                entry_deg=scene["entry_deg"])
             path = out / f"{stem}_phi{tag}.png"
             Path(batch.temp_path(path)).write_bytes(png)
@@ -227,6 +253,7 @@ def cmd_generate(args) -> int:
     elif not args.quiet:
         removed = f", removed {len(stale)} of the previous run's files" if stale else ""
         write_stdout(format_summary(rep) + "\n" + "".join(f"  NOT MODELLED: {n}\n" for n in rep["not_modelled"])
+                     + (f"  [imperfections]: {rep['imperfections']}\n" if "imperfections" in rep else "")
                      + f"\n  wrote {len(files)} files to {out}/ ({report_path.name}){removed} in {time.perf_counter() - t0:.2f} s\n")
     return EXIT_OK
 
