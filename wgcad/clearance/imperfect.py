@@ -412,7 +412,8 @@ def audit_imperfect(drive, settings, imp: Imperfections, progress=None, chunk_sa
         gap_f = Finding("entry_gap", ent["gap"], exact, tooth_angle=fold(ent["gap_tooth_angle"]), section_z=ent["gap_z"],
                         generator_angle=ent["gap_phi_h"], tooth=ent["gap_tooth"],
                         details={"crossing": "flexspline tip arc crossing the rigid tip circle",
-                                 "passages": ent["passages"], "spread": ent["spread"]})
+                                 "passages": ent["passages"], "spread": ent["spread"], "all_passages": ent["all"],
+                                 "perfect_gaps": [float(g[0]) for g, _ in gaps], "perfect_phi": [float(g[1]) for g, _ in gaps]})
     else:
         gap_f = Finding("entry_gap", float("nan"), exact, details={"passages": ent.get("passages", 0)})
     if np.isfinite(ent.get("pinch", np.nan)):

@@ -128,7 +128,8 @@ def imperfect_entry(drive, imp, isc, scene, perfect_gaps, perfect_pinch, angles,
     -------
     dict with ``gap``, ``gap_phi_h``, ``gap_tooth``, ``gap_z``, ``gap_tooth_angle`` and, where the perfect drive
     has a pinch, ``pinch``, ``pinch_phi_h``, ``pinch_tooth``, ``pinch_z``, ``pinch_tooth_angle``,
-    ``pinch_rigid``; ``passages`` (per section), ``spread`` (largest minus smallest passage gap), mm and rad.
+    ``pinch_rigid``; ``passages`` (per section), ``spread`` (largest minus smallest passage gap), mm and rad;
+    ``all``: every passage's generator angle, gap on the polygons and section index.
     """
     sgn = scene.entry_sign
     step = float(np.median(np.diff(angles))) if len(angles) > 1 else 2.0 * pi
@@ -152,6 +153,7 @@ def imperfect_entry(drive, imp, isc, scene, perfect_gaps, perfect_pinch, angles,
         return out
     v, ph, k, si = (np.concatenate(x) for x in zip(*rows))
     out["spread"] = float(v.max() - v.min())
+    out["all"] = {"phi_h": ph, "gap": v, "section": si}  # every passage's polygon figure (for the picture)
     best = int(np.argmin(v))
     if refine:
         near = np.nonzero(v <= v[best] + 2.0 * isc.chord_gap)[0]

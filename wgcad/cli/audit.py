@@ -171,8 +171,8 @@ def _imperfect_not_checked(args, settings: dict) -> list[str]:
                      f"(run-out, eccentricity, e_h^g) meet the housing's and the cam's in other phases there "
                      f"(--turns full sweeps all {full}, {full / max(done, 1e-9):g}x the samples)")
     if args.plot:
-        notes.append("--plot with [imperfections]: the profile and clearance-against-angle pictures show the perfect drive "
-                     "(the tightest-spot picture shows the imperfect one)")
+        notes.append("--plot with [imperfections]: the profile picture shows the perfect drive's passage (the vs_angle picture "
+                     "shows every imperfect passage's entry gap, the tightest-spot picture the imperfect parts)")
     return notes
 
 
@@ -192,21 +192,40 @@ def _audit_pngs(drive, result):
     w = result.worst
     e = result.entry
     name = drive.design.drive.name
+    ent = result.findings["entry_gap"].details
+    if imperfect and "perfect_gaps" in ent:
+        # the perfect drive's curve: its own entry gap marked (the imperfect passages have their own picture)
+        i = int(np.nanargmin(ent["perfect_gaps"]))
+        entry_deg, entry_um = float(np.rad2deg(ent["perfect_phi"][i])), 1e3 * ent["perfect_gaps"][i]
+    else:
+        entry_deg, entry_um = e["tooth_angle_deg"], 1e3 * result.entry_gap
     data = {
         "phi_deg": np.rad2deg(prof["phi"]),
         "sections": [{"z": s["z"], "working_um": 1e3 * s["working"], "nonworking_um": 1e3 * s["nonworking"]} for s in prof["sections"]],
-        "entry_deg": e["tooth_angle_deg"],
-        "entry_um": 1e3 * result.entry_gap,
+        "entry_deg": entry_deg,
+        "entry_um": entry_um,
+        "worst_label": "imperfect parts' minimum" if imperfect else "minimum",
         "worst_deg": w["tooth_angle_deg"],
         "worst_um": w["clearance_um"],
         "tol_um": 1e3 * result.interference_tol,
     }
     yield "profile", clearance_profile_png(data, f"{name}: clearance of a flexspline tooth along its passage (every tooth follows it){perfect_note}")
     mesh = 360.0 / drive.design.drive.z_rigid
-    ang = np.deg2rad(np.linspace(0.0, 3 * mesh, 601))
-    wv, nv = clearance_vs_angle(scene, prof, ang)
-    yield "vs_angle", clearance_vs_angle_png(np.rad2deg(ang), 1e3 * wv, 1e3 * nv, 1e3 * result.interference_tol,
-                                             f"{name}: smallest clearance over all teeth; periodic with the mesh period {mesh:.4f} deg (3 shown){perfect_note}")
+    if imperfect and "all_passages" in ent:
+        # the errors break the mesh period: every passage of a tooth through the entry has its own gap
+        from ..export.imperfect_figures import entry_passages_png
+
+        a = ent["all_passages"]
+        yield "vs_angle", entry_passages_png(
+            np.rad2deg(a["phi_h"]), 1e3 * a["gap"], a["section"], secs, [1e3 * g for g in ent["perfect_gaps"]],
+            1e3 * result.interference_tol,
+            f"{name}: entry gap of every passage of a tooth through the entry, imperfect parts "
+            f"({result.settings.get('generator_turns', 1):g} generator turn(s); the audit's smallest is refined on the exact curves)")
+    else:
+        ang = np.deg2rad(np.linspace(0.0, 3 * mesh, 601))
+        wv, nv = clearance_vs_angle(scene, prof, ang)
+        yield "vs_angle", clearance_vs_angle_png(np.rad2deg(ang), 1e3 * wv, 1e3 * nv, 1e3 * result.interference_tol,
+                                                 f"{name}: smallest clearance over all teeth; periodic with the mesh period {mesh:.4f} deg (3 shown){perfect_note}")
     # the teeth around the tightest spot, at the worst sample's generator angle and section
     phi_h = np.deg2rad(w["generator_angle_deg"])
     z = w["section_z_mm"]

@@ -263,7 +263,7 @@ def clearance_profile_figure(profile: dict, title: str):
         ax.plot([profile["entry_deg"]], [profile["entry_um"]], "v", color="tab:green", ms=9, zorder=5,
                 label=f"entry gap {profile['entry_um']:.2f} um at {profile['entry_deg']:+.1f}°")
     ax.plot([profile["worst_deg"]], [profile["worst_um"]], "o", color="tab:red", ms=8, zorder=5,
-            label=f"minimum {profile['worst_um']:.2f} um at {profile['worst_deg']:+.1f}°")
+            label=profile.get("worst_label", "minimum") + f" {profile['worst_um']:.2f} um at {profile['worst_deg']:+.1f}°")
     # y: from the deepest point to above the highest marker; the curves rise to
     # millimetres out of mesh, and showing that would flatten the engagement
     lo = min(min(lows), profile["worst_um"], -tol)
