@@ -1,4 +1,4 @@
-"""``wgcad ke``: no-load kinematic error and lost motion of an imperfect drive, the installation-angle lever (docs/models.md 6.2)."""
+"""``wgcad ke``: kinematic error and lost motion of an imperfect drive, no load and under load, the installation-angle lever (docs/models.md 6.2, 6.3)."""
 
 from __future__ import annotations
 
@@ -24,9 +24,15 @@ def cmd_ke(args) -> int:
     from ..drive import build_drive
     from ..export.atomic import atomic_batch, ensure_writable_dir
 
+    if args.torque_nm is not None:
+        _torques(args.torque_nm)  # bad torques are refused before any work
     design = load_design(args.design)
     drive = build_drive(design)
     imp = Imperfections.from_spec(design.imperfections)
+    if args.torque_nm is not None:
+        from ..design.load import require_bearing
+
+        require_bearing(design)  # ... and a design the elastic model cannot build
     if args.plot:
         ensure_writable_dir(Path(args.plot).parent if str(Path(args.plot).parent) else Path("."))
     if args.json:
@@ -66,6 +72,9 @@ def cmd_ke(args) -> int:
               "errors must stay well below the overlap for the linear model (docs/models.md 6.2) - under load use the elastic model")
     sc = out["shortcuts"]
     print(f"  shortcuts that hold: mesh period {sc['mesh_period']}, identical waves {sc['identical_waves']}, mirror {sc['mirror_symmetry']} ({sc['why']})")
+    loaded = []
+    if args.torque_nm is not None:
+        loaded = _loaded(args, drive, imp, res, tab, out)
     scan = None
     if args.optimize_install_angle:
         best, best_pp, grid, pp = K.optimize_install_angle(tab, imp, "rigid")
@@ -88,6 +97,12 @@ def cmd_ke(args) -> int:
             stem = Path(args.plot)
             Path(batch.temp_path(stem.with_name(stem.name + "_ke.png"))).write_bytes(
                 ke_png(f"{d.name}: kinematic error, no load", res, orders, amp, expected, intr))
+            if loaded:
+                from ..export.ke_figures import ke_load_png
+
+                Path(batch.temp_path(stem.with_name(stem.name + "_ke_load.png"))).write_bytes(
+                    ke_load_png(f"{d.name}: kinematic error under load (elastic model at whole mesh periods) and at no load",
+                                res, loaded))
             if scan is not None:
                 Path(batch.temp_path(stem.with_name(stem.name + "_install.png"))).write_bytes(
                     install_png(f"{d.name}: largest KE against installation angle", scan[0], scan[1], scan[2], scan[3], scan[0], scan[4]))
@@ -104,6 +119,47 @@ def cmd_ke(args) -> int:
     return EXIT_OK
 
 
+def _torques(text: str) -> list:
+    from ..errors import DesignError
+    from .load import torque_levels
+
+    torques = torque_levels(text)
+    if any(t <= 0 for t in torques):
+        raise DesignError("--torque-nm", "the loaded KE needs torques > 0 N m (no load is the KE without the flag)")
+    return torques
+
+
+def _loaded(args, drive, imp, res, tab, out: dict) -> list:
+    """The loaded KE at each ``--torque-nm`` (elastic model, docs/models.md 6.3): printed, added to ``out``, returned."""
+    from ..accuracy.ke_load import loaded_ke
+    from ..deformation.elastic import build_model
+    from .common import Progress, want_progress
+
+    torques = _torques(args.torque_nm)
+    model = build_model(drive)  # a design without [bearing] data: a one-line DesignError naming it
+    bar = Progress(want_progress(False))
+    loaded = []
+    out["loaded"] = []
+    for T in torques:
+        bar.start(f"{T:g} N m")
+        L = loaded_ke(drive, imp, T, samples=args.load_samples, model=model, progress=lambda i, n: bar.set(i / n, f"{T:g} N m"))
+        bar.close()
+        idx = L.periods * tab.N
+        nl = res.ke[idx] - res.ke[idx[0]]
+        nl_pp = float(nl.max() - nl.min())
+        loaded.append(L)
+        out["loaded"].append({"torque_nm": T, "ke_pp_arcsec": round(L.ke_pp * _AS, 4), "samples": int(len(L.ke)),
+                              "no_load_ke_pp_at_samples_arcsec": round(nl_pp * _AS, 4),
+                              "mean_wind_up_arcsec": round(L.wind_up * _AS, 3),
+                              "teeth_in_contact": [int(L.teeth_in_contact.min()), int(L.teeth_in_contact.max())],
+                              "seconds": round(L.seconds, 3)})
+        print(f"  under {T:g} N m (elastic model at {len(L.ke)} whole mesh periods over the revolution): largest KE "
+              f"{L.ke_pp * _AS:.2f} arcsec against {nl_pp * _AS:.2f} at no load at the same angles; wind-up {L.wind_up * _AS:.1f} arcsec, "
+              f"{L.teeth_in_contact.min()}-{L.teeth_in_contact.max()} tooth contacts")
+    print("  under load NOT CHECKED: the KE within a mesh period (the elastic model has states at whole mesh periods only)")
+    return loaded
+
+
 def _per_mesh(text: str) -> int:
     import argparse
 
@@ -113,6 +169,18 @@ def _per_mesh(text: str) -> int:
         raise argparse.ArgumentTypeError(f"'{text}' is not a whole number") from None
     if not 1 <= n <= 512:
         raise argparse.ArgumentTypeError(f"must be 1..512 generator angles per mesh period, got {n}")
+    return n
+
+
+def _load_samples(text: str) -> int:
+    import argparse
+
+    try:
+        n = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"'{text}' is not a whole number") from None
+    if not 2 <= n <= 100_000:
+        raise argparse.ArgumentTypeError(f"must be 2..100000 load states, got {n}")
     return n
 
 
@@ -128,4 +196,8 @@ def register(sub) -> None:
     k.add_argument("--json", help="write the figures as JSON here")
     k.add_argument("--plot", help="PNG path stem: writes STEM_ke.png, STEM_flank.png (and STEM_install.png)")
     k.add_argument("--per-mesh", type=_per_mesh, default=16, help="generator angles per mesh period (default 16)")
+    k.add_argument("--torque-nm", metavar="T", help="also the KE under these output torques (a value, a list or START:STOP:STEP, "
+                   "N m > 0) from the elastic model (needs [bearing]); STEM_ke_load.png with --plot")
+    k.add_argument("--load-samples", type=_load_samples, default=None, metavar="N",
+                   help="load states over the flexspline revolution, at whole mesh periods (default 4 |u_hg| + 4)")
     k.set_defaults(func=cmd_ke)

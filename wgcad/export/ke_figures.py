@@ -7,7 +7,7 @@ import numpy as np
 
 from .mpl import png_bytes, pyplot as _plt
 
-__all__ = ["ke_png", "install_png", "flank_png"]
+__all__ = ["ke_png", "install_png", "flank_png", "ke_load_png"]
 
 _AS = 180.0 / np.pi * 3600.0
 
@@ -90,4 +90,28 @@ def flank_png(title: str, header, rows) -> bytes:
         a.grid(alpha=0.3)
         a.legend(fontsize=8)
     fig.suptitle(title)
+    return _png(fig, plt)
+
+
+def ke_load_png(title: str, res, loaded: list) -> bytes:
+    """No-load KE over the revolution with the loaded KE at its whole mesh periods, one curve per torque (arcsec against generator turns)."""
+    plt = _plt()
+    fig, ax = plt.subplots(1, 1, figsize=(11, 5.2), dpi=150)
+    turns = np.abs(res.phi_h) / (2 * np.pi)
+    ax.plot(turns, res.ke * _AS, lw=0.4, color="0.55", label=f"no load, every angle: {res.ke_pp * _AS:.2f}'' peak to peak")
+    if loaded:
+        L = loaded[0]
+        idx = L.periods * res.n_per_mesh
+        nl = (res.ke[idx] - res.ke[idx[0]]) * _AS
+        ax.plot(np.abs(L.phi_h) / (2 * np.pi), nl, "s", ms=3.5, mfc="none", color="k",
+                label=f"no load at the loaded samples' angles: {nl.max() - nl.min():.2f}'' peak to peak")
+    for i, L in enumerate(loaded):
+        t = np.abs(L.phi_h) / (2 * np.pi)
+        ax.plot(t, L.ke * _AS, "o", ms=2.5, color=f"C{i}",
+                label=f"{L.torque_nm:g} N m: {L.ke_pp * _AS:.2f}'' peak to peak at {len(L.ke)} whole mesh periods")
+    ax.set_xlabel("generator turns (one flexspline revolution)")
+    ax.set_ylabel("KE, arcsec (each curve from its first sample)")
+    ax.legend(fontsize=8.5, loc="upper left", bbox_to_anchor=(1.01, 1.0), borderaxespad=0.0)
+    ax.grid(alpha=0.3)
+    ax.set_title(title + "\n(samples at whole mesh periods: a stroboscopic view of the cam-order content)", fontsize=10)
     return _png(fig, plt)

@@ -126,9 +126,12 @@ def _rim(model: ElasticModel, loads: np.ndarray, rigid) -> tuple:
     return w, v, th, el
 
 
-def _poses(model: ElasticModel, loads: np.ndarray, rigid):
+def _poses(model: ElasticModel, loads: np.ndarray, rigid, tooth_errors=None):
     """Poses of every tooth of every section (flattened ``section * z_g + tooth``), their neutral-line origins and
-    the elastic field, plus the indices of the teeth whose tips reach within RADIAL_MARGIN of the rigid tips."""
+    the elastic field, plus the indices of the teeth whose tips reach within RADIAL_MARGIN of the rigid tips.
+
+    ``tooth_errors``: ``(turn (S z_g,), move (S z_g, 2))``, each tooth's pose turned about the axis by ``turn``
+    then moved by ``move`` (relative to the rigid teeth: an imperfect drive's errors, :func:`solve_load`)."""
     d = model.drive
     z_g = model.tables.z_g
     S = len(model.zs)
@@ -139,6 +142,10 @@ def _poses(model: ElasticModel, loads: np.ndarray, rigid):
     c, sn = np.cos(phi).ravel(), np.sin(phi).ravel()
     w, v = w.ravel(), v.ravel()
     origin = np.stack([(d.r_m + w) * c - v * sn, (d.r_m + w) * sn + v * c], axis=-1)
+    if tooth_errors is not None:
+        rot = rot + tooth_errors[0]
+        shift = _displaced(shift, tooth_errors)
+        origin = _displaced(origin, tooth_errors)
     # outermost tip radius of each placed tooth: |R p + s|^2 = |p|^2 + |s|^2 + 2 p . R^T s, one small product
     tip = model.scene.flex_tip_local
     cr, sr = np.cos(rot), np.sin(rot)
@@ -209,7 +216,7 @@ def _dense_loads(n: int, idx, F, f, b) -> np.ndarray:
 
 
 def solve_load(model: ElasticModel, torque_nm: float, cam_offset_um: float = 0.0, cam_offset_deg: float = 0.0,
-               tol: float = POSITION_TOL, warm: "LoadState | None" = None) -> LoadState:
+               tol: float = POSITION_TOL, warm: "LoadState | None" = None, tooth_errors=None) -> LoadState:
     """Solve the drive under output torque ``torque_nm`` with the cam axis offset by ``cam_offset_um`` at ``cam_offset_deg``.
 
     Generator at angle 0 (major axis on +x, tooth 0 on it, rigid gear fixed).
@@ -228,6 +235,12 @@ def solve_load(model: ElasticModel, torque_nm: float, cam_offset_um: float = 0.0
         a bearing that cannot carry the load.
     ContactSolveError
         No convergence (never a silent return).
+
+    ``tooth_errors`` places the flexspline teeth of an imperfect drive
+    relative to the rigid teeth: ``(turn, move)`` per tooth of every section
+    (flattened ``section * z_g + tooth``), rad and mm
+    (:mod:`wgcad.accuracy.ke_load` builds them from the run-out and
+    eccentricities); the cam offset stays the physical input above.
     """
     if not (np.isfinite(torque_nm) and torque_nm >= 0):
         raise DesignError("torque_nm", f"must be >= 0 N m, got {torque_nm:g}")
@@ -271,7 +284,7 @@ def solve_load(model: ElasticModel, torque_nm: float, cam_offset_um: float = 0.0
         pairs = model.cache["nominal_pairs"].copy()
     for it in range(_MAX_LINEARISATIONS):
         t0 = time.perf_counter()
-        rot, shift, origin, el, cand = _poses(model, loads, rigid)
+        rot, shift, origin, el, cand = _poses(model, loads, rigid, tooth_errors)
         if cand.size == 0 and torque_nm > 0:
             raise DesignError("generator.w0_coef", "the flexspline teeth never reach the rigid teeth (no tooth tip within "
                               f"{RADIAL_MARGIN:g} mm of the rigid tip circle): no torque can be carried")
@@ -309,7 +322,7 @@ def solve_load(model: ElasticModel, torque_nm: float, cam_offset_um: float = 0.0
         F_t_new[keys] = F[Z:]
         # convergence: the largest move of an engaging tooth from the linearisation's poses to the solution's
         # (the fixed-point residual itself, from the tables: no engine call)
-        o_new = _origins(model, loads_new, sol.a)
+        o_new = _origins(model, loads_new, sol.a, tooth_errors)
         k2 = keys // 2
         d = np.hypot(*(o_new[k2] - origin[k2]).T)
         change = max(float(d.max()) if d.size else 0.0, abs(float(sol.a[2] - rigid[2])) * model.drive.r_m)
@@ -354,7 +367,7 @@ def solve_load(model: ElasticModel, torque_nm: float, cam_offset_um: float = 0.0
     model.bearing.check(F_ball)
     t0 = time.perf_counter()
     pairs2 = pairs.copy()
-    keys2, gaps2, exact2 = pairs2.report(*_poses(model, loads, rigid), rigid)
+    keys2, gaps2, exact2 = pairs2.report(*_poses(model, loads, rigid, tooth_errors), rigid)
     t_geo += time.perf_counter() - t0
     psi, law_loads = _merge_loads(tab.angles, loads)
     laws = [LoadedLaw(centre, model.section_law(i), model.ring, psi, law_loads, model.scales[i], tuple(rigid))
@@ -413,13 +426,21 @@ def solve_load(model: ElasticModel, torque_nm: float, cam_offset_um: float = 0.0
     return LoadState(model, float(torque_nm), e, laws, rigid, contacts, residuals, {"geometry": t_geo, "solver": t_sol}, pairs2)
 
 
-def _origins(model: ElasticModel, loads: np.ndarray, rigid) -> np.ndarray:
+def _displaced(points: np.ndarray, tooth_errors) -> np.ndarray:
+    """Points ``(S z_g, 2)`` of each tooth turned about the axis by ``turn`` and moved by ``move`` (``tooth_errors``)."""
+    turn, move = tooth_errors
+    ct, st = np.cos(turn), np.sin(turn)
+    return np.stack([ct * points[:, 0] - st * points[:, 1], st * points[:, 0] + ct * points[:, 1]], axis=-1) + move
+
+
+def _origins(model: ElasticModel, loads: np.ndarray, rigid, tooth_errors=None) -> np.ndarray:
     """Neutral-line origins ``(S z_g, 2)`` of every tooth of every section (flattened as in :func:`_poses`)."""
     w, v, _, _ = _rim(model, loads, rigid)
     phi = model.tables.angles[: model.tables.z_g]
     c, sn = np.cos(phi), np.sin(phi)
     r = model.drive.r_m + w
-    return np.stack([r * c - v * sn, r * sn + v * c], axis=-1).reshape(-1, 2)
+    out = np.stack([r * c - v * sn, r * sn + v * c], axis=-1).reshape(-1, 2)
+    return out if tooth_errors is None else _displaced(out, tooth_errors)
 
 
 class _Anderson:
