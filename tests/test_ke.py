@@ -289,3 +289,32 @@ def test_pruned_table_gives_the_exhaustive_ke(name, scale):
         assert np.abs(x[fin] - y[fin]).max() * AS < 1e-3
     ang = np.linspace(0.0, 2 * math.pi, 8, endpoint=False)
     assert np.abs(K.install_angle_scan(fast, imp, ang) - K.install_angle_scan(ref, imp, ang)).max() * AS < 1e-3
+
+
+@pytest.mark.parametrize("name", ["d2_imperfect", "d4_discrete"])
+def test_lanes_drop_only_contacts_that_are_never_first(name, monkeypatch):
+    # _lanes keeps per lattice class the candidates that can be first, from a bound that compares each contact
+    # with its group's best through both contacts' sensitivities (second features included). The KE with
+    # every contact of the class as a candidate must be the same, sample by sample.
+    drive = build_drive(load_design(TEMPLATES / f"{name}.toml"))
+    imp = (Imperfections.from_spec(drive.design.imperfections) if name == "d2_imperfect" else
+           Imperfections(flex_runout=0.02, rigid_runout=0.02, cam_cam=0.01, cam_fixed=0.008, rigid_ecc=0.004,
+                         rigid_ecc_phase=2.2, flex_ecc=0.003, flex_ecc_phase=1.0))
+    tab = K.contact_table(drive, imp)
+    I = 4096
+    a = K.kinematic_error(drive, imp, table=tab, samples=I)
+
+    def every(tab_, side, imp_, slack=1.05):
+        S = tab_.sides[side]
+        cls = [np.nonzero(S["m"] % tab_.N == c)[0] for c in (-tab_.sigma * np.arange(tab_.N)) % tab_.N]
+        out = np.full((tab_.N, max(len(x) for x in cls)), -1, dtype=int)
+        for r, x in enumerate(cls):
+            out[r, : len(x)] = x
+        return out
+
+    pruned = (K._lanes(tab, tab.side_w, imp) >= 0).sum()
+    assert pruned < 0.5 * (every(tab, tab.side_w, imp) >= 0).sum()  # the lanes do drop most contacts
+    monkeypatch.setattr(K, "_lanes", every)
+    b = K.kinematic_error(drive, imp, table=tab, samples=I)
+    np.testing.assert_array_equal(a.delta_w, b.delta_w)
+    np.testing.assert_array_equal(a.delta_n, b.delta_n)
