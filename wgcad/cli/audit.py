@@ -288,7 +288,8 @@ def register(sub) -> None:
                     "Prints a summary; --json - puts the JSON on standard output and the summary on standard error "
                     "(--quiet drops it), so the audit can be piped. A design's [imperfections] are honoured: every tooth is "
                     "posed with its run-out, eccentricity and cam offset (the mesh-period, wave and mirror shortcuts do not "
-                    "hold then, and the entry gap and pinch are not computed).", width=79),
+                    "hold then; the entry gap and pinch are those of every passage of a tooth through the entry; --turns "
+                    "sweeps more of the error cycle).", width=79),
         epilog=EPILOG, formatter_class=argparse.RawDescriptionHelpFormatter)
     a.add_argument("design", help="design file (TOML), e.g. templates/d1_involute.toml")
     grp = a.add_mutually_exclusive_group()
