@@ -7,7 +7,7 @@ import os
 import sys
 from pathlib import Path
 
-from .common import EPILOG, EXIT_INTERFERENCE, EXIT_OK, add_memory_flag, angle_count, positive_float
+from .common import EPILOG, EXIT_INTERFERENCE, EXIT_OK, add_memory_flag, angle_count, positive_float, whole_number
 
 __all__ = ["register", "cmd_audit"]
 
@@ -262,20 +262,6 @@ def _audit_pngs(drive, result):
 
 
 
-def _turns(text: str):
-    import argparse
-
-    if text == "full":
-        return None
-    try:
-        n = int(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"'{text}' is neither a whole number nor 'full'") from None
-    if not 1 <= n <= 10_000:
-        raise argparse.ArgumentTypeError(f"must be 1..10000 generator turns or 'full', got {n}")
-    return n
-
-
 def register(sub) -> None:
     """Add the subcommand to the ``wgcad`` parser's subparsers."""
     import argparse
@@ -295,7 +281,7 @@ def register(sub) -> None:
     grp = a.add_mutually_exclusive_group()
     grp.add_argument("--angles", type=angle_count, metavar="N", help="N generator angles over a full revolution")
     grp.add_argument("--step-deg", type=positive_float(0.0, 90.0, "deg"), default=0.5, help="generator-angle step, deg (default 0.5)")
-    a.add_argument("--turns", type=_turns, default=1, metavar="N|full",
+    a.add_argument("--turns", type=whole_number(1, 10_000, "generator turns", {"full": None}), default=1, metavar="N|full",
                    help="generator turns swept for an imperfect drive ([imperfections]), or 'full' for the whole cycle "
                         "(the numerator of |u_hg|: 100 for 200/202 teeth; default 1)")
     a.add_argument("--sections", type=int, default=3, metavar="N",

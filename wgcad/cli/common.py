@@ -136,14 +136,25 @@ def positive_float(lo: float, hi: float, unit: str):
     return conv
 
 
-def angle_count(text: str) -> int:
-    try:
-        n = int(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"'{text}' is not a whole number") from None
-    if not 4 <= n <= 3_600_000:
-        raise argparse.ArgumentTypeError(f"must be 4..3600000 angles per revolution, got {n}")
-    return n
+def whole_number(lo: int, hi: int, what: str, words: dict | None = None):
+    """An argparse type: a whole number in ``lo..hi`` of ``what``, or one of ``words`` (word -> value)."""
+    def conv(text: str):
+        if words and text in words:
+            return words[text]
+        try:
+            n = int(text)
+        except ValueError:
+            alt = "".join(f" nor '{w}'" for w in words) if words else ""
+            raise argparse.ArgumentTypeError(f"'{text}' is {'neither' if words else 'not'} a whole number{alt}") from None
+        if not lo <= n <= hi:
+            alt = "".join(f" or '{w}'" for w in words) if words else ""
+            raise argparse.ArgumentTypeError(f"must be {lo}..{hi} {what}{alt}, got {n}")
+        return n
+
+    return conv
+
+
+angle_count = whole_number(4, 3_600_000, "angles per revolution")
 
 
 def add_memory_flag(parser) -> None:

@@ -5,7 +5,7 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
-from .common import EPILOG, EXIT_OK
+from .common import EPILOG, EXIT_OK, whole_number
 
 __all__ = ["register", "cmd_ke"]
 
@@ -61,7 +61,7 @@ def cmd_ke(args) -> int:
     print(f"{d.name}: no-load KE over one flexspline revolution ({res.turns:g} generator turns, {len(res.ke)} angles)")
     print(f"  engagement: {res.engagement}; lost motion {out['lost_motion_arcsec']['min']:.1f} .. {out['lost_motion_arcsec']['max']:.1f} arcsec")
     print(f"  largest KE (peak to peak): {out['ke_pp_arcsec']:.2f} arcsec; perfect parts: {out['intrinsic_ke_pp_arcsec']:.3f} arcsec")
-    print(f"  strongest orders: " + ", ".join(f"{s['order']:g} ({s['amplitude_arcsec']:.2f}'')" for s in out["spectrum_top"][:4]))
+    print("  strongest orders: " + ", ".join(f"{s['order']:g} ({s['amplitude_arcsec']:.2f}'')" for s in out["spectrum_top"][:4]))
     out["deep_overlap_fraction"] = round(res.deep_overlap_fraction, 4)
     if res.deep_overlap_fraction > 0:
         print(f"  WARNING: at {100 * res.deep_overlap_fraction:.1f} % of the angles the first contact is a pair that overlaps "
@@ -160,30 +160,6 @@ def _loaded(args, drive, imp, res, tab, out: dict) -> list:
     return loaded
 
 
-def _per_mesh(text: str) -> int:
-    import argparse
-
-    try:
-        n = int(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"'{text}' is not a whole number") from None
-    if not 1 <= n <= 512:
-        raise argparse.ArgumentTypeError(f"must be 1..512 generator angles per mesh period, got {n}")
-    return n
-
-
-def _load_samples(text: str) -> int:
-    import argparse
-
-    try:
-        n = int(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"'{text}' is not a whole number") from None
-    if not 2 <= n <= 100_000:
-        raise argparse.ArgumentTypeError(f"must be 2..100000 load states, got {n}")
-    return n
-
-
 def register(sub) -> None:
     """Add the subcommand to the ``wgcad`` parser's subparsers."""
     import argparse
@@ -195,9 +171,9 @@ def register(sub) -> None:
                    help="scan the rigid gear's installation angle (36 angles, then finer) and the flexspline's position")
     k.add_argument("--json", help="write the figures as JSON here")
     k.add_argument("--plot", help="PNG path stem: writes STEM_ke.png, STEM_flank.png (and STEM_install.png)")
-    k.add_argument("--per-mesh", type=_per_mesh, default=16, help="generator angles per mesh period (default 16)")
+    k.add_argument("--per-mesh", type=whole_number(1, 512, "generator angles per mesh period"), default=16, help="generator angles per mesh period (default 16)")
     k.add_argument("--torque-nm", metavar="T", help="also the KE under these output torques (a value, a list or START:STOP:STEP, "
                    "N m > 0) from the elastic model (needs [bearing]); STEM_ke_load.png with --plot")
-    k.add_argument("--load-samples", type=_load_samples, default=None, metavar="N",
+    k.add_argument("--load-samples", type=whole_number(2, 100_000, "load states"), default=None, metavar="N",
                    help="load states over the flexspline revolution, at whole mesh periods (default 4 |u_hg| + 4)")
     k.set_defaults(func=cmd_ke)
