@@ -34,8 +34,17 @@ __all__ = ["passages", "imperfect_entry", "CROSS_WINDOW"]
 #: 8 deg. A radial error moves the crossing by (error) / (dw/dphi); at D1's crossing (70 deg) dw/dphi is
 #: ~1.4 mm/rad, so 0.1 mm of error moves it ~4 deg
 CROSS_WINDOW = np.deg2rad(8.0)
-_CROSS_GRID = 65  # 0.25 deg steps over the window
+_CROSS_GRID = 33  # 0.5 deg steps over the window (then regula falsi in the bracket)
 _FALSI = 40  # regula falsi steps (Illinois): to 1e-12 rad of tooth angle or the iteration limit
+#: passages handled at once: their crossing grids (65 poses each) and pinch windows stay a few MB whatever the
+#: number of turns swept (the whole 100-turn cycle of D1 has 121,200 passages)
+_CHUNK = 1024
+#: pinch windows searched at once (lowest bounds first)
+_PINCH_BATCH = 64
+#: passages refined on the exact curves at once (lowest polygon figures first)
+_REFINE_BATCH = 16
+#: more candidates than this are first sorted out on polygons 8 times finer (as wgcad.clearance.imperfect)
+_FINE_ABOVE = 48
 #: half-width (rad) of the window around a passage's moved perfect pinch: two pinch grid steps
 PINCH_HALF = 2.0 * PINCH_STEP
 
@@ -142,10 +151,12 @@ def imperfect_entry(drive, imp, isc, scene, perfect_gaps, perfect_pinch, angles,
         if not np.isfinite(g0):
             continue
         ph0, k = passages(scene, p0, lo, hi)
-        ph = _crossings(drive, imp, isc, ph0, k, z, sgn)
+        ph = np.concatenate([_crossings(drive, imp, isc, ph0[a : a + _CHUNK], k[a : a + _CHUNK], z, sgn)
+                             for a in range(0, len(ph0), _CHUNK)] or [np.zeros(0)])
         ok = np.isfinite(ph)
-        rot, shift = _poses(drive, imp, isc, ph[ok], k[ok], z)
-        v = clearance_at_poses(isc, rot, shift)["min"] if ok.any() else np.zeros(0)
+        po, ko = ph[ok], k[ok]
+        v = np.concatenate([clearance_at_poses(isc, *_poses(drive, imp, isc, po[a : a + _CHUNK], ko[a : a + _CHUNK], z))["min"]
+                            for a in range(0, len(po), _CHUNK)] or [np.zeros(0)])
         rows.append((v, ph[ok], k[ok], np.full(int(ok.sum()), si)))
         shifts[si] = (ph0, k, ph - ph0)  # the crossing's shift in generator angle, NaN where none
         out["passages"] += int(len(ph0))
@@ -156,14 +167,42 @@ def imperfect_entry(drive, imp, isc, scene, perfect_gaps, perfect_pinch, angles,
     out["all"] = {"phi_h": ph, "gap": v, "section": si}  # every passage's polygon figure (for the picture)
     best = int(np.argmin(v))
     if refine:
-        near = np.nonzero(v <= v[best] + 2.0 * isc.chord_gap)[0]
-        vals = np.empty(len(near))
-        for s in np.unique(si[near]):
-            sel = near[si[near] == s]
-            rot, shift = _poses(drive, imp, isc, ph[sel], k[sel], perfect_gaps[s][1])
-            vals[np.searchsorted(near, sel)] = refine_min(isc, rot, shift, clearance_at_poses(isc, rot, shift))["min"]
-        j = int(np.argmin(vals))
-        best, gap = int(near[j]), float(vals[j])
+        # a passage's exact gap is within the polygons' chord_gap of its polygon one: refined lowest first, in
+        # batches, until the next polygon figure less that margin is above the best exact one
+        order = np.argsort(v, kind="stable")
+        order = order[v[order] - isc.chord_gap <= v[order[0]] + isc.chord_gap]  # those that can hold the minimum
+        vr, margin = v, isc.chord_gap
+        if len(order) > _FINE_ABOVE:
+            # many alike (the same cam phase every turn): sorted out first on polygons 8 times finer, as the
+            # clearance audit does
+            from ..drive import build_drive
+            from .imperfect import ImperfectScene
+            from .scene import Scene
+
+            fine = ImperfectScene.from_scene(Scene(build_drive(drive.design, tol=drive.tol / 8)), imp)
+            vf = np.empty(len(order))
+            for s in np.unique(si[order]):
+                m = np.nonzero(si[order] == s)[0]
+                for a in range(0, len(m), _CHUNK):
+                    mm = m[a : a + _CHUNK]
+                    rot, shift = _poses(drive, imp, isc, ph[order[mm]], k[order[mm]], perfect_gaps[s][1])
+                    vf[mm] = clearance_at_poses(fine, rot, shift)["min"]
+            vr, margin = np.full(len(v), np.inf), fine.chord_gap
+            vr[order] = vf
+            order = order[np.argsort(vf, kind="stable")]
+            order = order[vr[order] - margin <= vr[order[0]] + margin]
+        gap, at = np.inf, 0
+        while at < len(order) and vr[order[at]] - margin < gap:
+            b = order[at : at + _REFINE_BATCH]
+            b = b[vr[b] - margin < gap]
+            for s in np.unique(si[b]):
+                sel = b[si[b] == s]
+                rot, shift = _poses(drive, imp, isc, ph[sel], k[sel], perfect_gaps[s][1])
+                vals = refine_min(isc, rot, shift, clearance_at_poses(isc, rot, shift))["min"]
+                j = int(np.argmin(vals))
+                if vals[j] < gap:
+                    gap, best = float(vals[j]), int(sel[j])
+            at += _REFINE_BATCH
     else:
         gap = float(v[best])
     out.update(gap=gap, gap_phi_h=float(ph[best]), gap_tooth=int(k[best]), gap_z=perfect_gaps[si[best]][1])
@@ -193,21 +232,26 @@ def _pinch(drive, imp, isc, scene, perfect_gaps, perfect_pinch, shifts, refine):
         # the passage's generator angle at the perfect pinch's tooth angle, moved by its crossing shift
         centre = ph0[ok] + (p_pin - p0) / c + dph[ok]
         G = len(offs)
-        phs = centre[:, None] + offs[None, :] / c
-        rot, shift = _poses(drive, imp, isc, phs.ravel(), np.repeat(k[ok], G), z)
-        v = clearance_at_poses(isc, rot, shift)["min"].reshape(-1, G)
-        cand.append((v.min(axis=1), v.min(axis=1) - 0.5 * speed[si] * (offs[1] - offs[0]) / abs(c), centre, k[ok], si))
+        ko = k[ok]
+        v = np.empty((len(centre), G))
+        for a in range(0, len(centre), _CHUNK):
+            phs = centre[a : a + _CHUNK, None] + offs[None, :] / c
+            rot, shift = _poses(drive, imp, isc, phs.ravel(), np.repeat(ko[a : a + _CHUNK], G), z)
+            v[a : a + _CHUNK] = clearance_at_poses(isc, rot, shift)["min"].reshape(-1, G)
+        cand.append((v.min(axis=1), v.min(axis=1) - 0.5 * speed[si] * (offs[1] - offs[0]) / abs(c), centre, ko, si))
     best = min(float(x[0].min()) for x in cand if len(x[0]))
     # passages whose window can hold a value below the best sampled one (Lipschitz between grid points)
-    lo_, hi_, kk, ss = [], [], [], []
+    lo_, hi_, kk, ss, lbs = [], [], [], [], []
     for vmin, lb, centre, k, si in cand:
         sel = np.nonzero(lb < best + 2.0 * isc.chord_gap)[0]
-        for i in sel:
-            lo_.append(centre[i] - PINCH_HALF / abs(c))
-            hi_.append(centre[i] + PINCH_HALF / abs(c))
-            kk.append(int(k[i]))
-            ss.append(si)
-    lo_, hi_, kk, ss = np.array(lo_), np.array(hi_), np.array(kk), np.array(ss)
+        lo_.append(centre[sel] - PINCH_HALF / abs(c))
+        hi_.append(centre[sel] + PINCH_HALF / abs(c))
+        kk.append(k[sel])
+        ss.append(np.full(len(sel), si))
+        lbs.append(lb[sel])
+    lo_, hi_, kk, ss, lbs = (np.concatenate(x) for x in (lo_, hi_, kk, ss, lbs))
+    o = np.argsort(lbs, kind="stable")  # lowest bounds first: they set the bar for the rest
+    lo_, hi_, kk, ss, lbs = lo_[o], hi_[o], kk[o], ss[o], lbs[o]
 
     def f(x, idx):
         vals = np.empty(len(x))
@@ -218,7 +262,17 @@ def _pinch(drive, imp, isc, scene, perfect_gaps, perfect_pinch, shifts, refine):
         return vals
 
     V = np.array([speed[s] for s in ss])
-    val, x, i = lipschitz_min(f, lo_, hi_, V, 0.1 * drive.tol, n0=9)
+    tol = 0.1 * drive.tol
+    val, x, i = np.inf, np.nan, -1
+    at = 0
+    # windows in batches, lowest bounds first; a window whose bound is above the best found cannot hold it
+    while at < len(lo_) and lbs[at] < val - tol:
+        b = np.arange(at, min(len(lo_), at + _PINCH_BATCH))
+        b = b[lbs[b] < val - tol]
+        v_b, x_b, j = lipschitz_min(lambda x_, idx: f(x_, b[idx]), lo_[b], hi_[b], V[b], tol, n0=9)
+        if v_b < val:
+            val, x, i = v_b, x_b, int(b[j])
+        at += _PINCH_BATCH
     if refine:
         z = perfect_gaps[ss[i]][1]
         w = 0.5 * (hi_[i] - lo_[i])
