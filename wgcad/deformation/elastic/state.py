@@ -10,6 +10,7 @@ import numpy as np
 from wgcad.errors import DesignError
 from wgcad.placement import pose_from_displacements
 
+from .anderson import Anderson
 from .loaded import LoadedLaw
 from .model import ElasticModel
 from .solve import ContactSolveError, solve_contact_qp
@@ -34,10 +35,6 @@ _MAX_LINEARISATIONS = 100
 _OMEGA_MIN = 1.0 / 64.0
 #: Solutions the re-linearisation's Anderson acceleration combines (0: plain fixed-point iteration).
 ANDERSON_DEPTH = 3
-#: The acceleration starts once the teeth move less than this per pass, mm: before, contact sets change.
-ANDERSON_START = 0.02
-_LEVER = 2.0  # mm, a tooth's lever: weighs ring couples against forces in the acceleration's metric
-_KREF = 1e5  # N/mm, a contact stiffness: weighs rim motions against forces there
 #: A cold start's first pass (nominal geometry) solves the contact problem up to this many times, the Hertz
 #: contacts linearised again about each solution's forces (no engine call: the poses have not moved).
 #: Linearised about no load the balls (P ~ delta^(3/2)) are far too soft: one solve moved the teeth three
@@ -267,7 +264,7 @@ def solve_load(model: ElasticModel, torque_nm: float, cam_offset_um: float = 0.0
     t_geo = t_sol = 0.0
     pivots = 0
     omega, last_change = 1.0, np.inf
-    acc = _Anderson(model.drive.r_m, ANDERSON_DEPTH)
+    acc = Anderson(model.drive.r_m, ANDERSON_DEPTH)
     settled, relaxed = 0, False
     change = 0.0
     cold = warm is None
@@ -293,7 +290,7 @@ def solve_load(model: ElasticModel, torque_nm: float, cam_offset_um: float = 0.0
         idx, b, f, A, q, s_c = _assemble(model, pairs, keys, el, rigid, e, F_ball, F_teeth_prev[keys])
         M = Compliance(tab, idx, b * f[:, None], s_c)
         active = np.concatenate([F_ball > 0, prev_active[keys]])
-        F_h = None
+        F_h = F = None  # F: the solution of the pass (set by the first solve below)
         for h in range(_HERTZ_START if (it == 0 and cold) else 1):
             if h:
                 if F_h is not None and np.abs(F - F_h).max() <= _HERTZ_TOL * F.max():
@@ -441,54 +438,6 @@ def _origins(model: ElasticModel, loads: np.ndarray, rigid, tooth_errors=None) -
     r = model.drive.r_m + w
     out = np.stack([r * c - v * sn, r * sn + v * c], axis=-1).reshape(-1, 2)
     return out if tooth_errors is None else _displaced(out, tooth_errors)
-
-
-class _Anderson:
-    """Anderson acceleration of the re-linearisation (type II, Walker & Ni 2011) on the ring loads and rim motion.
-
-    The next linearisation point is the affine combination of the last
-    solutions that best cancels their residuals (solution minus
-    linearisation point), so it balances the torque as each of them does.
-    Forces weigh in N, couples per ``_LEVER`` mm, motions times ``_KREF``
-    N/mm (a contact stiffness): the least-squares metric only. The history is
-    dropped when a step does not lower the residual (a change of contact set).
-    """
-
-    def __init__(self, r_m: float, depth: int):
-        self.r_m, self.depth = r_m, depth
-        self.reset()
-
-    def reset(self):
-        self.X, self.G, self.last = [], [], np.inf
-
-    def _vec(self, loads, rigid):
-        return np.concatenate([loads[:, :2].ravel(), loads[:, 2] / _LEVER,
-                               _KREF * np.array([rigid[0], rigid[1], rigid[2] * self.r_m])])
-
-    def step(self, loads, rigid, loads_new, rigid_new, change):
-        if self.depth == 0:
-            return loads_new, np.array(rigid_new, dtype=float)
-        if change > self.last or change > ANDERSON_START:
-            self.reset()
-            if change > ANDERSON_START:
-                return loads_new, np.array(rigid_new, dtype=float)
-        self.last = change
-        self.X.append(self._vec(loads, rigid))
-        self.G.append(self._vec(loads_new, rigid_new))
-        self.X, self.G = self.X[-(self.depth + 1):], self.G[-(self.depth + 1):]
-        if len(self.X) < 2:
-            return loads_new, np.array(rigid_new, dtype=float)
-        R = [g - x for g, x in zip(self.G, self.X)]
-        dR = np.stack([R[i + 1] - R[i] for i in range(len(R) - 1)], axis=1)
-        dG = np.stack([self.G[i + 1] - self.G[i] for i in range(len(R) - 1)], axis=1)
-        gamma, *_ = np.linalg.lstsq(dR, R[-1], rcond=1e-10)
-        y = self.G[-1] - dG @ gamma
-        n = len(loads)
-        out = np.empty_like(loads)
-        out[:, 0], out[:, 1] = y[: 2 * n].reshape(n, 2).T
-        out[:, 2] = y[2 * n: 3 * n] * _LEVER
-        r = y[3 * n:] / _KREF
-        return out, np.array([r[0], r[1], r[2] / self.r_m])
 
 
 def _loads_on_table(tab, psi, loads) -> np.ndarray:
