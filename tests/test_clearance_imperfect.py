@@ -96,7 +96,9 @@ def test_zero_imperfections_give_the_perfect_audit(d1):
     assert got.interference == ref.interference
     # entry gap and pinch: every passage is the perfect one (the mesh period holds: one per section measured)
     assert abs(got.entry_gap - ref.entry_gap) <= REFINE_TOL
-    assert abs(got.findings["entry_pinch"].value - ref.findings["entry_pinch"].value) <= REFINE_TOL
+    for key in ("entry_crossing", "entry_pinch"):  # NaN where the drive has no pinch: NaN on both routes
+        a, b = got.findings[key].value, ref.findings[key].value
+        assert (np.isnan(a) and np.isnan(b)) or abs(a - b) <= REFINE_TOL, key
     assert got.entry["section_z_mm"] == ref.entry["section_z_mm"]
 
 
@@ -164,7 +166,7 @@ def test_audit_cli_honours_imperfections(tmp_path, capsys):
     for suffix in ("profile", "vs_angle", "tightest"):
         assert (tmp_path / f"pic_{suffix}.png").stat().st_size > 10_000
     text_out = capsys.readouterr().out
-    assert "imperfect parts" in text_out and "entry gap:" in text_out and "NOT CHECKED: entry gap" not in text_out
+    assert "imperfect parts" in text_out and "entry gap Delta" in text_out and "NOT CHECKED: entry gap" not in text_out
 
 
 def test_fixed_flexspline_keeps_the_perfect_audit_and_says_so(tmp_path):
@@ -309,8 +311,9 @@ def test_entry_gap_of_every_passage_against_a_dense_reference(d1):
 
     st = _settings(d1, 1.0)
     got = IM.audit_imperfect(d1, st, S4)
-    e = got.findings["entry_gap"]
+    e = got.findings["entry_crossing"]
     assert np.isfinite(e.value) and e.details["passages"] == 3 * len(passages(Scene(d1), 1.0, 0.0, 2 * np.pi)[0])
+    assert got.entry_gap <= e.value  # Delta: the crossing, or a pinch below it
     sc = Scene(d1)
     fine = build_drive(d1.design, tol=1e-6)
     rr, rs = rigid_poses(d1, S4)

@@ -40,7 +40,7 @@ BAD = [
     ("flexspline", "rim_thickness", "-1.4", "flexspline.rim_thickness", "must be > 0"),
     ("generator", "law", '"elliptic"', "generator.law", "must be one of"),
     ("generator", "beta_deg", "95.0", "generator.beta_deg", "(0, 90)"),
-    ("rigid", "fillet_coef", "0.3", "rigid.fillet_coef", "largest that fits"),
+    ("rigid", "fillet_coef", "1.0", "rigid.fillet_coef", "largest that fits"),
     ("tooth", "form", '"cycloid"', "tooth.form", "must be one of involute, cycloidal"),
     ("drive", "waves", "1", "drive.waves", "must be >= 2"),
     ("generator", "offset", "2.0", "generator.offset", "used only by the ellipse law"),

@@ -172,8 +172,8 @@ def test_internal_error_exit_3_one_line_no_traceback(tmp_path, capsys, monkeypat
 
 
 def test_interference_keeps_exit_1_and_bad_input_exit_2(capsys):
-    code, out, err = run(["audit", TEMPLATES / "d1_involute.toml", "--step-deg", "3", "--quiet"], capsys)
-    assert code == 1 and err == ""  # D1 as shipped interferes (the README's example of exit 1)
+    code, out, err = run(["audit", TEMPLATES / "d1_involute_nominal.toml", "--step-deg", "3", "--quiet"], capsys)
+    assert code == 1 and err == ""  # the teaching template's nominal teeth interfere (the README's example of exit 1)
 
 
 # -- several designs in one folder, re-runs ----------------------------------------------------------

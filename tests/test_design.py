@@ -113,10 +113,10 @@ def test_z_rigid_million_on_d1_is_refused_not_reported_as_no_interference(tmp_pa
 @pytest.mark.parametrize("z_rigid,w0,field", [(2000, None, "drive.z_rigid"), (208, "1.1", "generator.w0_coef"),
                                                (206, "1.1", None), (202, "0.05", None)])
 def test_teeth_that_never_meet_are_refused_in_one_line(z_rigid, w0, field, tmp_path, capsys):
-    # D1 (docs/models.md 2.1): flexspline tip r_a = 80 + 0.8 (1 + 3.1) = 83.28 mm, rigid tip 0.4 z_rigid + 0.8 (3.2 - 1);
-    # the largest W0 over the coned face is at the open end, W0 * 160/142 (docs/models.md 3.1). 206 teeth still
-    # mesh, 208 leave the tips 0.69 mm short (a larger W0 would close it), 2000 teeth 717 mm (no W0 can)
-    text = edit_toml((TEMPLATES / "d1_involute.toml").read_text(), "drive", "z_rigid", str(z_rigid))
+    # D1 with textbook teeth (docs/models.md 2.1): flexspline tip r_a = 80 + 0.8 (1 + 3.1) = 83.28 mm, rigid tip
+    # 0.4 z_rigid + 0.8 (3.2 - 1); the largest W0 over the coned face is at the open end, W0 * 160/142 (docs/models.md
+    # 3.1). 206 teeth still mesh, 208 leave the tips 0.69 mm short (a larger W0 would close it), 2000 teeth 717 mm
+    text = edit_toml((TEMPLATES / "d1_involute_nominal.toml").read_text(), "drive", "z_rigid", str(z_rigid))
     if w0:
         text = edit_toml(text, "generator", "w0_coef", w0)
     p = tmp_path / "d.toml"

@@ -23,9 +23,17 @@ def test_report_layer_converts_units_of_a_hand_made_finding():
     assert w["tooth_angle_deg"] == 5.0 and w["mirror"] == {"tooth_angle_deg": -5.0, "location": "non-working flank"}
     assert w["overlap_area_um2"] == 150.0 and w["section_z_mm"] == 30.0 and w["method"] == "exact"
     gap = Finding("entry_gap", float("nan"), "exact")
+    crossing = Finding("entry_crossing", float("nan"), "exact")
     pinch = Finding("entry_pinch", float("nan"), "exact")
-    e = entry_json(gap, pinch, "entry (+phi)")
+    e = entry_json(gap, crossing, pinch, "entry (+phi)")
     assert e["tooth_angle_deg"] is None and e["pinch_um"] is None and e["tip_to_tip_risk"] is False
+    assert e["crossing_um"] is None and e["kind"] is None
+    gap = Finding("entry_gap", -1.5e-3, "exact", tooth_angle=math.radians(-47.5), section_z=30.0, location="tip",
+                  details={"edge": "working", "kind": "crossing"})
+    crossing = Finding("entry_crossing", -1.5e-3, "exact", tooth_angle=math.radians(-47.5), section_z=30.0,
+                       details={"edge": "working"})
+    e = entry_json(gap, crossing, pinch, "entry (-phi)")
+    assert e["tooth_angle_deg"] == -47.5 and e["crossing_um"] == -1.5 and e["edge"] == "working" and e["kind"] == "crossing"
 
 
 def test_unknown_figure_or_method_is_refused():

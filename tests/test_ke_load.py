@@ -12,7 +12,7 @@ from wgcad.accuracy.imperfect import Imperfections
 from wgcad.accuracy.ke_load import loaded_ke, sample_periods
 from wgcad.cli import main
 from wgcad.deformation.elastic import build_model
-from wgcad.design import load_design
+from wgcad.design import load_design, with_changes
 from wgcad.drive import build_drive
 
 AS = 180.0 / math.pi * 3600.0
@@ -40,25 +40,50 @@ def test_zero_errors_give_no_loaded_ke(d1):
     assert L.wind_up > 0
 
 
-def test_rigid_eccentricity_is_the_opposite_stationary_cam_offset(d1):
+def test_rigid_eccentricity_is_the_opposite_stationary_cam_offset():
     # Two routes to one drive: the rigid gear shifted by e (each flexspline tooth moved by -e relative to the
     # rigid teeth, ke_load.tooth_errors) and the cam shifted by -e (the elastic model's own cam offset, which
-    # the rim follows through the balls). Only relative positions matter to the contacts and the rim is free
-    # to translate, so the rim's rotation must agree at every sample, to the solver's tolerance.
-    drive, model = d1
+    # the rim follows through the balls). Only relative positions matter to the contacts when the rim floats
+    # (a rim held by its cup would be held on the housing's axis, which the first route moves with it), so
+    # with a floating rim the two must give the same state at every sample, to the solver's tolerance: the
+    # rim's rotation and every tooth force.
+    from wgcad.accuracy.ke_load import tooth_errors
+    from wgcad.deformation.elastic import solve_load
+
+    drive = build_drive(with_changes(load_design(TEMPLATES / "d1_involute.toml"), load={"rim_lateral_stiffness_n_per_mm": 0.0}))
+    model = build_model(drive)
     e, psi = 0.015, 0.7
-    a = loaded_ke(drive, Imperfections(rigid_ecc=e, rigid_ecc_phase=psi), 500.0, samples=5, model=model, tol=TOL)
-    b = loaded_ke(drive, Imperfections(cam_fixed=e, cam_fixed_phase=psi + math.pi), 500.0, samples=5, model=model, tol=TOL)
-    assert np.abs(a.theta - b.theta).max() < 4 * TOL / drive.r_m  # measured 1e-9 rad
-    # and the offset does move the rim: the check is not between two unperturbed states
-    c = loaded_ke(drive, Imperfections(), 500.0, samples=5, model=model, tol=TOL)
-    assert np.abs(a.theta - c.theta).max() > 20 * TOL / drive.r_m
+    ia = Imperfections(rigid_ecc=e, rigid_ecc_phase=psi)
+    ib = Imperfections(cam_fixed=e, cam_fixed_phase=psi + math.pi)
+    ref = solve_load(model, 500.0, tol=TOL)
+
+    def tooth_forces(st):
+        c = st.contacts
+        t = c["kind"] == 1
+        out = np.zeros(model.tables.z_g)
+        np.add.at(out, c["tooth"][t], c["force"][t])
+        return out
+
+    moved = 0.0
+    for n in (0, 4040, 12120):
+        ea, ua, da = tooth_errors(model, ia, n)
+        eb, ub, db = tooth_errors(model, ib, n)
+        a = solve_load(model, 500.0, ua, da, tooth_errors=ea, tol=TOL)
+        b = solve_load(model, 500.0, ub, db, tooth_errors=eb, tol=TOL)
+        assert abs(a.rigid[2] - b.rigid[2]) < 4 * TOL / drive.r_m
+        Fa, Fb = tooth_forces(a), tooth_forces(b)
+        assert np.abs(Fa - Fb).max() < 0.01 * Fa.max()  # 1e-5 mm steps at 1e5 N/mm: 1 N against 1.4 kN
+        moved = max(moved, float(np.abs(Fa - tooth_forces(ref)).max() / Fa.max()))
+    # the eccentricity does move the load among the teeth (9 % of the largest), five times the agreement asked above:
+    # the check is not between two unperturbed states
+    assert moved > 0.05
 
 
 def test_load_sharing_averages_the_errors(d1, tmp_path):
     # run-out, eccentricity and a stationary cam offset of a few tens of micrometres: unloaded, the first pair
-    # to touch sets the output; under load some 40 pairs share it and their errors average out. Measured on
-    # these errors at 24 samples: 12.90'' no load at the same angles, 4.79'' at 100 N m, 2.60'' at 500 N m.
+    # to touch sets the output; under load some 18 pairs share it and their errors average out. Measured on
+    # these errors at 24 samples: 23.3'' no load at the same angles, 18.1'' at 100 N m (4-6 contacts), 1.86'' at
+    # 500 N m (17-19), 1.74'' at 3000 N m (44-47).
     drive, model = d1
     imp = Imperfections(flex_runout=0.02, flex_runout_phase=math.radians(260), rigid_runout=0.02, cam_fixed=0.01, rigid_ecc=0.01)
     tab = K.contact_table(drive, imp)
@@ -67,7 +92,7 @@ def test_load_sharing_averages_the_errors(d1, tmp_path):
     idx = L.periods * tab.N
     no_load = res.ke[idx] - res.ke[idx[0]]
     assert L.ke_pp < 0.5 * (no_load.max() - no_load.min())
-    assert L.teeth_in_contact.min() > 20
+    assert L.teeth_in_contact.min() > 12
 
 
 def _d1_with_errors(tmp_path):
@@ -105,6 +130,6 @@ def test_cli_bad_load_flags_exit_2(tmp_path, capsys, args, field):
 
 
 def test_cli_design_without_bearing_exits_2(capsys):
-    assert main(["ke", str(TEMPLATES / "d2.toml"), "--torque-nm", "80"]) == 2
+    assert main(["ke", str(TEMPLATES / "d3_external.toml"), "--torque-nm", "80"]) == 2
     err = capsys.readouterr().err
     assert "bearing." in err and err.count("\n") == 1

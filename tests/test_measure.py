@@ -79,7 +79,9 @@ def test_cycloidal_span_numerical_against_the_exact_curve(gear):
     # parameter (continuous), instead of reading it off the sampled outline's vertices
     sp, r, rho = gear.spec, gear.r, gear.rho
     k = workshop_figures(gear)["span"]["k"]
-    q = pi * rho / r
+    # the flank's angle from the tooth centre at the pitch circle: a quarter pitch, less the thinning's turn of
+    # each flank, thinning / (2 r) (docs/models.md 2.1)
+    q = pi * rho / r - sp.thinning / (2 * r)
     gamma = 2 * pi / sp.z
     turn = (k - 1) * gamma / 2.0  # the upper flank of tooth k-1, seen from the group's axis
 

@@ -140,4 +140,6 @@ def test_symmetric_band_stays_within_tol_on_either_side(name, g):
         one = sample_curve(p.point, p.t0, p.t1, tol)
         o1, i1 = band_deviation(p, one)
         assert i1 <= 1e-9
-    assert worst_out > 0.3 * tol and worst_in > 0.3 * tol  # both sides really used
+    # both sides really used (a one-sided error would leave one of them at 0; the short flanks of the rebuilt
+    # D1 flexspline reach 0.26 tol outside, the others 0.3-0.5)
+    assert worst_out > 0.2 * tol and worst_in > 0.2 * tol

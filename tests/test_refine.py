@@ -31,7 +31,7 @@ DENSE_TOL = 1e-7
 def _pairs(name, n_pairs=12):
     drive = build_drive(load_design(TEMPLATES / f"{name}.toml"))
     scene = Scene(drive)
-    z = None if not drive.coned else float(drive.sections(3)[-1])  # the open end: the deepest engagement
+    z = None if not drive.coned else float(drive.sections(3)[0])  # the open end (z = 0): the deepest engagement
     half = np.pi / scene.n_w
     phi = np.linspace(-half, half, 1441)
     rot, shift = scene.pose(phi, z)

@@ -12,7 +12,7 @@ from wgcad.regression import compare, load_baseline
 from wgcad.testing import assert_matches_baseline, baseline_drifts, record_baseline
 
 BASELINES = TEMPLATES.parent / "tests" / "baselines"
-NAMES = ["d1_involute", "d1_cycloidal", "d2", "d3_external", "d4_discrete"]
+NAMES = ["d1_involute", "d1_cycloidal", "d2", "d3_external", "d4_discrete", "d1_involute_nominal"]
 
 
 @pytest.mark.parametrize("name", NAMES)
@@ -65,7 +65,7 @@ def test_audit_clean_design_exits_0_and_writes_json_and_plots(tmp_path, capsys):
 
 
 def test_audit_interference_exits_1(tmp_path, capsys):
-    code, so, se = run(["audit", TEMPLATES / "d1_involute.toml", "--step-deg", "5", "--json", tmp_path / "r.json"], capsys)
+    code, so, se = run(["audit", TEMPLATES / "d1_involute_nominal.toml", "--step-deg", "5", "--json", tmp_path / "r.json"], capsys)
     res = json.loads((tmp_path / "r.json").read_text())
     assert code == 1 and res["interference"] and "INTERFERENCE" in so
     assert res["worst"]["section_z_mm"] == 0.0  # coning: the open end is the deepest

@@ -17,20 +17,37 @@ def drive(name):
 
 def test_theory_check_d1_depth_2m_clearances_quarter_m():
     # docs/models.md 2.1: x_g 3.1, x_b 3.2, h_a* 1, c* 0.25, W0 = 1.1 m -> depth 2 m, both clearances 0.25 m
+    # (the teaching template's textbook teeth)
     m = 0.8
-    mf = mesh_figures(drive("d1_involute"))
+    mf = mesh_figures(drive("d1_involute_nominal"))
     assert mf["depth_of_engagement_mm"] == pytest.approx(2 * m, abs=1e-9)
     assert mf["clearance_flex_tip_major_um"] == pytest.approx(250 * m, abs=1e-6)
     assert mf["clearance_rigid_tip_major_um"] == pytest.approx(250 * m, abs=1e-6)
 
 
+def test_rebuilt_d1_tips_on_one_circle_depth_w0():
+    # templates/d1_involute.toml: h_a* = (1 + x_b - x_g) / 2 = 0.55 puts both tips on 82.92 mm, so the depth of
+    # engagement is W0 (0.97625 m at the centre line); the radial clearances on the major axis are each tip's
+    # distance to the other gear's root there
+    m, W0 = 0.8, 0.97625 * 0.8
+    r_ag = 80 + m * (3.1 + 0.55)
+    r_ab = 80.8 + m * (3.2 - 0.55)
+    r_fg = 80 + m * (3.1 - 0.55 - 0.25)
+    r_fb = 80.8 + m * (3.2 + 0.55 + 0.25)
+    assert r_ag == pytest.approx(r_ab, abs=1e-12)
+    mf = mesh_figures(drive("d1_involute"))
+    assert mf["depth_of_engagement_mm"] == pytest.approx(r_ag + W0 - r_ab, abs=1e-9)
+    assert mf["clearance_flex_tip_major_um"] == pytest.approx(1e3 * (r_fb - (r_ag + W0)), abs=1e-6)
+    assert mf["clearance_rigid_tip_major_um"] == pytest.approx(1e3 * (r_ab - (r_fg + W0)), abs=1e-6)
+
+
 def test_d1_minor_axis_tip_gap_by_hand():
     # four-force law, section II at phi = pi/2 (docs/models.md 3.4), written out here
-    m, beta, W0 = 0.8, np.deg2rad(35.0), 1.1 * 0.8
+    m, beta, W0 = 0.8, np.deg2rad(35.0), 0.97625 * 0.8
     D = 8 / cos(beta) - pi * (pi - 2 * beta + 2 * tan(beta))
     w_minor = W0 * (8 / cos(beta) - 2 * pi * (1 + beta * tan(beta))) / D
-    r_ag = 80 + m * (1 + 3.1)
-    r_ab = 80.8 + m * (3.2 - 1)
+    r_ag = 80 + m * (0.55 + 3.1)
+    r_ab = 80.8 + m * (3.2 - 0.55)
     mf = mesh_figures(drive("d1_involute"))
     assert mf["w_minor_mm"] == pytest.approx(w_minor, abs=1e-6)
     assert mf["tip_gap_minor_um"] == pytest.approx(1e3 * (r_ab - (r_ag + w_minor)), abs=1e-3)
@@ -54,14 +71,19 @@ def test_d4_disc_law_by_hand():
 
 
 def test_d3_external_deformation_by_hand():
-    # internal-toothed flexspline squeezed inward by W0 = m onto an external rigid gear, x = 0:
-    # depth 2 m, clearances 0.25 m (the mirror image of docs/models.md 2.1's check)
-    m = 0.9
+    # internal-toothed flexspline squeezed inward by W0 = m onto an external rigid gear, x = 0, h_a* = 0.5 (both
+    # tips on one circle): the depth of engagement is W0 = m, each clearance the tip's distance to the other
+    # gear's root on the major axis (the mirror image of docs/models.md 2.1's check)
+    m, ha, c = 0.9, 0.5, 0.25
+    r_g, r_b = 135.0, 134.1  # internal flexspline 300 teeth, external rigid 298
+    r_ag, r_fg = r_g - ha * m, r_g + (ha + c) * m  # internal teeth: tips inward
+    r_ab, r_fb = r_b + ha * m, r_b - (ha + c) * m
+    W0 = m
     mf = mesh_figures(drive("d3_external"))
     assert mf["w_major_mm"] == pytest.approx(-m)
-    assert mf["depth_of_engagement_mm"] == pytest.approx(2 * m, abs=1e-9)
-    assert mf["clearance_flex_tip_major_um"] == pytest.approx(250 * m, abs=1e-6)
-    assert mf["clearance_rigid_tip_major_um"] == pytest.approx(250 * m, abs=1e-6)
+    assert mf["depth_of_engagement_mm"] == pytest.approx(r_ab - (r_ag - W0), abs=1e-9)
+    assert mf["clearance_flex_tip_major_um"] == pytest.approx(1e3 * ((r_ag - W0) - r_fb), abs=1e-6)
+    assert mf["clearance_rigid_tip_major_um"] == pytest.approx(1e3 * ((r_fg - W0) - r_ab), abs=1e-6)
     assert mf["tip_gap_minor_um"] > 0  # out of mesh on the minor axis
 
 
@@ -69,9 +91,11 @@ def test_coning_raises_deformation_at_the_open_end():
     d = drive("d1_involute")
     rep = drive_report(d)
     ends = rep["mesh_at_face_ends"]
-    # W0(z) = W0 (l - z)/(l - z_h): l = 160, z_h = 18 -> W0(0) = W0 * 160/142
-    assert ends["z_0_mm"]["w_major_mm"] == pytest.approx(0.88 * 160 / 142, abs=1e-6)
-    assert ends["z_30_mm"]["w_major_mm"] == pytest.approx(0.88 * 130 / 142, abs=1e-6)
+    # W0(z) = W0 (l - z)/(l - z_h): l = 160, z_h = 18 -> W0(0) = W0 * 160/142: the 1.1 m [S1] states at the open end
+    W0 = 0.97625 * 0.8
+    assert ends["z_0_mm"]["w_major_mm"] == pytest.approx(W0 * 160 / 142, abs=1e-6)
+    assert ends["z_0_mm"]["w_major_mm"] == pytest.approx(1.1 * 0.8, abs=1e-6)
+    assert ends["z_30_mm"]["w_major_mm"] == pytest.approx(W0 * 130 / 142, abs=1e-6)
 
 
 @pytest.mark.parametrize("name", ["d1_involute", "d1_cycloidal", "d2", "d3_external", "d4_discrete"])

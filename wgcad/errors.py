@@ -1,6 +1,6 @@
 """The error hierarchy of wgcad: one base class, subclasses that also inherit the builtin they resemble."""
 
-__all__ = ["WgcadError", "DesignError", "InputFileError", "OutputError", "GeometryError"]
+__all__ = ["WgcadError", "DesignError", "InputFileError", "OutputError", "GeometryError", "ModelError", "EXIT_MODEL"]
 
 
 class WgcadError(Exception):
@@ -32,3 +32,16 @@ class OutputError(WgcadError, OSError):
 
 class GeometryError(WgcadError, ArithmeticError):
     """A geometric construction failed although the design passed validation."""
+
+
+#: exit code of :class:`ModelError`: the input is valid, the model could not answer for it
+EXIT_MODEL = 4
+
+
+class ModelError(WgcadError, ArithmeticError):
+    """A model did not converge, or the drive lies outside what it represents (the input itself is valid).
+
+    The message says what failed and what to change (a tolerance, a load, the design's clearances).
+    """
+
+    exit_code = EXIT_MODEL

@@ -41,7 +41,7 @@ from .. import constants
 from ..placement import tooth_pose
 from .backlash import backlash
 from .findings import Finding
-from .entry import entry_crossings, entry_gap, entry_pinch, lipschitz_min
+from .entry import EDGES, entry_crossings, entry_gap, entry_passages, entry_pinch, lipschitz_min, location, section_poses, smallest
 from .scene import Scene, _classify, clearance_at_poses, refine_min, tooth_clearance, tooth_clearance_sections
 from .search import AuditSettings, _evaluate, _fold, _sample_phi, _SectionSearch
 
@@ -89,7 +89,8 @@ class AuditResult:
     def entry(self) -> dict:
         from ..report.audit import entry_json
 
-        return entry_json(self.findings["entry_gap"], self.findings["entry_pinch"], self.entry_side)
+        f = self.findings
+        return entry_json(f["entry_gap"], f.get("entry_crossing", f["entry_gap"]), f["entry_pinch"], self.entry_side)
 
     @property
     def backlash_range(self) -> dict:
@@ -106,6 +107,7 @@ class AuditResult:
         """Unrounded tooth angles (rad) of the tightest spot, the entry crossing and the pinch."""
         f = self.findings
         return {"worst_phi": f["min_clearance"].tooth_angle, "entry_phi": f["entry_gap"].tooth_angle,
+                "crossing_phi": f["entry_crossing"].tooth_angle if "entry_crossing" in f else None,
                 "pinch_phi": f["entry_pinch"].tooth_angle, "min_clearance_polygon": f["min_clearance"].polygon_value}
 
     def to_json(self) -> dict:
@@ -120,6 +122,17 @@ class AuditResult:
 #: (~30 ms) and a polygon pass, far less than refining hundreds of samples on the curves
 _FINE_ABOVE = 48
 _FINE = 8
+
+
+#: samples measured at once in the refinement stages: a flat minimum (D1's tip against a flank near the major axis
+#: at the open end) leaves thousands of candidates at fine angle steps; in batches the memory stays bounded
+#: (the fine polygons' pairs of 2048 samples take ~60 MB), the cost per batch is what one call costs
+_BATCH = 2048
+
+
+def _chunked(fn, n: int) -> np.ndarray:
+    """``fn(slice)`` over ``range(n)`` in batches of :data:`_BATCH`, concatenated."""
+    return np.concatenate([fn(slice(a, min(a + _BATCH, n))) for a in range(0, n, _BATCH)]) if n else np.zeros(0)
 
 
 def _ticker(progress):
@@ -230,7 +243,7 @@ def audit(drive, settings: AuditSettings, progress=None) -> AuditResult:
         from ..drive import build_drive
 
         ref_scene = Scene(build_drive(drive.design, tol=drive.tol / _FINE))
-        cand_v = tooth_clearance_sections(ref_scene, phi_sorted[cand_i], cand_s, sections)
+        cand_v = _chunked(lambda sl: tooth_clearance_sections(ref_scene, phi_sorted[cand_i[sl]], cand_s[sl], sections), len(cand_i))
         n_fine = len(cand_v)
         o = np.argsort(cand_v, kind="stable")
         cand_s, cand_i, cand_v = cand_s[o], cand_i[o], cand_v[o]
@@ -250,7 +263,8 @@ def audit(drive, settings: AuditSettings, progress=None) -> AuditResult:
             if live.size == 0:
                 break
             sl = live
-            vals = tooth_clearance_sections(scene, phi_sorted[cand_i[sl]], cand_s[sl], sections, exact=True)
+            vals = _chunked(lambda c: tooth_clearance_sections(scene, phi_sorted[cand_i[sl][c]], cand_s[sl][c], sections, exact=True),
+                            len(sl))
             n_refined += len(vals)
             j = int(np.argmin(vals))
             if vals[j] < exact_best:
@@ -262,26 +276,15 @@ def audit(drive, settings: AuditSettings, progress=None) -> AuditResult:
         where = (int(cand_s[0]), int(cand_i[0]))
     si, i = where
     z_w = sections[si]
-    exact = "exact" if settings.refine else "polygon"
     worst = _worst_finding(scene, phi_all, period, float(phi_sorted[i]), z_w, settings.refine, angles, best, best_poly)
     ste = _stage(tick, "entry gap")
     ste(0.0)
-    gaps = list(zip(entry_crossings(scene, sections, exact=settings.refine), sections))
-    (eg, ephi), ez = min(gaps, key=lambda t: (np.inf if np.isnan(t[0][0]) else t[0][0]))
-    crossed = bool(np.isfinite(eg))  # NaN: the tips never cross the rigid tip circle (no angle, no section)
-    entry = Finding("entry_gap", float(eg) if crossed else float("nan"), exact,
-                    tooth_angle=float(ephi) if crossed else None, section_z=ez if crossed else None,
-                    details={"crossing": "flexspline tip arc crossing the rigid tip circle"})
-    stp = _stage(tick, "pinch")
-    stp(0.0)
-    pinch = entry_pinch(scene, [(g[1], z) for g, z in gaps if np.isfinite(g[0])], exact=settings.refine) if crossed else None
-    if pinch is None:
-        pinch_f = Finding("entry_pinch", float("nan"), exact, details={"tip_to_tip_risk": False})
-    else:
-        pc, pp, pz, ploc = pinch
-        # tip-to-tip jamming: the tooth tip meets a rigid tooth before its flank engages
-        pinch_f = Finding("entry_pinch", float(pc), exact, tooth_angle=float(pp), section_z=pz, location=ploc,
-                          details={"tip_to_tip_risk": bool(pc < settings.interference_tol and ploc == "tip")})
+    entry, crossing_f, pinch_f = entry_findings(scene, sections, settings.refine, settings.interference_tol)
+    if np.isfinite(pinch_f.value) and pinch_f.value < best:
+        # a pinch is a sample of the same clearance, found by its own finer search: the minimum holds it too
+        best = float(pinch_f.value)
+        worst = _worst_finding(scene, phi_all, period, float(pinch_f.tooth_angle), pinch_f.section_z, settings.refine, angles,
+                               best, best_poly)
     _stage(tick, "backlash")(0.0)
     # backlash at the first requested generator angle, middle section
     z_mid = sections[len(sections) // 2]
@@ -321,7 +324,8 @@ def audit(drive, settings: AuditSettings, progress=None) -> AuditResult:
     }
     res = AuditResult(
         settings=rs,
-        findings={"min_clearance": worst, "entry_gap": entry, "entry_pinch": pinch_f, "backlash": backlash_f},
+        findings={"min_clearance": worst, "entry_gap": entry, "entry_crossing": crossing_f, "entry_pinch": pinch_f,
+                  "backlash": backlash_f},
         interference=best < -settings.interference_tol,
         interference_tol=settings.interference_tol,
         counts=counts,
@@ -329,6 +333,41 @@ def audit(drive, settings: AuditSettings, progress=None) -> AuditResult:
     )
     res.elapsed_s = time.perf_counter() - t0
     return res
+
+
+def entry_findings(scene: Scene, sections: list, refine: bool, interference_tol: float):
+    """Delta of [S1] (``entry_gap``), the crossing (``entry_crossing``) and the smallest pinch (``entry_pinch``) of the
+    analytic law over the sections, as :class:`Finding` records (docs/models.md 5)."""
+    method = "exact" if refine else "polygon"
+    passages = entry_passages(scene, section_poses(scene, sections), len(sections), exact=refine)
+    nan = float("nan")
+    best = smallest(passages)
+    if best is None:  # the tips never cross the rigid tip circle
+        return (Finding("entry_gap", nan, method), Finding("entry_crossing", nan, method),
+                Finding("entry_pinch", nan, method, details={"tip_to_tip_risk": False}))
+    z = sections[best.index]
+    e = EDGES.index(best.delta_edge)
+    loc = location(scene, best.delta_phi, z, e)
+    per = [{"section_z": sections[p.index], "crossing": p.crossing, "crossing_gaps": p.crossing_gaps,
+            "pinch": p.pinch, "delta": p.delta, "delta_phi": p.delta_phi, "edge": p.delta_edge, "kind": p.delta_kind}
+           for p in passages]
+    gap = Finding("entry_gap", best.delta, method, tooth_angle=best.delta_phi, section_z=z, location=loc,
+                  details={"edge": best.delta_edge, "kind": best.delta_kind, "passages": per,
+                           "tip_to_tip_risk": bool(best.delta < interference_tol and loc == "tip")})
+    cr = min((p for p in passages if np.isfinite(p.crossing)), key=lambda p: min(p.crossing_gaps))
+    ce = int(np.argmin(cr.crossing_gaps))
+    crossing = Finding("entry_crossing", float(cr.crossing_gaps[ce]), method, tooth_angle=cr.crossing,
+                       section_z=sections[cr.index], details={"edge": EDGES[ce],
+                                                              "crossing": "flexspline tip arc crossing the rigid tip circle"})
+    pins = [(pin[0], pin[1], p.index, e2) for p in passages for e2, pin in enumerate(p.pinch) if pin is not None]
+    if pins:
+        pv, pp, pk, pe = min(pins)
+        ploc = location(scene, pp, sections[pk], pe)
+        pinch = Finding("entry_pinch", float(pv), method, tooth_angle=float(pp), section_z=sections[pk], location=ploc,
+                        details={"edge": EDGES[pe], "tip_to_tip_risk": bool(pv < interference_tol and ploc == "tip")})
+    else:
+        pinch = Finding("entry_pinch", nan, method, details={"tip_to_tip_risk": False})
+    return gap, crossing, pinch
 
 
 def accuracy_settings(drive, refine: bool) -> dict:

@@ -13,7 +13,7 @@ from dataclasses import dataclass, field
 __all__ = ["Finding", "FIGURES", "METHODS"]
 
 #: the figures an audit reports
-FIGURES = ("min_clearance", "entry_gap", "entry_pinch", "backlash")
+FIGURES = ("min_clearance", "entry_gap", "entry_crossing", "entry_pinch", "backlash")
 
 #: how a figure was obtained
 METHODS = {

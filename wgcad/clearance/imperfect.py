@@ -409,13 +409,13 @@ def audit_imperfect(drive, settings, imp: Imperfections, progress=None, chunk_sa
     rs["entry_side"] = "entry (+phi)" if scene.entry_sign > 0 else "entry (-phi)"
     fold = lambda a: float((a + pi / scene.n_w) % (2 * pi / scene.n_w) - pi / scene.n_w)  # noqa: E731  (nearest major axis)
     if np.isfinite(ent.get("gap", np.nan)):
-        gap_f = Finding("entry_gap", ent["gap"], exact, tooth_angle=fold(ent["gap_tooth_angle"]), section_z=ent["gap_z"],
+        gap_f = Finding("entry_crossing", ent["gap"], exact, tooth_angle=fold(ent["gap_tooth_angle"]), section_z=ent["gap_z"],
                         generator_angle=ent["gap_phi_h"], tooth=ent["gap_tooth"],
                         details={"crossing": "flexspline tip arc crossing the rigid tip circle",
                                  "passages": ent["passages"], "spread": ent["spread"], "all_passages": ent["all"],
                                  "perfect_gaps": [float(g[0]) for g, _ in gaps], "perfect_phi": [float(g[1]) for g, _ in gaps]})
     else:
-        gap_f = Finding("entry_gap", float("nan"), exact, details={"passages": ent.get("passages", 0)})
+        gap_f = Finding("entry_crossing", float("nan"), exact, details={"passages": ent.get("passages", 0)})
     if np.isfinite(ent.get("pinch", np.nan)):
         ploc = _classify(isc, ent["pinch_rot"], ent["pinch_shift"], ent["pinch_rigid"])
         pinch_f = Finding("entry_pinch", ent["pinch"], exact, tooth_angle=fold(ent["pinch_tooth_angle"]),
@@ -423,9 +423,18 @@ def audit_imperfect(drive, settings, imp: Imperfections, progress=None, chunk_sa
                           details={"tip_to_tip_risk": bool(ent["pinch"] < settings.interference_tol and ploc == "tip")})
     else:
         pinch_f = Finding("entry_pinch", float("nan"), exact, details={"tip_to_tip_risk": False})
+    # Delta of [S1] (docs/models.md 5): the smallest gap of the entry, the pinch where the tips pass or, without
+    # one, the crossing; over every passage
+    delta_src, kind = ((pinch_f, "pinch") if np.isfinite(pinch_f.value) and not (pinch_f.value > gap_f.value)
+                       else (gap_f, "crossing"))
+    delta_f = Finding("entry_gap", float(delta_src.value), exact, tooth_angle=delta_src.tooth_angle, section_z=delta_src.section_z,
+                      location=delta_src.location, generator_angle=delta_src.generator_angle, tooth=delta_src.tooth,
+                      details={"kind": kind if np.isfinite(delta_src.value) else None, "edge": "working or non-working",
+                               "tip_to_tip_risk": bool(pinch_f.details.get("tip_to_tip_risk", False) and kind == "pinch")})
     findings = {
         "min_clearance": worst,
-        "entry_gap": gap_f,
+        "entry_gap": delta_f,
+        "entry_crossing": gap_f,
         "entry_pinch": pinch_f,
         "backlash": Finding("backlash", float(bl), "brent", generator_angle=float(angles[0]), section_z=z_mid),
     }

@@ -61,7 +61,8 @@ def main(argv=None) -> int:
     Exit codes: 0 success, 1 interference or baseline drift (audit), 2 bad
     input (one line on stderr, nothing written), 3 internal error (one line
     asking for a report; the traceback with ``--traceback`` or
-    ``WGCAD_TRACEBACK=1``), 128 + signal number when interrupted (SIGINT,
+    ``WGCAD_TRACEBACK=1``), 4 the model could not answer (no convergence, or
+    the drive outside it: one line, nothing written), 128 + signal number when interrupted (SIGINT,
     SIGTERM, SIGHUP: temporary files are removed first).
     """
     parser = build_parser()

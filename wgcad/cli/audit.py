@@ -192,7 +192,7 @@ def _audit_pngs(drive, result):
     w = result.worst
     e = result.entry
     name = drive.design.drive.name
-    ent = result.findings["entry_gap"].details
+    ent = result.findings["entry_crossing"].details
     if imperfect and "perfect_gaps" in ent:
         # the perfect drive's curve: its own entry gap marked (the imperfect passages have their own picture)
         i = int(np.nanargmin(ent["perfect_gaps"]))

@@ -12,7 +12,7 @@ from pathlib import Path
 from ..errors import WgcadError
 from .progress import Progress
 
-__all__ = ["EXIT_OK", "EXIT_INTERFERENCE", "EXIT_INPUT", "EXIT_INTERNAL", "EPILOG", "TRACEBACK_ENV", "Parser",
+__all__ = ["EXIT_OK", "EXIT_INTERFERENCE", "EXIT_INPUT", "EXIT_INTERNAL", "EXIT_MODEL", "EPILOG", "TRACEBACK_ENV", "Parser",
            "angles_deg", "positive_float", "angle_count", "out_dir", "angle_tag", "circle", "Progress",
            "Terminated", "signals_raise", "internal_error_line", "want_progress", "add_memory_flag", "not_modelled"]
 
@@ -20,6 +20,7 @@ EXIT_OK = 0
 EXIT_INTERFERENCE = 1  # reserved for `wgcad audit`: interference found or baseline drift
 EXIT_INPUT = 2  # bad design file, flag or output path; nothing written
 EXIT_INTERNAL = 3  # an unexpected error inside wgcad (a bug): one line, a request for a report
+EXIT_MODEL = 4  # valid input the model could not answer: it did not converge or the drive is outside it
 
 #: set to 1 to get the Python traceback of an internal error (same as --traceback)
 TRACEBACK_ENV = "WGCAD_TRACEBACK"
@@ -29,6 +30,8 @@ EPILOG = f"""exit codes:
   1    interference found, or drift from --baseline (audit)
   2    bad input: design file, flag, or output path (one-line message, nothing written)
   3    internal error: a bug in wgcad (one-line message; --traceback or {TRACEBACK_ENV}=1 shows the traceback)
+  4    the model could not answer: it did not converge, or the drive lies outside what it represents (one
+       line saying what to change; the input itself is valid; nothing written)
   130  interrupted (Ctrl-C); 143 SIGTERM; 129 SIGHUP: temporary files removed, nothing half-written
   141  standard output closed by its reader (e.g. | head)
 """

@@ -156,6 +156,30 @@ def _loaded(args, drive, imp, res, tab, out: dict) -> list:
         print(f"  under {T:g} N m (elastic model at {len(L.ke)} whole mesh periods over the revolution): largest KE "
               f"{L.ke_pp * _AS:.2f} arcsec against {nl_pp * _AS:.2f} at no load at the same angles; wind-up {L.wind_up * _AS:.1f} arcsec, "
               f"{L.teeth_in_contact.min()}-{L.teeth_in_contact.max()} tooth contacts")
+        if args.optimize_install_angle:
+            import math
+
+            import numpy as np
+
+            from ..accuracy.ke_load import install_lever
+
+            bar.start(f"installation angle, {T:g} N m")
+            lev = install_lever(drive, imp, T, model=model, samples=args.load_samples, design=L,
+                                progress=lambda i, n: bar.set(i / n, f"installation angle, {T:g} N m"))
+            bar.close()
+            out["loaded"][-1]["install_angle"] = {
+                "best_rigid_angle_deg": round(math.degrees(lev.best_angle), 3),
+                "best_ke_pp_arcsec": round(lev.best.ke_pp * _AS, 4),
+                "design_angle_deg": round(math.degrees(imp.rigid_install), 3),
+                "design_ke_pp_arcsec": round(lev.design.ke_pp * _AS, 4),
+                "lever": round(lev.lever, 4),
+                "angles_deg": [round(float(a), 3) for a in np.degrees(lev.grid)],
+                "rigid_ke_pp_arcsec": [round(float(v) * _AS, 4) for v in lev.grid_pp],
+                "scan_samples": lev.scan_samples, "seconds": round(lev.seconds, 3)}
+            print(f"    rigid gear installation angle under {T:g} N m: best {math.degrees(lev.best_angle):.1f} deg, largest KE "
+                  f"{lev.best.ke_pp * _AS:.2f} arcsec against {lev.design.ke_pp * _AS:.2f} at the design's "
+                  f"{math.degrees(imp.rigid_install):g} deg ({lev.lever:.2f} times lower; scan of {len(lev.grid)} angles with "
+                  f"{lev.scan_samples} states each: {lev.grid_pp.min() * _AS:.1f} .. {lev.grid_pp.max() * _AS:.1f} arcsec)")
     print("  under load NOT CHECKED: the KE within a mesh period (the elastic model has states at whole mesh periods only)")
     return loaded
 

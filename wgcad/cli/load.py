@@ -9,7 +9,11 @@ from pathlib import Path
 from ..errors import DesignError
 from .common import EXIT_INTERFERENCE, EXIT_OK, Progress
 
-__all__ = ["register_args", "run_load", "torque_levels"]
+__all__ = ["register_args", "run_load", "torque_levels", "RATED", "RATED_STEPS"]
+
+#: ``--torque-nm`` without a value: the design's rated torque, from zero in RATED_STEPS steps
+RATED = "rated"
+RATED_STEPS = 12
 
 
 def torque_levels(text: str) -> list[float]:
@@ -36,8 +40,9 @@ def torque_levels(text: str) -> list[float]:
 def register_args(a) -> None:
     """Add the load flags to the ``audit`` subparser."""
     g = a.add_argument_group("under load (elastic contact model; needs [bearing] in the design)")
-    g.add_argument("--torque-nm", metavar="SPEC", help="output torques: START:STOP:STEP (e.g. 0:3000:250), a value or a list; "
-                   "exit 1 when the entry gap closes at a requested load")
+    g.add_argument("--torque-nm", metavar="SPEC", nargs="?", const=RATED,
+                   help="output torques: START:STOP:STEP (e.g. 0:3000:250), a value or a list; without SPEC, 0 to the "
+                   "design's [load] rated_torque_nm in 12 steps; exit 1 when the entry gap Delta closes at a requested load")
     g.add_argument("--cam-offset-um", type=float, default=None, help="cam axis offset e_h, um (default: [load] of the design, else 0)")
     g.add_argument("--cam-offset-deg", type=float, default=None, help="direction of e_h from the major axis, deg (default: [load], else 0)")
     g.add_argument("--compare", metavar="DESIGN2", help="also sweep DESIGN2 and plot both designs' entry gap against torque "
@@ -47,12 +52,24 @@ def register_args(a) -> None:
 def _summary(name: str, res: dict) -> str:
     lines = [f"{name}: under load (elastic contact model, {len(res['model']['sections_z_mm'])} sections), "
              f"cam offset {res['cam_offset_um']:g} um at {res['cam_offset_deg']:g} deg"]
-    lines.append("  torque N m | entry gap um | teeth in contact | max tooth force N | max ball load N | wind-up arcmin | stiffness N m/rad")
+    mnt = res["model"].get("mounted")
+    if mnt:
+        lines.append(f"  on the cam at no load: W0 {mnt['w0_um']:.1f} um at the major axis (the design's), the rim within "
+                     f"{mnt['largest_departure_from_law_um']:.1f} um of the law (largest at {mnt['departure_at_deg']:+.1f} deg), "
+                     f"held by {mnt['balls_in_contact']} balls of {mnt['ball_preload_n']:.0f} N")
+    lines.append("  torque N m | entry gap Delta um (where)           | tip crossing um | teeth in contact | max tooth force N | "
+                 "max ball load N | generator N m | wind-up arcmin | secant N m/rad | tangent N m/rad")
     for k, lv in enumerate(res["levels"]):
-        st = res["stiffness_nm_per_rad"][k - 1] if k else None
+        sec = res["secant_stiffness_nm_per_rad"][k]
+        tan = res["tangent_stiffness_nm_per_rad"][k - 1] if k else None
         eg = "none" if lv["entry_gap_um"] is None else f"{lv['entry_gap_um']:9.3f}"
-        lines.append(f"  {lv['torque_nm']:10g} | {eg:>12} | {lv['teeth_in_contact']:16d} | {lv['largest_tooth_force_n']:17.1f} | "
-                     f"{lv['max_ball_load_n']:15.1f} | {lv['wind_up_arcmin']:14.4f} | " + ("-" if st is None else f"{st:.4g}"))
+        at = lv.get("entry_gap_at")
+        where = "" if not at else f"{at['tooth_angle_deg']:+6.1f} deg z {at['section_z_mm']:g} {at['edge']}"
+        cr = "none" if lv.get("crossing_gap_um") is None else f"{lv['crossing_gap_um']:.3f}"
+        lines.append(f"  {lv['torque_nm']:10g} | {eg:>9} {where:<25} | {cr:>15} | {lv['teeth_in_contact']:16d} | "
+                     f"{lv['largest_tooth_force_n']:17.1f} | {lv['max_ball_load_n']:15.1f} | {lv['generator_torque_nm']:13.3f} | "
+                     f"{lv['wind_up_arcmin']:14.4f} | " + ("-" if sec is None else f"{sec:14.4g}") + " | "
+                     + ("-" if tan is None else f"{tan:.4g}"))
     top = res["levels"][-1]
     lines.append(f"  at {top['torque_nm']:g} N m: smallest clearance of unloaded pairs "
                  + ("-" if top["min_clearance_um"] is None else f"{top['min_clearance_um']:.3f} um")
@@ -91,11 +108,24 @@ def _sweep(path, torques, e_um, e_deg, sections, progress):
     return drive, res
 
 
+def _levels(args) -> list[float]:
+    """The torque levels of ``--torque-nm``: as given, or 0 to ``[load] rated_torque_nm`` in :data:`RATED_STEPS` steps."""
+    if args.torque_nm != RATED:
+        return torque_levels(args.torque_nm)
+    from ..design import load_design
+
+    rated = load_design(args.design).load.rated_torque_nm
+    if rated is None or not rated > 0:
+        raise DesignError("load.rated_torque_nm", "--torque-nm without a value sweeps 0 to the rated torque: give "
+                          "[load] rated_torque_nm > 0 in the design or a SPEC to the flag")
+    return [rated * i / RATED_STEPS for i in range(RATED_STEPS + 1)]
+
+
 def run_load(args) -> int:
     """The load audit: sweep, print, write JSON and PNGs atomically; exit 1 when the entry gap closes."""
     from ..export.atomic import atomic_batch, ensure_writable_dir
 
-    torques = torque_levels(args.torque_nm)
+    torques = _levels(args)
     for path in (args.json, args.plot):
         if path:
             ensure_writable_dir(Path(path).parent if str(Path(path).parent) else Path("."))

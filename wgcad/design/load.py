@@ -46,6 +46,12 @@ class LoadSpec:
     cam_offset_um: float = _key("radial offset e_h of the cam axis from the rigid gear's", unit="um", lo=0.0, hi=10000.0, why="a magnitude (the direction is cam_offset_deg); 10 mm is far beyond any mounting error", default=0.0)
     cam_offset_deg: float = _key("direction of e_h from the generator's major axis", unit="deg", lo=-360.0, hi=360.0, why="one turn either way", default=0.0)
     ball_phase_deg: float = _key("angle of the first ball from the major axis", unit="deg", lo=-360.0, hi=360.0, why="one turn either way", default=0.0)
+    #: radial stiffness with which the flexspline's supports hold the toothed rim centred, N/mm: a cup's wall
+    #: bending and shearing as a thin tube from the diaphragm (docs/models.md 4.1); 0 lets the rim float
+    #: radial stiffness of the cam's support (input shaft and its bearings), N/mm: the balls' imbalance moves the
+    #: cam against it (docs/models.md 4.1); 0 for a floating (self-centring) generator, e.g. on an Oldham coupling
+    cam_support_stiffness_n_per_mm: float | None = _key("radial stiffness holding the cam on the drive axis (0: floating generator)", unit="N/mm", lo=0.0, hi=1e9, why="not negative; 1e9 N/mm is a rigid support", default=None, default_doc="rigid (the cam held where its offset puts it)")
+    rim_lateral_stiffness_n_per_mm: float | None = _key("radial stiffness holding the toothed rim on the drive axis (0: floating)", unit="N/mm", lo=0.0, hi=1e9, why="not negative; 1e9 N/mm is a rigid support", default=None, default_doc="the cup wall as a thin tube from the diaphragm to the generator centre line; 0 without [generator] cone_length")
 
 
 def _nonneg(where: str, value) -> None:

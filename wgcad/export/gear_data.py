@@ -73,49 +73,21 @@ def span_measurement(gear) -> dict | None:
 
 
 def pin_dimension(gear, pin_diameter: float | None = None) -> dict | None:
-    """Dimension between (internal) or over (external) two pins of an involute gear (docs/models.md 2.1).
+    """Dimension between (internal) or over (external) two pins of an involute gear, by the rule the generate report
+    states (:func:`wgcad.profiles.measure._pins`: contact nearest mid-flank with the pin standing out of the teeth
+    and clear of the root, gauge pins in 1 um steps), docs/models.md 2.1. None for other forms."""
+    from ..profiles.measure import _pins
 
-    A pin of radius ``rho`` centred on the space centre line at radius
-    ``R_c`` touches both flanks when the involute through its centre lies
-    ``rho`` (along the common normal, in base-circle roll length) from the
-    flanks: internal gear, ``inv(a_c) = psi_s - rho / r_b`` with ``psi_s``
-    the half space angle on the base circle; external gear,
-    ``inv(a_c) = psi_t + rho / r_b - pi / z`` (``psi_t`` the half tooth
-    angle). ``R_c = r_b / cos(a_c)``; between pins ``M = 2 R_c c - D``,
-    over pins ``M = 2 R_c c + D``, ``c = 1`` (even ``z``) or ``cos(pi/2z)``
-    (odd). Default pin ``1.44 m`` (internal) / ``1.728 m`` (external). None
-    when the contact point is not on the involute flank.
-    """
     sp = gear.spec
     if sp.form != "involute" or gear.r_base is None:
         return None
-    rng = _flank_radii(gear)
-    if rng is None:
+    p = _pins(gear, pin_diameter)
+    if not (p["pin_stands_out_of_the_teeth"] and p["pin_clear_of_the_root"]):
         return None
-    m = sp.module
-    D = pin_diameter if pin_diameter is not None else (1.44 if sp.internal else 1.728) * m
-    rho = 0.5 * D
-    r_b = gear.r_base
-    if sp.internal:
-        # gear.half_angle of an internal gear is half the *tooth* (pi/z - space half angle)
-        psi_s = math.pi / sp.z - float(gear.half_angle(r_b))
-        a_c = inv_inverse(psi_s - rho / r_b)
-    else:
-        psi_t = float(gear.half_angle(r_b))
-        a_c = inv_inverse(psi_t + rho / r_b - math.pi / sp.z)
-    if a_c <= 0:
-        return None
-    R_c = r_b / math.cos(a_c)
-    # contact: on the base tangent through the pin centre, rho from the centre
-    L_c = r_b * math.tan(a_c)
-    L_contact = L_c + rho if sp.internal else L_c - rho
-    rc = math.hypot(r_b, L_contact)
-    if not rng[0] < rc < rng[1]:
-        return None
-    c = 1.0 if sp.z % 2 == 0 else math.cos(math.pi / (2 * sp.z))
-    M = 2.0 * R_c * c - D if sp.internal else 2.0 * R_c * c + D
-    return {"pin_diameter_mm": D, "M_mm": M, "pin_centre_radius_mm": R_c, "contact_radius_mm": rc,
-            "kind": "between pins" if sp.internal else "over pins"}
+    M = p["between_pins_mm" if sp.internal else "over_pins_mm"]
+    return {"pin_diameter_mm": p["pin_diameter_mm"], "M_mm": M, "pin_centre_radius_mm": 0.5 * p["pin_centre_diameter_mm"],
+            "contact_radius_mm": 0.5 * p["contact_diameter_mm"], "kind": "between pins" if sp.internal else "over pins",
+            "rule": p["pin_diameter_source"]}
 
 
 def gear_data(gear, tol: float) -> dict:

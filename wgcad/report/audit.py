@@ -38,13 +38,21 @@ def worst_json(f) -> dict:
     return out
 
 
-def entry_json(gap, pinch, side: str) -> dict:
-    """The entry crossing and the pinch after it (``entry_gap`` and ``entry_pinch`` findings) for the JSON document."""
+def entry_json(gap, crossing, pinch, side: str) -> dict:
+    """The entry: Delta of [S1] (``entry_gap``), the tip-circle crossing (``entry_crossing``) and the pinch after it
+    (``entry_pinch``) for the JSON document (docs/models.md 5)."""
     crossed = bool(np.isfinite(gap.value))
     out = {
         "tooth_angle_deg": _deg(gap.tooth_angle) if crossed else None,
         "section_z_mm": _z(gap.section_z) if crossed else None,
+        "edge": gap.details.get("edge") if crossed else None,
+        "kind": gap.details.get("kind") if crossed else None,
+        "location": gap.location if crossed else None,
         "side": side,
+        "crossing_um": round(1e3 * crossing.value, 4) if np.isfinite(crossing.value) else None,
+        "crossing_tooth_angle_deg": _deg(crossing.tooth_angle) if np.isfinite(crossing.value) else None,
+        "crossing_section_z_mm": _z(crossing.section_z) if np.isfinite(crossing.value) else None,
+        "crossing_edge": crossing.details.get("edge"),
     }
     if np.isfinite(pinch.value):
         out.update({
@@ -52,18 +60,29 @@ def entry_json(gap, pinch, side: str) -> dict:
             "pinch_tooth_angle_deg": _deg(pinch.tooth_angle),
             "pinch_section_z_mm": _z(pinch.section_z),
             "pinch_location": pinch.location,
-            "tip_to_tip_risk": bool(pinch.details.get("tip_to_tip_risk", False)),
+            "pinch_edge": pinch.details.get("edge"),
         })
     else:
         out.update({"pinch_um": None, "pinch_tooth_angle_deg": None, "pinch_section_z_mm": None,
-                    "pinch_location": None, "tip_to_tip_risk": False})
+                    "pinch_location": None, "pinch_edge": None})
+    out["tip_to_tip_risk"] = bool(gap.details.get("tip_to_tip_risk", False) or pinch.details.get("tip_to_tip_risk", False))
+    if "passages" in gap.details and isinstance(gap.details["passages"], list):
+        out["sections"] = [{
+            "section_z_mm": _z(p["section_z"]),
+            "entry_gap_um": round(1e3 * p["delta"], 4) if np.isfinite(p["delta"]) else None,
+            "tooth_angle_deg": _deg(p["delta_phi"]) if np.isfinite(p["delta"]) else None,
+            "edge": p["edge"] or None, "kind": p["kind"] or None,
+            "crossing_tooth_angle_deg": _deg(p["crossing"]) if np.isfinite(p["crossing"]) else None,
+            "crossing_working_um": round(1e3 * p["crossing_gaps"][0], 4) if np.isfinite(p["crossing"]) else None,
+            "crossing_non_working_um": round(1e3 * p["crossing_gaps"][1], 4) if np.isfinite(p["crossing"]) else None,
+        } for p in gap.details["passages"]]
     if gap.details.get("note"):
         out["note"] = gap.details["note"]
-    if gap.tooth is not None:  # an imperfect drive: the passage the figures happen in
-        out["tooth"] = int(gap.tooth)
-        out["generator_angle_deg"] = _deg(gap.generator_angle)
-        out["passages"] = int(gap.details.get("passages", 0))
-        out["spread_um"] = round(1e3 * gap.details["spread"], 4) if "spread" in gap.details else None
+    if crossing.tooth is not None:  # an imperfect drive: the passage the figures happen in
+        out["tooth"] = int(crossing.tooth)
+        out["generator_angle_deg"] = _deg(crossing.generator_angle)
+        out["passages"] = int(crossing.details.get("passages", 0))
+        out["spread_um"] = round(1e3 * crossing.details["spread"], 4) if "spread" in crossing.details else None
         if np.isfinite(pinch.value):
             out["pinch_tooth"] = int(pinch.tooth)
             out["pinch_generator_angle_deg"] = _deg(pinch.generator_angle)
@@ -137,18 +156,23 @@ def audit_summary(name: str, res: dict) -> str:
         pass  # not computed (imperfect parts): the caller's NOT CHECKED lines say so
     elif res["entry_gap_um"] is not None:
         sec = "" if e["section_z_mm"] is None else f", section z = {e['section_z_mm']:g} mm"
-        lines.append(f"  entry gap: {res['entry_gap_um']:.3f} um at tooth angle {e['tooth_angle_deg']:+.3f} deg{sec} "
-                     "(flexspline tip crossing the rigid tip circle)"
+        what = ("the pinch where the tips pass each other" if e["kind"] == "pinch" else "at the tip crossing (no pinch: the smallest gap of the entry)")
+        lines.append(f"  entry gap Delta [S1]: {res['entry_gap_um']:.3f} um by the {e['edge']} edge ({e['location']}) at tooth angle "
+                     f"{e['tooth_angle_deg']:+.3f} deg{sec}, {what}"
+                     + ("  TIP-TO-TIP RISK" if e["tip_to_tip_risk"] else ""))
+        csec = "" if e["crossing_section_z_mm"] is None else f", section z = {e['crossing_section_z_mm']:g} mm"
+        lines.append(f"  tip crossing: {e['crossing_um']:.3f} um by the {e['crossing_edge']} edge at tooth angle "
+                     f"{e['crossing_tooth_angle_deg']:+.3f} deg{csec} (flexspline tip circle meeting the rigid tip circle)"
                      + (f"; tooth {e['tooth']} at generator angle {e['generator_angle_deg']:.3f} deg, the smallest of "
                         f"{e['passages']} passages (they spread over {e['spread_um']:.3f} um)" if "tooth" in e else ""))
         if e["pinch_um"] is None:
-            lines.append("  entry pinch: none (from the crossing to the major axis the clearance never rises again from a minimum)")
+            lines.append("  entry pinch: none (after the crossing the gaps never dip and rise again before the flanks engage)")
         else:
             psec = "" if e["pinch_section_z_mm"] is None else f", section z = {e['pinch_section_z_mm']:g} mm"
-            lines.append(f"  entry pinch: {e['pinch_um']:.3f} um at tooth angle {e['pinch_tooth_angle_deg']:+.3f} deg{psec}, {e['pinch_location']}"
+            lines.append(f"  entry pinch: {e['pinch_um']:.3f} um by the {e['pinch_edge']} edge at tooth angle "
+                         f"{e['pinch_tooth_angle_deg']:+.3f} deg{psec}, {e['pinch_location']}"
                          + (f"; tooth {e['pinch_tooth']} at generator angle {e['pinch_generator_angle_deg']:.3f} deg"
-                            if "pinch_tooth" in e else "")
-                         + ("  TIP-TO-TIP RISK" if e["tip_to_tip_risk"] else ""))
+                            if "pinch_tooth" in e else ""))
     else:
         lines.append("  entry gap: none (the tips never cross the rigid tip circle)")
     b = res["backlash_at"]

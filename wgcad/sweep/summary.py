@@ -195,14 +195,13 @@ def format_summary(s: dict, info=None) -> str:
         lims = ", ".join(f"{k} " + " and ".join(x for x in ((f">= {v['min']:g}" if v["min"] is not None else ""),
                                                            (f"<= {v['max']:g}" if v["max"] is not None else "")) if x)
                          for k, v in s["limits"].items())
-        lines.append(f"  YIELD {100 * y['fraction']:.2f} % ({y['pass']} of {y['of']}), {100 * s['confidence']:.0f} % interval "
-                     f"{100 * y['ci'][0]:.2f} .. {100 * y['ci'][1]:.2f} % (Clopper-Pearson); limits: {lims}")
+        lines.append(f"  YIELD {100 * y['fraction']:.2f} % ({y['pass']} of the {y['of']} samples whose every model held), "
+                     f"{100 * s['confidence']:.0f} % interval {100 * y['ci'][0]:.2f} .. {100 * y['ci'][1]:.2f} % "
+                     f"(Clopper-Pearson); limits: {lims}")
         if c["refused"] or c["failed"] or c["error"]:
             lines.append(f"  counting refused, failed and error samples as failures: {100 * y['counting_refused_as_failures']:.2f} %")
-    deep = s["figures"].get("ke_deep_overlap_fraction")
-    if deep and deep.get("n") and deep["max"] > 0:
-        lines.append(f"  WARNING: KE of samples resting on deeply overlapping contacts (mean share of angles "
-                     f"{100 * deep['mean']:.1f} %): the linear error model is not to be trusted there (README, kinematic error)")
+    elif y is not None:
+        lines.append(f"  YIELD not defined: no sample's models held ({c['done']} stored: see the reasons above)")
     if s["sensitivity"]:
         top = [r for r in s["sensitivity"] if r["failure"] is not None][:5]
         if top:

@@ -25,7 +25,7 @@ from collections import OrderedDict
 
 import numpy as np
 
-from ..errors import DesignError, WgcadError
+from ..errors import DesignError, ModelError, WgcadError
 from .figures import parse_figure
 from .sampling import envelope_amplitudes_um, sample_design_data, sample_values
 
@@ -119,6 +119,11 @@ def _ke(payload, data, design, drive) -> dict:
     key = _h([_geometry_key(data), env, design.imperfections.cam_offset_cam_phase_deg, payload["ke_per_mesh"]])
     tab = _cached("table", key, lambda: K.contact_table(drive, tab_imp, payload["ke_per_mesh"]))
     res = K.kinematic_error(drive, imp, table=tab)
+    if res.deep_overlap_fraction > 0:
+        # the figure exists only where its model holds (docs/models.md 6.2): this sample's is not recorded
+        raise ModelError(f"KE outside the linear error model: at {100 * res.deep_overlap_fraction:.1f} % of the angles the "
+                         f"first contact overlaps so deeply (turning back > {K.DEEP_OVERLAP * _AS:.0f} arcsec) that the "
+                         "model does not hold; more side clearance or smaller errors, or the elastic model (load figures)")
     lm = res.lost_motion
     return {"ke_pp_arcsec": res.ke_pp * _AS, "lost_motion_min_arcsec": float(lm.min()) * _AS,
             "lost_motion_max_arcsec": float(lm.max()) * _AS, "ke_deep_overlap_fraction": float(res.deep_overlap_fraction)}

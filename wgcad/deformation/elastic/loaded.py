@@ -17,10 +17,13 @@ __all__ = ["LoadedLaw", "displacements_many"]
 class LoadedLaw(Law):
     """Neutral line of the loaded flexspline, usable wherever a :class:`~wgcad.deformation.Law` is.
 
-    ``state(phi)`` = the nominal law of the section + ``scale`` times the
-    ring's response to the contact loads (n >= 2 modes, :class:`Ring`) + the
+    ``state(phi)`` = ``scale`` times the ring's response to the contact loads
+    (n >= 2 modes, :class:`Ring`; the rim is round when unloaded and the
+    cam's balls are among the loads, so this is the whole deformation) + the
     rigid-body motion ``(dx, dy, rot)`` of the rim (first order in ``rot``:
-    ``w -= rot v``, ``v += rot (r_m + w)``, ``theta += rot``). ``phi`` is the
+    ``w -= rot v``, ``v += rot (r_m + w)``, ``theta += rot``, with the
+    section's nominal law standing for the deformed rim in these second-order
+    coupling terms). ``phi`` is the
     material angle from the generator's major axis as for every law; the
     loads are expressed in the generator frame, so the state is the one the
     drive holds at the generator angle it was solved for, and the clearance
@@ -98,13 +101,13 @@ class LoadedLaw(Law):
         v_t = -dx * s + dy * c
         return RimState(
             phi,
-            w=nom.w + el["w"] + w_t - rot * nom.v,
-            dw=nom.dw + el["dw"] + v_t - rot * nom.dv,
-            d2w=nom.d2w + el["d2w"] - w_t + rot * nom.dw,
-            v=nom.v + el["v"] + v_t + rot * (self.r_m + nom.w),
-            dv=nom.dv + el["dv"] - w_t + rot * nom.dw,
-            theta=nom.theta + el["theta"] + rot,
-            dtheta=nom.dtheta + el["dtheta"],
+            w=el["w"] + w_t - rot * nom.v,
+            dw=el["dw"] + v_t - rot * nom.dv,
+            d2w=el["d2w"] - w_t + rot * nom.dw,
+            v=el["v"] + v_t + rot * (self.r_m + nom.w),
+            dv=el["dv"] - w_t + rot * nom.dw,
+            theta=el["theta"] + rot,
+            dtheta=el["dtheta"],
         )
 
 
@@ -162,10 +165,10 @@ def displacements_many(laws, phis) -> list[tuple]:
     for k in loaded:
         law = laws[k]
         p = ps[k]
-        (nw, nv, nth), (ew, ev, eth) = nom[k], el[k]
+        (nw, nv, _), (ew, ev, eth) = nom[k], el[k]
         dx, dy, rot = law.rigid
         c, s = np.cos(p), np.sin(p)
-        out[k] = (nw + law.scale * ew + dx * c + dy * s - rot * nv,
-                  nv + law.scale * ev - dx * s + dy * c + rot * (law.r_m + nw),
-                  nth + law.scale * eth + rot)
+        out[k] = (law.scale * ew + dx * c + dy * s - rot * nv,
+                  law.scale * ev - dx * s + dy * c + rot * (law.r_m + nw),
+                  law.scale * eth + rot)
     return out

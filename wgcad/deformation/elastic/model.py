@@ -44,6 +44,11 @@ class ElasticModel:
         +1 when the load torque on the flexspline is counter-clockwise (working flank ``upper``).
     ei_parts : dict
         The bending-stiffness contributions, N mm^2 (reported).
+    lateral_stiffness : float
+        Radial stiffness of the rim's support (the cup), N/mm; 0: the rim floats (its translation is set by the
+        contacts alone).
+    cam_stiffness : float
+        Radial stiffness of the cam's support, N/mm; inf: held where its offset puts it; 0: floating.
     tables : RingTables
         The ring's influence and the nominal rim at the tooth and ball angles (what every solver pass reads).
     """
@@ -60,6 +65,14 @@ class ElasticModel:
     torque_sign: float
     ei_parts: dict
     tables: RingTables
+    lateral_stiffness: float = 0.0
+    cam_stiffness: float = float("inf")
+
+    @property
+    def support_stiffness(self) -> np.ndarray:
+        """Stiffness of each rigid-body freedom of the contact problem: rim ``dx, dy`` (its support), rim rotation
+        (free: the torque balances it), cam ``dx, dy`` (its support; inf: held), N/mm and N mm/rad."""
+        return np.array([self.lateral_stiffness, self.lateral_stiffness, 0.0, self.cam_stiffness, self.cam_stiffness])
     #: results reused between load states of this model (the tooth pairs measured at the nominal state)
     cache: dict = field(default_factory=dict, repr=False, compare=False)
 
@@ -150,5 +163,19 @@ def build_model(drive, sections: int = 3) -> ElasticModel:
     k_cup = G * 2.0 * pi * r_c**3 * t_cup / cup_len if cup_len > 0 else float("inf")
     laws = [drive.law_at(float(z)) if drive.coned else drive.law for z in zs]
     tables = ring_tables(ring, d.drive.z_flex, psi, laws, drive.law)
+    k_lat = d.load.rim_lateral_stiffness_n_per_mm
+    if k_lat is None:
+        k_lat = cup_lateral_stiffness(E, G, r_c, t_cup, d.generator.cone_length - d.generator.generator_z) if f is not None else 0.0
+    k_cam = d.load.cam_support_stiffness_n_per_mm
     return ElasticModel(drive, scene, ring, bearing, teeth, zs, widths, np.asarray(f_of(zs), dtype=float),
-                        float(k_cup), 1.0 if scene.working == "upper" else -1.0, parts, tables)
+                        float(k_cup), 1.0 if scene.working == "upper" else -1.0, parts, tables, float(k_lat),
+                        float("inf") if k_cam is None else float(k_cam))
+
+
+def cup_lateral_stiffness(E: float, G: float, r: float, t: float, length: float) -> float:
+    """Radial stiffness (N/mm) of a thin tube of radius ``r``, wall ``t`` and ``length``, clamped at the diaphragm,
+    loaded at its free end: bending ``L^3 / (3 E pi r^3 t)`` plus shear ``L / (k G 2 pi r t)`` with the thin tube's
+    shear coefficient ``k = 1/2`` (docs/models.md 4.1). The diaphragm's own tilt is left out: an upper bound."""
+    I = pi * r**3 * t
+    A = 2.0 * pi * r * t
+    return 1.0 / (length**3 / (3.0 * E * I) + length / (0.5 * G * A))

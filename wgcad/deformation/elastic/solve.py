@@ -2,18 +2,18 @@
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 from scipy.linalg import cho_factor, cho_solve
 
-from wgcad.errors import WgcadError
+from wgcad.errors import ModelError
 
-__all__ = ["ContactSolveError", "QPSolution", "solve_contact_qp"]
+__all__ = ["ContactSolveError", "QPSolution", "solve_contact_qp", "solve_supported"]
 
 
-class ContactSolveError(WgcadError, ArithmeticError):
-    """The contact problem has no solution or the solver did not converge (never returned silently)."""
+class ContactSolveError(ModelError):
+    """The contact problem has no solution or the solver did not converge (never returned silently; exit code 4)."""
 
 
 @dataclass(frozen=True)
@@ -73,6 +73,9 @@ def _kkt(M, q, A, f, W, MW=None):
     cf = cho_factor(Mw, check_finite=False)
     y = cho_solve(cf, np.column_stack([q[W], Aw]), check_finite=False)
     y_q, y_A = y[:, 0], y[:, 1:]
+    if r == 0:  # no free body (every freedom held or sprung): the contacts alone
+        F[W] = -y_q
+        return F, np.zeros(0)
     S = Aw.T @ y_A
     rhs = f + Aw.T @ y_q
     # S = A_W' M_WW^-1 A_W: singular when the active contacts cannot hold a rigid-body motion
@@ -144,8 +147,11 @@ def solve_contact_qp(M, q, A, f, active=None, tol_gap: float = 1e-12, max_iter: 
 
 
 def _finish(M, q, A, f, F, a, gap, it, tol_gap) -> QPSolution:
-    scale_f = float(np.abs(A * F[:, None]).max()) if F.size else 0.0
-    eq = float(np.abs(A.T @ F - f).max()) / max(scale_f, float(np.abs(f).max()), 1e-300)
+    if A.shape[1] == 0:
+        eq = 0.0
+    else:
+        scale_f = float(np.abs(A * F[:, None]).max()) if F.size else 0.0
+        eq = float(np.abs(A.T @ F - f).max()) / max(scale_f, float(np.abs(f).max()), 1e-300)
     if eq > 1e-9:
         raise ContactSolveError(
             f"contact solver: the active contacts cannot balance the loads (equilibrium residual {eq:.2e}); "
@@ -155,3 +161,33 @@ def _finish(M, q, A, f, F, a, gap, it, tol_gap) -> QPSolution:
     Fs = max(float(F.max()) if F.size else 0.0, 1e-300)
     comp = float(np.abs(F * gap).max()) / (Fs * qs) if F.size else 0.0
     return QPSolution(F, a, gap, it + 1, comp, eq)
+
+
+def solve_supported(M, q, A, f, stiffness, active=None) -> QPSolution:
+    """:func:`solve_contact_qp` with the rigid-body freedoms ``A`` ``(m, r)`` each free, sprung or held.
+
+    ``stiffness`` ``(r,)`` per freedom (N/mm or N mm/rad): 0, a free body
+    (an equality ``A_j' F = f_j``, its displacement a multiplier); ``inf``,
+    held (the freedom dropped); else an elastic support, whose compliance
+    ``A_j A_j' / k_j`` joins the contact compliance (``M`` must offer
+    ``with_support``) and whose displacement is
+    ``a_j = -(A_j' F - f_j) / k_j`` (docs/models.md 4.1). The returned ``a``
+    has all ``r`` freedoms.
+    """
+    k = np.asarray(stiffness, dtype=float)
+    eq = k == 0.0
+    sp = np.isfinite(k) & (k > 0.0)
+    q = np.asarray(q, dtype=float)
+    A = np.asarray(A, dtype=float)
+    f = np.asarray(f, dtype=float)
+    if sp.any():
+        c = 1.0 / k[sp]
+        As = A[:, sp]
+        M = M.with_support(As, c)
+        q = q - As @ (c * f[sp])
+    sol = solve_contact_qp(M, q, A[:, eq], f[eq], active=active)
+    a = np.zeros(len(k))
+    a[eq] = sol.a
+    if sp.any():
+        a[sp] = -c * (As.T @ sol.F - f[sp])
+    return replace(sol, a=a)

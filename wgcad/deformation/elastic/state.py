@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
@@ -11,9 +11,10 @@ from wgcad.errors import DesignError
 from wgcad.placement import pose_from_displacements
 
 from .anderson import Anderson
+from .cam import ball_rows, cam_excess, generator_torque, mounted
 from .loaded import LoadedLaw
 from .model import ElasticModel
-from .solve import ContactSolveError, solve_contact_qp
+from .solve import ContactSolveError, solve_supported
 from .tables import Compliance
 from .pairs import GAP_MARGIN, MeasuredPairs
 
@@ -35,10 +36,11 @@ _MAX_LINEARISATIONS = 100
 _OMEGA_MIN = 1.0 / 64.0
 #: Solutions the re-linearisation's Anderson acceleration combines (0: plain fixed-point iteration).
 ANDERSON_DEPTH = 3
-#: A cold start's first pass (nominal geometry) solves the contact problem up to this many times, the Hertz
-#: contacts linearised again about each solution's forces (no engine call: the poses have not moved).
-#: Linearised about no load the balls (P ~ delta^(3/2)) are far too soft: one solve moved the teeth three
-#: times too far (D1, 1500 N m: 0.52 mm, then 0.37 mm back), and the next passes re-measured every pair.
+#: Every state's first pass solves the contact problem up to this many times, the Hertz contacts linearised
+#: again about each solution's forces (no engine call: the poses have not moved). Linearised about a much
+#: smaller load the balls (P ~ delta^(3/2)) are far too soft: one solve moved the teeth three times too far
+#: (D1, 1500 N m from cold: 0.52 mm, then 0.37 mm back), and a warm start from 0 to 3000 N m crawled under
+#: relaxation past 100 passes.
 _HERTZ_START = 8
 #: ... until the forces change by less than this share of the largest (a starting point, not the answer:
 #: the passes that follow converge to the same fixed point).
@@ -82,6 +84,11 @@ class LoadState:
     timing: dict = field(default_factory=dict)
     #: the tooth pairs measured on the exact geometry at this state (a warm start's first pass reuses them)
     pairs: object = field(default=None, repr=False, compare=False)
+    #: torque the balls put on the cam, N mm (counter-clockwise positive; frictionless: on average over a mesh
+    #: period the output torque over the ratio, docs/models.md 4.1)
+    generator_torque: float = 0.0
+    #: the cam's motion against its support, mm (generator frame; zero when it is held)
+    cam_shift: np.ndarray = field(default_factory=lambda: np.zeros(2))
 
     @property
     def mesh_wind_up(self) -> float:
@@ -117,9 +124,12 @@ def _rim(model: ElasticModel, loads: np.ndarray, rigid) -> tuple:
     dx, dy, rot = (float(x) for x in rigid)
     nom = tab.nominal
     f = model.scales[:, None]
-    w = nom[:, 0] + f * el[0] + (dx * c + dy * sn) - rot * nom[:, 1]
-    v = nom[:, 1] + f * el[1] + (-dx * sn + dy * c) + rot * (model.drive.r_m + nom[:, 0])
-    th = nom[:, 2] + f * el[2] + rot
+    # the rim is round when unloaded: the cam's balls bend it (their forces are among the loads), so the
+    # elastic field is the whole displacement; the rotation turns the deformed rim, which is the nominal
+    # law to within the bearing's clearance (its coupling terms are second order: rot times w, v)
+    w = f * el[0] + (dx * c + dy * sn) - rot * nom[:, 1]
+    v = f * el[1] + (-dx * sn + dy * c) + rot * (model.drive.r_m + nom[:, 0])
+    th = f * el[2] + rot
     return w, v, th, el
 
 
@@ -165,14 +175,12 @@ def _assemble(model: ElasticModel, pairs: MeasuredPairs, keys, el, rigid, e, F_p
     br = model.bearing
     tab = model.tables
     Z = len(br.psi)
-    # balls: b = (-1, 0, 0) at psi_i, A = (-cos, -sin, v_nom), q = clearance - e . e_r (exact: linear in the state)
-    v_nom = tab.centre_ball[1]
-    cb, sb = np.cos(br.psi), np.sin(br.psi)
+    # balls: along the cam's normals, the rim round when unloaded (cam.ball_rows, docs/models.md 4.1)
+    rows = ball_rows(model, cam_excess(model), e)
     idx_b = tab.z_g + np.arange(Z)
-    b_b = np.tile([-1.0, 0.0, 0.0], (Z, 1))
-    A_b = np.stack([-cb, -sb, v_nom], axis=-1)
+    b_b, A_b = rows.b, rows.A
     o_b, s_b = br.tangent(F_prev_ball, FORCE_FLOOR)
-    q_b = br.clearance - (e[0] * cb + e[1] * sb) + o_b
+    q_b = rows.q + o_b
     if len(keys) == 0:
         return idx_b, b_b, np.ones(Z), A_b, q_b, s_b
     sec, tooth = np.divmod(keys // 2, tab.z_g)
@@ -182,7 +190,7 @@ def _assemble(model: ElasticModel, pairs: MeasuredPairs, keys, el, rigid, e, F_p
     s_t = s_t + model.teeth.bending(pairs.point[keys], pairs.normal[keys], width)
     q_t = pairs.q_geo[keys] + o_t
     return (np.concatenate([idx_b, tooth]), np.concatenate([b_b, pairs.b[keys]]), np.concatenate([np.ones(Z), f_t]),
-            np.concatenate([A_b, pairs.A[keys]]), np.concatenate([q_b, q_t]), np.concatenate([s_b, s_t]))
+            np.concatenate([A_b, np.pad(pairs.A[keys], ((0, 0), (0, 2)))]), np.concatenate([q_b, q_t]), np.concatenate([s_b, s_t]))
 
 
 def _first_guess(model: ElasticModel, keys, q, Z: int, torque_nm: float):
@@ -247,7 +255,7 @@ def solve_load(model: ElasticModel, torque_nm: float, cam_offset_um: float = 0.0
         raise DesignError("tol", f"must be > 0 mm, got {tol:g}")
     e = _cam_offset(cam_offset_um, cam_offset_deg)
     M_rim = model.torque_sign * 1e3 * torque_nm
-    f_ext = np.array([0.0, 0.0, M_rim])
+    f_ext = np.array([0.0, 0.0, M_rim, 0.0, 0.0])
     tab = model.tables
     n_ang = len(tab.angles)
     Z = len(model.bearing.psi)
@@ -260,6 +268,10 @@ def solve_load(model: ElasticModel, torque_nm: float, cam_offset_um: float = 0.0
     if warm is not None:
         loads, rigid = _loads_on_table(tab, warm.laws[0].psi, warm.laws[0].loads), np.array(warm.rigid)
         F_ball = warm.contacts["force"][warm.contacts["kind"] == 0].copy()
+    else:
+        # a cold start begins on the cam: the rim pressed onto it by the balls alone (no teeth, no torque)
+        mnt = mounted(model, e)
+        loads, rigid, F_ball = mnt.loads.copy(), mnt.rigid.copy(), mnt.force.copy()
     centre = model.drive.law
     t_geo = t_sol = 0.0
     pivots = 0
@@ -267,18 +279,18 @@ def solve_load(model: ElasticModel, torque_nm: float, cam_offset_um: float = 0.0
     acc = Anderson(model.drive.r_m, ANDERSON_DEPTH)
     settled, relaxed = 0, False
     change = 0.0
-    cold = warm is None
     # a warm start's pairs were measured at exactly its state: the first pass measures only what moves
     if warm is not None and warm.pairs is not None and warm.pairs.model is model:
         pairs = warm.pairs.copy()
     else:
-        # a cold start's first pass is the nominal state: its pairs are measured once per model
-        if "nominal_pairs" not in model.cache:
+        # a cold start's first pass is the mounted state: its pairs are measured once per model and cam offset
+        key = ("mounted_pairs", float(e[0]), float(e[1]))
+        if key not in model.cache:
             nominal = MeasuredPairs(model)
-            rot0, shift0, origin0, el0, cand0 = _poses(model, np.zeros((n_ang, 3)), np.zeros(3))
-            nominal.update(rot0, shift0, origin0, el0, cand0, np.zeros(3), full=True)
-            model.cache["nominal_pairs"] = nominal
-        pairs = model.cache["nominal_pairs"].copy()
+            rot0, shift0, origin0, el0, cand0 = _poses(model, loads, rigid)
+            nominal.update(rot0, shift0, origin0, el0, cand0, rigid, full=True)
+            model.cache[key] = nominal
+        pairs = model.cache[key].copy()
     for it in range(_MAX_LINEARISATIONS):
         t0 = time.perf_counter()
         rot, shift, origin, el, cand = _poses(model, loads, rigid, tooth_errors)
@@ -291,17 +303,20 @@ def solve_load(model: ElasticModel, torque_nm: float, cam_offset_um: float = 0.0
         M = Compliance(tab, idx, b * f[:, None], s_c)
         active = np.concatenate([F_ball > 0, prev_active[keys]])
         F_h = F = None  # F: the solution of the pass (set by the first solve below)
-        for h in range(_HERTZ_START if (it == 0 and cold) else 1):
+        for h in range(_HERTZ_START if it == 0 else 1):
             if h:
                 if F_h is not None and np.abs(F - F_h).max() <= _HERTZ_TOL * F.max():
                     break
-                # a cold start's first pass: the Hertz contacts linearised again about the forces just found,
+                # the first pass: the Hertz contacts linearised again about the forces just found,
                 # on the same geometry (its poses have not moved: no engine call), before the teeth move
                 _, _, _, _, q, s_c = _assemble(model, pairs, keys, el, rigid, e, F[:Z], F[Z:])
                 M = M.with_contact(s_c)
                 active = F > 0
             try:
-                sol = solve_contact_qp(M, q, A, f_ext, active=active if (it or h) else _first_guess(model, keys, q, Z, torque_nm))
+                sol = solve_supported(M, q, A, f_ext, model.support_stiffness,
+                                      active=active if (it or h) else _first_guess(model, keys, q, Z, torque_nm))
+                cam_shift = sol.a[3:].copy()
+                sol = replace(sol, a=sol.a[:3])
             except ContactSolveError as exc:
                 if torque_nm > 0 and len(keys) and "balance" in str(exc):
                     raise DesignError("generator.w0_coef", f"no set of tooth contacts can carry {torque_nm:g} N m: the teeth never meet "
@@ -354,7 +369,9 @@ def solve_load(model: ElasticModel, torque_nm: float, cam_offset_um: float = 0.0
         prev_active = np.zeros(n_keys, dtype=bool)
         prev_active[keys] = F[Z:] > 0
     else:
-        raise ContactSolveError(f"load state at {torque_nm:g} N m: tooth positions still moving after {_MAX_LINEARISATIONS} re-linearisations")
+        raise ContactSolveError(f"the elastic model did not converge at {torque_nm:g} N m: tooth positions still moving by "
+                                f"{1e3 * change:.3g} um after {_MAX_LINEARISATIONS} re-linearisations; a looser tolerance, "
+                                "a nearby torque or more side clearance may let it settle")
     # the reported state is the last contact solution itself (not a relaxed mixture): its forces, points and
     # normals are in equilibrium to round-off; the exact gaps are then measured on the final poses
     keys, F, sol, idx, b, f, point, normal = last
@@ -385,9 +402,10 @@ def solve_load(model: ElasticModel, torque_nm: float, cam_offset_um: float = 0.0
         appr_t = gap_t = np.zeros(0)
         exact_t = np.zeros(0, dtype=bool)
     cb, sb = np.cos(model.bearing.psi), np.sin(model.bearing.psi)
-    w_nom, v_nom = tab.centre_ball
-    wb = (tab.influence[3 * tab.z_g :: 3] @ loads.ravel()) + rigid[0] * cb + rigid[1] * sb - rigid[2] * v_nom
-    gap_b = model.bearing.clearance - (e[0] * cb + e[1] * sb) + wb
+    w_nom, v_nom, _ = tab.centre_ball
+    rows = ball_rows(model, cam_excess(model), e)
+    U_b = (tab.influence[3 * tab.z_g:] @ loads.ravel()).reshape(-1, 3)
+    gap_b = rows.q - (rows.b * U_b).sum(axis=1) - rows.A @ np.concatenate([rigid, cam_shift])
     appr_b = model.bearing.approach(F_ball)
     # exact complementarity of the nonlinear contacts: gap + approach >= 0, F >= 0, F (gap + approach) = 0
     g_all = np.concatenate([gap_b + appr_b, gap_t + appr_t])
@@ -408,7 +426,7 @@ def solve_load(model: ElasticModel, torque_nm: float, cam_offset_um: float = 0.0
         "gap_exact": np.concatenate([np.ones(Z, dtype=bool), exact_t]),
         "approach": np.concatenate([appr_b, appr_t]),
         "point": np.concatenate([ball_pt, point if n_t else empty2]),
-        "normal": np.concatenate([-np.stack([cb, sb], axis=-1), normal if n_t else empty2]),
+        "normal": np.concatenate([-rows.normal, normal if n_t else empty2]),
     }
     residuals = {
         "equilibrium": sol.equilibrium,
@@ -420,7 +438,9 @@ def solve_load(model: ElasticModel, torque_nm: float, cam_offset_um: float = 0.0
         "position_change_mm": change,
         "settled_by_relaxation": relaxed,
     }
-    return LoadState(model, float(torque_nm), e, laws, rigid, contacts, residuals, {"geometry": t_geo, "solver": t_sol}, pairs2)
+    # the torque the balls put on the cam (docs/models.md 4.1)
+    return LoadState(model, float(torque_nm), e, laws, rigid, contacts, residuals, {"geometry": t_geo, "solver": t_sol}, pairs2,
+                     generator_torque(rows, F_ball), cam_shift)
 
 
 def _displaced(points: np.ndarray, tooth_errors) -> np.ndarray:

@@ -9,6 +9,7 @@ import numpy as np
 
 from wgcad.constants import INTERFERENCE_TOL
 
+from .cam import cam_excess, mounted
 from .mesh import entry_gaps
 from .model import ElasticModel
 from .state import LoadState, solve_load
@@ -41,10 +42,17 @@ def level_summary(st: LoadState, entry=None) -> dict:
     gp = iter(entry if entry is not None else entry_gaps(m.scene, _entry_laws(st)))
     for w, phase in enumerate((0.0, pi)):
         for i, law in enumerate(st.laws):
-            g, phi = next(gp)
-            entries.append({"wave": w, "section_z_mm": float(m.zs[i]), "entry_gap_um": round(1e3 * g, 4),
-                            "tooth_angle_deg": _deg(phi + phase)})
-    gaps = [e["entry_gap_um"] for e in entries if np.isfinite(e["entry_gap_um"])]
+            p = next(gp)
+            ok = bool(np.isfinite(p.delta))
+            entries.append({"wave": w, "section_z_mm": float(m.zs[i]),
+                            "entry_gap_um": round(1e3 * p.delta, 4) if ok else None,
+                            "tooth_angle_deg": _deg(p.delta_phi + phase) if ok else None,
+                            "edge": p.delta_edge or None, "kind": p.delta_kind or None,
+                            "crossing_um": round(1e3 * min(p.crossing_gaps), 4) if ok else None,
+                            "crossing_tooth_angle_deg": _deg(p.crossing + phase) if ok else None})
+    gaps = [e["entry_gap_um"] for e in entries if e["entry_gap_um"] is not None]
+    cross = [e["crossing_um"] for e in entries if e["crossing_um"] is not None]
+    at = min((e for e in entries if e["entry_gap_um"] is not None), key=lambda e: e["entry_gap_um"], default=None)
     sections = []
     for i in range(len(m.zs)):
         sel = tooth & (c["section"] == i) & (F > 0)
@@ -74,6 +82,8 @@ def level_summary(st: LoadState, entry=None) -> dict:
     return {
         "torque_nm": st.torque_nm,
         "entry_gap_um": min(gaps) if gaps else None,
+        "entry_gap_at": None if at is None else {k: at[k] for k in ("wave", "section_z_mm", "tooth_angle_deg", "edge", "kind")},
+        "crossing_gap_um": min(cross) if cross else None,
         "entry": entries,
         "min_clearance_um": round(1e3 * float(c["gap"][free].min()), 4) if free.any() else None,
         "max_contact_approach_um": round(1e3 * float(c["approach"][tooth].max()), 4) if tooth.any() else 0.0,
@@ -89,11 +99,28 @@ def level_summary(st: LoadState, entry=None) -> dict:
         "max_ball_load_n": round(float(F[~tooth].max()), 3),
         "max_ball_pressure_mpa": round(float(m.bearing.pressure(F[~tooth]).max()), 1),
         "wind_up_arcmin": round(float(np.rad2deg(st.wind_up) * 60.0), 5),
+        "generator_torque_nm": round(1e-3 * st.generator_torque, 6),
+        "output_torque_over_ratio_nm": round(st.torque_nm / abs(m.scene.ratios["u_hg"]), 6),
         "mesh_wind_up_arcmin": round(float(np.rad2deg(st.mesh_wind_up) * 60.0), 5),
         "rim_shift_um": [round(1e3 * float(x), 4) for x in st.rigid[:2]],
         "residuals": {k: (float(v) if not isinstance(v, int) else v) for k, v in st.residuals.items()},
         "timing_s": {k: round(v, 4) for k, v in st.timing.items()},
     }
+
+
+def mounted_summary(model: ElasticModel, e) -> dict:
+    """The rim on the cam at no load (before the mesh): its W0, how far it departs from the design's law, the balls holding it."""
+    mt = mounted(model, e)
+    tab = model.tables
+    phi = tab.angles[: tab.z_g]
+    el = tab.tooth_field(mt.loads)
+    w = el[0] + mt.rigid[0] * np.cos(phi) + mt.rigid[1] * np.sin(phi)
+    law = model.drive.law.state(phi).w
+    dev = w - law
+    i = int(np.argmax(np.abs(dev)))
+    return {"w0_um": round(1e3 * mt.w0, 3), "cam_excess": round(cam_excess(model), 6),
+            "largest_departure_from_law_um": round(1e3 * float(dev[i]), 3), "departure_at_deg": _deg(phi[i]),
+            "balls_in_contact": int((mt.force > 0).sum()), "ball_preload_n": round(float(mt.force.max()), 3)}
 
 
 def torque_sweep(model: ElasticModel, torques_nm, cam_offset_um: float = 0.0, cam_offset_deg: float = 0.0,
@@ -102,7 +129,7 @@ def torque_sweep(model: ElasticModel, torques_nm, cam_offset_um: float = 0.0, ca
 
     Returns
     -------
-    dict with ``levels`` (list of :func:`level_summary`), ``stiffness_nm_per_rad``
+    dict with ``levels`` (list of :func:`level_summary`), ``secant_stiffness_nm_per_rad`` and ``tangent_stiffness_nm_per_rad``
     (secant between neighbouring levels), ``entry_gap_closes`` (bool) and settings.
     """
     kw = {} if tol is None else {"tol": tol}
@@ -121,14 +148,21 @@ def torque_sweep(model: ElasticModel, torques_nm, cam_offset_um: float = 0.0, ca
     gaps = entry_gaps(model.scene, [law for st in states for law in _entry_laws(st)])
     levels = [level_summary(st, gaps[k * n_e:(k + 1) * n_e]) for k, st in enumerate(states)]
     t_summary = time.perf_counter() - t1
-    stiff = []
+    # stiffness as catalogues state it: secant from the first level (zero load when the sweep starts there) and
+    # tangent, estimated by the increment between neighbouring levels
+    secant, tangent = [], []
+    for st in states:
+        dth = st.wind_up - states[0].wind_up
+        secant.append(round((st.torque_nm - states[0].torque_nm) / dth, 1) if dth > 0 else None)
     for a, b in zip(states[:-1], states[1:]):
         dth = b.wind_up - a.wind_up
-        stiff.append(round((b.torque_nm - a.torque_nm) / dth, 1) if dth > 0 else None)
+        tangent.append(round((b.torque_nm - a.torque_nm) / dth, 1) if dth > 0 else None)
     closes = any(lv["entry_gap_um"] is not None and lv["entry_gap_um"] < -1e3 * INTERFERENCE_TOL for lv in levels)
     return {
         "levels": levels,
-        "stiffness_nm_per_rad": stiff,
+        "secant_stiffness_nm_per_rad": secant,
+        "secant_from_torque_nm": states[0].torque_nm if states else None,
+        "tangent_stiffness_nm_per_rad": tangent,
         "entry_gap_closes": bool(closes),
         "interference_tol_um": 1e3 * INTERFERENCE_TOL,
         "cam_offset_um": cam_offset_um,
@@ -137,6 +171,7 @@ def torque_sweep(model: ElasticModel, torques_nm, cam_offset_um: float = 0.0, ca
             "ring_ei_n_mm2": {k: round(v, 1) for k, v in model.ei_parts.items()},
             "cup_torsional_stiffness_nm_per_rad": round(model.cup_stiffness * 1e-3, 1),
             "bearing_clearance_um": round(1e3 * model.bearing.clearance, 3),
+            "mounted": mounted_summary(model, states[0].cam_offset if states else np.zeros(2)),
             "sections_z_mm": [float(z) for z in model.zs],
         },
         "elapsed_s": round(time.perf_counter() - t0, 4),

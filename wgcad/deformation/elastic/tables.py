@@ -33,8 +33,9 @@ class RingTables:
         (radial, tangential, couple) at angle ``j``.
     nominal : (S, 3, z_g) float
         ``w, v, theta`` of each section's nominal law at the tooth angles.
-    centre_ball : (2, Z) float
-        ``w, v`` of the centre law at the ball angles.
+    centre_ball : (3, Z) float
+        ``w, v, theta`` of the centre law at the ball angles (the cam's shape and normals there,
+        docs/models.md 4.1).
     """
 
     angles: np.ndarray
@@ -68,7 +69,7 @@ def ring_tables(ring: Ring, z_g: int, ball_psi: np.ndarray, section_laws, centre
     cb = centre_law.state(np.asarray(ball_psi, dtype=float))
     for a in (ang, influence, nominal):
         a.setflags(write=False)
-    return RingTables(ang, int(z_g), influence, nominal, np.stack([cb.w, cb.v]))
+    return RingTables(ang, int(z_g), influence, nominal, np.stack([cb.w, cb.v, cb.theta]))
 
 
 class Compliance:
@@ -114,9 +115,27 @@ class Compliance:
             Z = np.einsum("kar,ka->kr", src, self._fb[new])  # (k, 3 n)
             D = np.einsum("kja,ja->jk", Z[:, self._rows].reshape(len(new), m, 3), self._fb)
             D[new, np.arange(len(new))] += self._s[new]
+            if getattr(self, "_At", None) is not None:
+                D += (self._At * self._c_sup) @ self._At[new].T
             self._D[:, new] = D
             self._have[new] = True
         return self._D[:, W]
+
+    def with_support(self, At: np.ndarray, c) -> "Compliance":
+        """The same compliance plus elastic supports of rigid-body freedoms: ``At diag(c) At'`` (``At`` ``(m, k)``: each
+        contact's ``A`` rows for those freedoms, ``c`` ``(k,)`` the supports' compliances). Contact forces move the
+        bodies by ``-c At' F`` against their supports, which every gap feels (docs/models.md 4.1)."""
+        new = object.__new__(Compliance)
+        new.__dict__.update(self.__dict__)
+        new._At = np.asarray(At, dtype=float)
+        new._c_sup = np.broadcast_to(np.asarray(c, dtype=float), (new._At.shape[1],)).copy()
+        new._D = self._D.copy()
+        j = np.nonzero(self._have)[0]
+        if j.size:
+            new._D[:, j] += (new._At * new._c_sup) @ new._At[j].T
+        new._have = self._have.copy()
+        new.diag = self.diag + (new._At * new._At * new._c_sup).sum(axis=1)
+        return new
 
     def with_contact(self, s: np.ndarray) -> "Compliance":
         """The same ring part with contact compliances ``s`` ``(m,)`` on the diagonal (the columns built so far kept)."""
