@@ -255,3 +255,63 @@ def test_csv_rows_round_trip(tmp_path):
                                      ALPHA, ALPHA_W)
     np.testing.assert_allclose(got[:, header.index("double_dT_um")], 1e3 * ref["double"].dT, rtol=1e-8, atol=1e-9)
     assert not [p for p in tmp_path.iterdir() if p.name != "flank.csv"]  # no temporary left behind
+
+
+@pytest.mark.parametrize("zone", [0.0, math.pi])
+def test_drive_errors_in_s2_terms_are_the_drive_poses_errors(zone):
+    # accuracy.drive_displacements maps an imperfect drive's errors onto [S2]'s terms: the translations (both
+    # eccentricities, the cam offsets) as radial and tangential motion of the flexspline's tooth against the
+    # rigid one in the zone, the run-outs along the line of action. The same errors move the posed teeth of
+    # accuracy.imperfect (flex_poses, rigid_poses); at whole mesh periods a flexspline tooth sits on the zone
+    # and rigid teeth flank it symmetrically, so the relative motion of the posed teeth, radial and along the
+    # pitch circle, must be the mapping's, dr and dt + kin / cos(alpha). Exact for the translations; the run-out
+    # of the rigid gear is read between the two flanking teeth (their mean differs from the zone's value by
+    # cos(pi / z_b) - 1, 1e-4 relative); all to first order in the errors: the poses turn the teeth by up to
+    # theta = (F_g/2 + e_g + F_b/2) / r ~ 1e-3 rad, whose second-order part moves a point by up to r theta^2
+    # (1e-4 mm), against errors of tens of micrometres (a wrong phase or factor would be off by those).
+    from pathlib import Path
+
+    from wgcad.accuracy.flank_errors import drive_displacements
+    from wgcad.accuracy.imperfect import Imperfections, flex_poses, rigid_poses
+    from wgcad.design import load_design
+    from wgcad.drive import build_drive
+
+    drive = build_drive(load_design(Path(__file__).resolve().parents[1] / "templates" / "d2.toml"))
+    imp = Imperfections(flex_runout=0.075, flex_runout_phase=1.1, rigid_runout=0.075, rigid_runout_phase=-0.7,
+                        flex_ecc=0.01, flex_ecc_phase=0.3, rigid_ecc=0.012, rigid_ecc_phase=2.5, cam_cam=0.08,
+                        cam_cam_phase=1.57, cam_fixed=0.03, cam_fixed_phase=0.4, cam_flex=0.02, cam_flex_phase=2.0,
+                        rigid_install=0.6, flex_install=-0.2)
+    d = drive.design.drive
+    z_g, z_b = d.z_flex, d.z_rigid
+    sigma = 1 if d.rotation == "ccw" else -1
+    alpha = math.radians(drive.design.tooth.pressure_angle_deg)
+    r = drive.flex.r
+    tol = r * ((0.5 * imp.flex_runout + imp.flex_ecc + 0.5 * imp.rigid_runout) / r) ** 2
+    for n in (0, 7, 1013, 5050, 14141):
+        phi_h = sigma * n * 2 * math.pi / z_b
+        Z = zone + phi_h
+        er, et = np.array([math.cos(Z), math.sin(Z)]), np.array([-math.sin(Z), math.cos(Z)])
+        # the flexspline tooth on the zone: its angle zone + phi_h - phi_g on the flexspline is a whole tooth
+        phi_g = phi_h * (z_g - z_b) / z_g
+        k = int(round((Z - phi_g) / (2 * math.pi / z_g))) % z_g
+        # a point of the tooth on its centre line at the pitch radius, with and without the errors
+        p = np.array([r, 0.0])
+        moved = []
+        for im in (imp, Imperfections()):
+            rot, shift = flex_poses(drive, im, phi_h, teeth=np.array([k]))
+            moved.append(np.array([math.cos(rot[0]) * p[0] - math.sin(rot[0]) * p[1],
+                                   math.sin(rot[0]) * p[0] + math.cos(rot[0]) * p[1]]) + shift[0])
+        df = moved[0] - moved[1]
+        # the two rigid teeth flanking the zone: their mean motion at the pitch radius
+        j = int(np.floor(Z / (2 * math.pi / z_b) - 0.5)) % z_b
+        jj = np.array([j, (j + 1) % z_b])
+        ri, si = rigid_poses(drive, imp, jj)
+        r0, s0 = rigid_poses(drive, Imperfections(), jj)
+        rb = drive.rigid.r
+        pts = [np.stack([rb * np.cos(rr), rb * np.sin(rr)], axis=-1) + ss for rr, ss in ((ri, si), (r0, s0))]
+        db = (pts[0] - pts[1]).mean(axis=0)
+        rel = df - db
+        dr, dt, kin = drive_displacements(drive, imp, phi_h, zone)
+        assert abs(float(rel @ er) - float(dr)) < tol, (n, float(rel @ er), float(dr))
+        assert abs(float(rel @ et) - float(dt + kin / math.cos(alpha))) < tol, (n, float(rel @ et), float(dt + kin / math.cos(alpha)))
+        assert np.hypot(*rel) > 0.05  # the errors do move the teeth by tens of micrometres here

@@ -45,6 +45,8 @@ __all__ = [
     "flank_errors_over_rotation",
     "flank_error_table",
     "write_flank_error_csv",
+    "drive_displacements",
+    "drive_flank_errors",
 ]
 
 #: engagement types: both flanks in contact, or one flank (left: the working
@@ -209,6 +211,12 @@ def flank_errors(theta_flex, theta_rigid, ecc: Eccentricities, alpha: float, alp
     dr = ecc.flex_geometric * np.cos(ty) + ecc.rigid_geometric * np.cos(tb)
     dt = ecc.flex_geometric * np.sin(ty) + ecc.rigid_geometric * np.sin(tb)
     kin = ecc.flex_kinematic * np.sin(ty + ecc.flex_phase) + ecc.rigid_kinematic * np.sin(tb + ecc.rigid_phase)
+    return _take_up(dr, dt, kin, alpha, alpha_w, engagement)
+
+
+def _take_up(dr, dt, kin, alpha: float, alpha_w: float, engagement: str) -> FlankErrors:
+    """The mesh's radial and tangential motion that takes up a relative displacement of the teeth in a zone:
+    ``dr`` radial, ``dt`` tangential (geometric), ``kin`` along the line of action (docs/models.md 6.1)."""
     sa, ca = math.sin(alpha), math.cos(alpha)
     sw, cw = math.sin(alpha_w), math.cos(alpha_w)
     if engagement == "double":
@@ -219,6 +227,57 @@ def flank_errors(theta_flex, theta_rigid, ecc: Eccentricities, alpha: float, alp
         return FlankErrors(dR=dn / sw, dT=dn / cw)
     dn = sa * dr - ca * dt - kin
     return FlankErrors(dR=dn / sw, dT=-dn / cw)
+
+
+def drive_displacements(drive, imp, phi_h, zone: float = 0.0):
+    """The relative displacement of the flexspline's tooth against the rigid gear's in a mesh zone of an imperfect
+    drive, split as [S2] does (docs/models.md 6.1): ``dr``, ``dt`` from the translations (both gears'
+    eccentricities, the cam offsets), ``kin`` from the run-outs along the line of action.
+
+    Everything is read from the drive's own error field (:mod:`wgcad.accuracy.imperfect`): the teeth of the
+    zone at generator angle ``phi_h`` (rad, rigid gear fixed) are the flexspline's tooth at its angle
+    ``zone + phi_h - phi_g`` and the rigid gear's at ``zone + phi_h``; a run-out ``F`` deviates a tooth along
+    the pitch circle by ``(F/2) sin(a + xi)``, which is ``cos(alpha)`` of that along the line of action
+    ([S2]'s ``e_k``); a translation ``D`` of the flexspline's teeth relative to the rigid ones is ``D . e_r``
+    radially and ``D . e_t`` tangentially in the zone ([S2]'s geometric terms). The cam offsets move the
+    flexspline's teeth with the rim: the cam-borne one is constant in the zone (a constant term), the
+    stationary one turns against it once a generator turn (as a rigid-gear eccentricity), the
+    flexspline-borne one with the flexspline.
+
+    Returns
+    -------
+    dr, dt, kin : (...) float, mm
+    """
+    from .imperfect import cam_offset, rigid_translation
+
+    d = drive.design.drive
+    phi_h = np.asarray(phi_h, dtype=np.float64)
+    phi_g = phi_h * (d.z_flex - d.z_rigid) / d.z_flex  # phi_h / u_hg, rigid gear fixed (docs/models.md 1)
+    Z = zone + phi_h  # the zone's direction in the rigid gear's frame
+    a_f = Z - phi_g  # the flexspline tooth there, in the flexspline's own frame
+    g = imp.flex_install
+    T_f = imp.flex_ecc * np.stack([np.cos(imp.flex_ecc_phase + g + phi_g), np.sin(imp.flex_ecc_phase + g + phi_g)], axis=-1)
+    D = T_f + cam_offset(imp, phi_h, phi_g) - rigid_translation(imp)
+    er = np.stack([np.cos(Z), np.sin(Z)], axis=-1)
+    et = np.stack([-np.sin(Z), np.cos(Z)], axis=-1)
+    dr = (D * er).sum(axis=-1)
+    dt = (D * et).sum(axis=-1)
+    tan_f = 0.5 * imp.flex_runout * np.sin(a_f - g + imp.flex_runout_phase)
+    tan_b = 0.5 * imp.rigid_runout * np.sin(Z - imp.rigid_install + imp.rigid_runout_phase)
+    alpha = float(np.deg2rad(drive.design.tooth.pressure_angle_deg))
+    return dr, dt, (tan_f - tan_b) * math.cos(alpha)
+
+
+def drive_flank_errors(drive, imp, phi_h, engagement: str = "double", zone: float = 0.0,
+                       alpha_w: float | None = None) -> FlankErrors:
+    """[S2]'s ``dR``, ``dT`` of an imperfect drive in a mesh zone (:func:`drive_displacements`), docs/models.md 6.1.
+
+    ``alpha_w`` defaults to the profile angle (the teeth of both gears are cut to one rack)."""
+    if engagement not in ENGAGEMENTS:
+        raise DesignError("engagement", f"must be one of {', '.join(ENGAGEMENTS)}, got {engagement!r}")
+    alpha = float(np.deg2rad(drive.design.tooth.pressure_angle_deg))
+    dr, dt, kin = drive_displacements(drive, imp, phi_h, zone)
+    return _take_up(dr, dt, kin, alpha, alpha if alpha_w is None else alpha_w, engagement)
 
 
 def flank_errors_over_rotation(phi_h, z_flex: int, z_rigid: int, ecc: Eccentricities, alpha: float,

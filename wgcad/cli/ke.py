@@ -17,7 +17,6 @@ def cmd_ke(args) -> int:
 
     import numpy as np
 
-    from ..accuracy import flank_error_table
     from ..accuracy import ke as K
     from ..accuracy.imperfect import Imperfections, shortcuts
     from ..design import load_design
@@ -106,16 +105,17 @@ def cmd_ke(args) -> int:
             if scan is not None:
                 Path(batch.temp_path(stem.with_name(stem.name + "_install.png"))).write_bytes(
                     install_png(f"{d.name}: largest KE against installation angle", scan[0], scan[1], scan[2], scan[3], scan[0], scan[4]))
-            s = design.imperfections
-            header, rows = flank_error_table(
-                np.linspace(0.0, 720.0, 1441), z_flex=d.z_flex, z_rigid=d.z_rigid,
-                pressure_angle_deg=design.tooth.pressure_angle_deg, working_pressure_angle_deg=design.tooth.pressure_angle_deg,
-                flex_geometric_um=s.flex_eccentricity_um, rigid_geometric_um=s.rigid_eccentricity_um,
-                flex_kinematic_um=0.5 * s.flex_runout_um, rigid_kinematic_um=0.5 * s.rigid_runout_um,
-                flex_phase_deg=s.flex_runout_phase_deg - s.flex_eccentricity_phase_deg,
-                rigid_phase_deg=s.rigid_runout_phase_deg - s.rigid_eccentricity_phase_deg)
+            from ..accuracy.flank_errors import ENGAGEMENTS, drive_flank_errors
+            from ..accuracy.imperfect import full_cycle_turns
+
+            # [S2]'s model on the drive's own errors (docs/models.md 6.1) over the whole error cycle
+            cyc = full_cycle_turns(d.z_flex, d.z_rigid)
+            sgn = 1.0 if d.rotation == "ccw" else -1.0
+            turns = np.linspace(0.0, cyc, 200 * cyc + 1)
+            errs = {(zi, eng): drive_flank_errors(drive, imp, sgn * 2 * np.pi * turns, eng, zone=zone)
+                    for zi, zone in enumerate((0.0, np.pi)) for eng in ENGAGEMENTS}
             Path(batch.temp_path(stem.with_name(stem.name + "_flank.png"))).write_bytes(
-                flank_png(f"{d.name}: double- and single-flank errors of the gears (docs/models.md 6.1)", header, rows))
+                flank_png(f"{d.name}: mesh errors of [S2]'s model, from the design's errors (docs/models.md 6.1)", turns, errs))
     return EXIT_OK
 
 

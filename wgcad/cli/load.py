@@ -95,6 +95,11 @@ def _sweep(path, torques, e_um, e_deg, sections, progress):
     from ..drive import build_drive
 
     drive = build_drive(load_design(path))
+    if drive.design.imperfections.any:
+        # the load audit models perfect parts: silently dropping the errors would report another drive
+        raise DesignError("imperfections", "the load audit (--torque-nm) models perfect parts and this design has "
+                          "[imperfections]: its KE under load is `wgcad ke --torque-nm`, its no-load clearance `wgcad audit` "
+                          "without --torque-nm; for the perfect drive's load audit remove the table")
     ld = drive.design.load
     e_um = ld.cam_offset_um if e_um is None else e_um
     e_deg = ld.cam_offset_deg if e_deg is None else e_deg

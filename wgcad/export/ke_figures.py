@@ -75,20 +75,35 @@ def install_png(title: str, rigid_deg, rigid_pp, best_deg, best_pp, flex_deg=Non
     return _png(fig, plt)
 
 
-def flank_png(title: str, header, rows) -> bytes:
-    """dR and dT (um) of both engagement types over the generator angle, from :func:`wgcad.accuracy.flank_error_table`."""
+#: plain names of the engagement types of [S2] in the figure's legend
+_ENGAGEMENT_NAMES = {"double": "double-flank (both flanks in contact)", "single_left": "single-flank, working flanks",
+                     "single_right": "single-flank, the other flanks"}
+
+
+def flank_png(title: str, turns, errors: dict, zones=("major axis", "second wave")) -> bytes:
+    """[S2]'s radial and tangential mesh errors (um) of both engagement types over generator turns, per zone.
+
+    ``errors``: ``{(zone index, engagement): FlankErrors}`` with arrays over ``turns``
+    (:func:`wgcad.accuracy.drive_flank_errors`). The whole error cycle is drawn so that the beat of the
+    rigid gear's order against the flexspline's shows.
+    """
     plt = _plt()
-    data = np.asarray(rows, dtype=float)
-    fig, ax = plt.subplots(1, 2, figsize=(12, 4.5), dpi=90)
-    x = data[:, 0] / 360.0
-    for col, name in enumerate(header[1:], start=1):
-        a = ax[0] if name.endswith("dR_um") else ax[1]
-        a.plot(x, data[:, col], lw=0.8, label=name.rsplit("_", 2)[0])
-    for a, lab in zip(ax, ("dR (radial), um", "dT (tangential), um")):
-        a.set_xlabel("generator turns")
-        a.set_ylabel(lab)
+    fig, ax = plt.subplots(2, 1, figsize=(12, 7.5), dpi=110, sharex=True)
+    styles = {"double": dict(lw=1.1, color="k"), "single_left": dict(lw=0.7, color="tab:red", alpha=0.8),
+              "single_right": dict(lw=0.7, color="tab:blue", alpha=0.8)}
+    for (zi, eng), fe in errors.items():
+        st = dict(styles[eng])
+        if zi:
+            st.update(ls="--")
+        lab = f"{_ENGAGEMENT_NAMES[eng]}, {zones[zi]}"
+        ax[0].plot(turns, 1e3 * fe.dR, label=lab, **st)
+        ax[1].plot(turns, 1e3 * fe.dT, label=lab, **st)
+    ax[0].set_ylabel("radial mesh error dR, um")
+    ax[1].set_ylabel("tangential mesh error dT, um")
+    ax[1].set_xlabel("generator turns (the whole error cycle)")
+    for a in ax:
         a.grid(alpha=0.3)
-        a.legend(fontsize=8)
+    ax[0].legend(fontsize=8, loc="upper left", bbox_to_anchor=(1.01, 1.0), borderaxespad=0.0)
     fig.suptitle(title)
     return _png(fig, plt)
 
