@@ -409,18 +409,21 @@ def audit_imperfect(drive, settings, imp: Imperfections, progress=None, chunk_sa
     rs["entry_side"] = "entry (+phi)" if scene.entry_sign > 0 else "entry (-phi)"
     fold = lambda a: float((a + pi / scene.n_w) % (2 * pi / scene.n_w) - pi / scene.n_w)  # noqa: E731  (nearest major axis)
     if np.isfinite(ent.get("gap", np.nan)):
+        edge, gloc = _entry_edge(drive, imp, isc, ent["gap_phi_h"], ent["gap_tooth"], ent["gap_z"], settings.refine)
         gap_f = Finding("entry_crossing", ent["gap"], exact, tooth_angle=fold(ent["gap_tooth_angle"]), section_z=ent["gap_z"],
-                        generator_angle=ent["gap_phi_h"], tooth=ent["gap_tooth"],
-                        details={"crossing": "flexspline tip arc crossing the rigid tip circle",
+                        location=gloc, generator_angle=ent["gap_phi_h"], tooth=ent["gap_tooth"],
+                        details={"crossing": "flexspline tip arc crossing the rigid tip circle", "edge": edge,
                                  "passages": ent["passages"], "spread": ent["spread"], "all_passages": ent["all"],
                                  "perfect_gaps": [float(g[0]) for g, _ in gaps], "perfect_phi": [float(g[1]) for g, _ in gaps]})
     else:
         gap_f = Finding("entry_crossing", float("nan"), exact, details={"passages": ent.get("passages", 0)})
     if np.isfinite(ent.get("pinch", np.nan)):
         ploc = _classify(isc, ent["pinch_rot"], ent["pinch_shift"], ent["pinch_rigid"])
+        pedge = _entry_edge(drive, imp, isc, ent["pinch_phi_h"], ent["pinch_tooth"], ent["pinch_z"], settings.refine,
+                            rigid=ent["pinch_rigid"])[0]
         pinch_f = Finding("entry_pinch", ent["pinch"], exact, tooth_angle=fold(ent["pinch_tooth_angle"]),
                           section_z=ent["pinch_z"], location=ploc, generator_angle=ent["pinch_phi_h"], tooth=ent["pinch_tooth"],
-                          details={"tip_to_tip_risk": bool(ent["pinch"] < settings.interference_tol and ploc == "tip")})
+                          details={"edge": pedge, "tip_to_tip_risk": bool(ent["pinch"] < settings.interference_tol and ploc == "tip")})
     else:
         pinch_f = Finding("entry_pinch", float("nan"), exact, details={"tip_to_tip_risk": False})
     # Delta of [S1] (docs/models.md 5): the smallest gap of the entry, the pinch where the tips pass or, without
@@ -429,7 +432,7 @@ def audit_imperfect(drive, settings, imp: Imperfections, progress=None, chunk_sa
                        else (gap_f, "crossing"))
     delta_f = Finding("entry_gap", float(delta_src.value), exact, tooth_angle=delta_src.tooth_angle, section_z=delta_src.section_z,
                       location=delta_src.location, generator_angle=delta_src.generator_angle, tooth=delta_src.tooth,
-                      details={"kind": kind if np.isfinite(delta_src.value) else None, "edge": "working or non-working",
+                      details={"kind": kind if np.isfinite(delta_src.value) else None, "edge": delta_src.details.get("edge"),
                                "tip_to_tip_risk": bool(pinch_f.details.get("tip_to_tip_risk", False) and kind == "pinch")})
     findings = {
         "min_clearance": worst,
@@ -442,6 +445,21 @@ def audit_imperfect(drive, settings, imp: Imperfections, progress=None, chunk_sa
                       interference_tol=settings.interference_tol, counts=counts, settings_angles=angles)
     res.elapsed_s = time.perf_counter() - t0
     return res
+
+
+def _entry_edge(drive, imp: Imperfections, isc: "ImperfectScene", phi_h: float, k: int, z, exact: bool, rigid=None):
+    """The edge (working / non-working) of the entry gap of tooth ``k`` at ``phi_h``, section ``z``, and where on
+    the tooth it lies: the edge facing rigid tooth ``rigid`` or, without one, the edge with the smaller gap."""
+    from .entry import EDGES, _edge_idx, edge_gaps
+
+    rot, shift = flex_poses_batch(drive, imp, np.array([phi_h]), np.array([k]), [z])[0]
+    shift = isc.relative(shift)
+    idx = _edge_idx(isc, rot, shift)
+    if rigid is None:
+        e = int(np.argmin(edge_gaps(isc, rot, shift, exact=exact)[0]))
+    else:
+        e = 0 if int(idx[0][0]) == int(rigid) else 1
+    return EDGES[e], _classify(isc, float(rot[0]), shift[0], int(idx[e][0]))
 
 
 def _backlash(drive, imp: Imperfections, phi_h: float, z) -> float:
