@@ -331,3 +331,58 @@ def test_lanes_drop_only_contacts_that_are_never_first(name, monkeypatch):
     b = K.kinematic_error(drive, imp, table=tab, samples=I)
     np.testing.assert_array_equal(a.delta_w, b.delta_w)
     np.testing.assert_array_equal(a.delta_n, b.delta_n)
+
+
+ALL_ERRORS = dict(flex_runout=0.075, flex_runout_phase=1.3, rigid_runout=0.06, rigid_runout_phase=-0.4, rigid_ecc=0.009,
+                  rigid_ecc_phase=-1.1, flex_ecc=0.012, flex_ecc_phase=0.7, cam_cam=0.08, cam_cam_phase=0.5, cam_flex=0.015,
+                  cam_flex_phase=2.0, cam_fixed=0.03, cam_fixed_phase=1.6, rigid_install=0.4, flex_install=-0.9)
+
+
+@pytest.mark.parametrize("name", ["d2_imperfect", "d4_discrete"])
+def test_harmonic_form_is_the_linear_error_terms(name):
+    # Every error is a first harmonic over the teeth or the generator angle, so each contact's linear terms are
+    # Re(A_e . w(i)) with three waves shared by all contacts (docs/models.md 6.2); the KE evaluates them so.
+    # Held to the term-by-term formulas (_terms: tooth indices, rigid pitches and normals per sample) at
+    # random samples, every error kind and installation angle at once, to float rounding (1e-15 rad against
+    # terms of ~1e-3 rad).
+    from wgcad.accuracy.ke_table import _harmonics, _terms, harmonic_terms
+
+    drive = build_drive(load_design(TEMPLATES / f"{name}.toml"))
+    imp = Imperfections(**ALL_ERRORS)
+    tab = K.contact_table(drive, imp)
+    i = np.sort(np.random.default_rng(5).choice(K._record(tab), 3000, replace=False))
+    for side in tab.sides:
+        lanes = K._lanes(tab, side, imp)
+        e = lanes[i % tab.N]
+        pad = e < 0
+        e = np.where(pad, 0, e)
+        for grp in ("cam", "rigid", "flex"):
+            ref = _terms(tab, side, imp, i[:, None], e, grp)
+            got = harmonic_terms(tab, lanes, _harmonics(tab, side, imp, (grp,)), i)
+            assert np.abs(ref[~pad]).max() > 1e-5  # the group does act
+            assert np.abs(got - ref)[~pad].max() < 1e-15
+
+
+@pytest.mark.parametrize("name", ["d2_imperfect", "d4_discrete"])
+def test_lane_minimum_prunes_only_what_cannot_be_first(name):
+    # lane_minimum evaluates in each block of samples only the lanes whose chord, widened by the waves' bend,
+    # can come below the block's best; the minimum over every lane at every sample must be the same.
+    from wgcad.accuracy.ke_table import _harmonics, harmonic_terms, lane_minimum
+
+    drive = build_drive(load_design(TEMPLATES / f"{name}.toml"))
+    imp = Imperfections(**ALL_ERRORS)
+    tab = K.contact_table(drive, imp)
+    i = np.arange(0, 20000)
+    for side in tab.sides:
+        lanes = K._lanes(tab, side, imp)
+        A = _harmonics(tab, side, imp)
+        g = tab.sides[side]["g"]
+        e = lanes[i % tab.N]
+        full = np.where(e >= 0, g[np.maximum(e, 0)] + harmonic_terms(tab, lanes, A, i), np.inf)
+        ref = full.min(axis=1)
+        for block in (4, 16, 64):
+            val, first = lane_minimum(tab, lanes, g, A, i, block=block)
+            assert np.abs(val - ref).max() < 1e-15
+            # the contact named is one that takes the minimum
+            hit = e == first[:, None]
+            assert np.all(np.abs(np.where(hit, full, np.inf).min(axis=1) - ref) < 1e-15)

@@ -31,9 +31,15 @@ What is exploited (tested against the direct computation in tests/test_ke.py):
   candidates;
 * **pruning**: a contact whose perfect closing rotation exceeds the best of
   its lattice class by more than both error bounds can never be the first;
-* **installation angles**: the closing rotations depend on an installation
-  angle ``gamma`` as ``base + X cos(gamma) + Y sin(gamma)``; ``X`` and ``Y``
-  are computed once and every angle costs a few array operations.
+* **harmonics**: every error is a first harmonic over the teeth or the
+  generator angle, so each contact's error terms are ``Re(A_e . w(i))``
+  with three waves shared by every contact; the first contact of a block
+  of samples is sought only among the lanes whose chord over the block,
+  widened by the waves' bend, can come lowest (exact:
+  :func:`wgcad.accuracy.ke_table.lane_minimum`);
+* **installation angles**: the coefficients depend on an installation
+  angle ``gamma`` as ``A + X cos(gamma) + Y sin(gamma)``; ``X`` and ``Y``
+  are computed once.
 """
 
 from __future__ import annotations
@@ -49,35 +55,26 @@ from ..kinematics import gear_ratios
 from ..placement import transform
 from .contact import closing_rotation
 from .imperfect import Imperfections, flex_poses, rigid_poses
-from .ke_table import _CHUNK, DEFAULT_N, ContactTable, _check, _geometry, _lanes, _terms, contact_table
+from .ke_table import DEFAULT_N, ContactTable, LanePlan, _check, _harmonics, _lanes, contact_table, lane_minimum
+
+#: generator angles per pass (a few MB of temporaries per lattice class)
+_SPAN = 1 << 16
 
 __all__ = ["ContactTable", "contact_table", "KEResult", "kinematic_error", "install_angle_scan",
            "optimize_install_angle", "closing_direct", "spectrum", "expected_orders", "DEFAULT_N", "DEEP_OVERLAP"]
 
 
 
-def _side_arrays(tab, side, imp, lanes, i, lever):
-    """``base`` and, with a lever, ``X``, ``Y`` (I, C) of one side for samples ``i``."""
-    e = lanes[i % tab.N]
-    pad = e < 0
-    e = np.where(pad, 0, e)
-    ii = i[:, None]
-    geo = _geometry(tab, side, ii, e)
-    base = tab.sides[side]["g"][e].copy()
-    used = {"cam": imp.cam_flex or imp.cam_fixed, "rigid": imp.rigid_runout or imp.rigid_ecc,
-            "flex": imp.flex_runout or imp.flex_ecc}
-    for grp in ("cam", "rigid", "flex"):
-        if grp != lever and used[grp]:  # a group without errors adds nothing
-            base += _terms(tab, side, imp, ii, e, grp, geo)
-    base[pad] = np.inf
+def _side_coeffs(tab, side, imp, lever):
+    """The harmonic coefficients (:func:`wgcad.accuracy.ke_table._harmonics`) of one side: of every error group but
+    the lever's, and, with a lever, of its group at installation angles 0 and 90 deg (``X``, ``Y``)."""
+    groups = tuple(g for g in ("cam", "rigid", "flex") if g != lever)
+    A = _harmonics(tab, side, imp, groups)
     if lever is None:
-        return base, None, None
+        return A, None, None
     key = "rigid_install" if lever == "rigid" else "flex_install"
-    X = _terms(tab, side, imp.replace(**{key: 0.0}), ii, e, lever, geo)
-    Y = _terms(tab, side, imp.replace(**{key: 0.5 * pi}), ii, e, lever, geo)
-    X[pad] = 0.0
-    Y[pad] = 0.0
-    return base, X, Y
+    return (A, _harmonics(tab, side, imp.replace(**{key: 0.0}), (lever,)),
+            _harmonics(tab, side, imp.replace(**{key: 0.5 * pi}), (lever,)))
 
 
 #: closing rotation (rad, negative: turning back) of the first contact's perfect pair beyond which the linear
@@ -146,14 +143,13 @@ def kinematic_error(drive, imp: Imperfections, n_per_mesh: int = DEFAULT_N, sect
     lw, ln = _lanes(tab, tab.side_w, imp), _lanes(tab, -tab.side_w, imp)
     dw, dn = np.empty(I), np.empty(I)
     deep = np.zeros(I, dtype=bool)
-    for a in range(0, I, _CHUNK):
-        i = np.arange(a, min(I, a + _CHUNK))
+    co = {s: _harmonics(tab, s, imp) for s in (tab.side_w, -tab.side_w)}
+    for a in range(0, I, _SPAN):
+        i = np.arange(a, min(I, a + _SPAN))
         for side, lanes, out in ((tab.side_w, lw, dw), (-tab.side_w, ln, dn)):
-            base = _side_arrays(tab, side, imp, lanes, i, None)[0]
-            first = np.argmin(base, axis=1)
-            out[a : a + len(i)] = base[np.arange(len(i)), first]
-            e = lanes[i % tab.N, first]
-            deep[a : a + len(i)] |= (e >= 0) & (tab.sides[side]["g"][np.maximum(e, 0)] < -DEEP_OVERLAP)
+            g = tab.sides[side]["g"]
+            out[a : a + len(i)], e = lane_minimum(tab, lanes, g, co[side], i)
+            deep[a : a + len(i)] |= (e >= 0) & (g[np.maximum(e, 0)] < -DEEP_OVERLAP)
     theta, lm = _theta(tab, dw, dn)
     phi_h = tab.sigma * np.arange(I) * 2 * pi / (tab.z_b * tab.N)
     eng = "single-flank (backlash)" if lm.min() >= 0 else "double-flank (interference)" if lm.max() < 0 else "mixed"
@@ -171,17 +167,20 @@ def install_angle_scan(tab: ContactTable, imp: Imperfections, angles, lever: str
     lw, ln = _lanes(tab, tab.side_w, imp), _lanes(tab, -tab.side_w, imp)  # the bounds hold for every angle
     hi = np.full(len(ang), -np.inf)
     lo = np.full(len(ang), np.inf)
-    for a in range(0, I, _CHUNK):
-        i = np.arange(a, min(I, a + _CHUNK))
-        bw, Xw, Yw = _side_arrays(tab, tab.side_w, imp, lw, i, lever)
-        bn, Xn, Yn = _side_arrays(tab, -tab.side_w, imp, ln, i, lever)
-        for g in range(len(ang)):
-            dw = (bw + ca[g] * Xw + sa[g] * Yw).min(axis=1)
-            dn = (bn + ca[g] * Xn + sa[g] * Yn).min(axis=1)
+    cw, cn = _side_coeffs(tab, tab.side_w, imp, lever), _side_coeffs(tab, -tab.side_w, imp, lever)
+    gw, gn = tab.sides[tab.side_w]["g"], tab.sides[-tab.side_w]["g"]
+    for a in range(0, I, _SPAN):
+        i = np.arange(a, min(I, a + _SPAN))
+        pw, pn = LanePlan(tab, lw, i), LanePlan(tab, ln, i)
+        for k in range(len(ang)):
+            # an installation angle turns the lever's errors: base + X cos + Y sin, harmonics and all
+            dw = lane_minimum(tab, lw, gw, cw[0] + ca[k] * cw[1] + sa[k] * cw[2], i, plan=pw)[0]
+            dn = lane_minimum(tab, ln, gn, cn[0] + ca[k] * cn[1] + sa[k] * cn[2], i, plan=pn)[0]
             th, _ = _theta(tab, dw, dn)
-            hi[g] = max(hi[g], th.max())
-            lo[g] = min(lo[g], th.min())
+            hi[k] = max(hi[k], th.max())
+            lo[k] = min(lo[k], th.min())
     return hi - lo
+
 
 
 def optimize_install_angle(tab: ContactTable, imp: Imperfections, lever: str = "rigid", n_grid: int = 36):

@@ -387,6 +387,182 @@ def _terms(tab: ContactTable, side: int, imp: Imperfections, i: np.ndarray, e: n
     return -S["c"][e] * (E[..., 0] * nx + E[..., 1] * ny)
 
 
+#: the linear error terms as first harmonics: ``Re(A[e] . w(i))`` with one wave per column of :func:`_waves`
+N_WAVES = 3
+
+
+def _waves(tab: ContactTable, i: np.ndarray) -> np.ndarray:
+    """The three waves the linear error terms of every contact are made of, ``(I, 3)`` complex, for samples ``i``.
+
+    With ``s`` the whole rigid pitches the lattice has turned by at sample
+    ``i`` (``s N = cls + sigma i``, exact), ``e^{2 pi i s / z_b}`` (rigid gear,
+    stationary cam offset, and the normals turning with the rigid pitches),
+    ``e^{2 pi i s / z_g}`` (flexspline teeth) and ``e^{i (2 pi s / z_b -
+    phi_g)}`` (the flexspline-borne cam offset seen along a normal).
+    """
+    N = tab.N
+    i = np.asarray(i)
+    s = ((-tab.sigma * i) % N + tab.sigma * i) // N
+    phi_h = tab.sigma * i * (2 * pi / (tab.z_b * N))
+    phi_g = phi_h / gear_ratios(tab.z_g, tab.z_b)["u_hg"]
+    ab, ag = 2 * pi * s / tab.z_b, 2 * pi * s / tab.z_g
+    return np.exp(1j * np.stack([ab, ag, ab - phi_g], axis=-1))
+
+
+def _harmonics(tab: ContactTable, side: int, imp: Imperfections, groups=("cam", "rigid", "flex")) -> np.ndarray:
+    """Each contact's linear error terms (the ``groups`` of :func:`_terms`) as coefficients of :func:`_waves`, ``(E, 3)``.
+
+    :func:`_terms` of contact ``e`` at sample ``i`` equals ``Re(A[e] @ w(i))``
+    (every error is a first harmonic over the teeth or the generator angle:
+    docs/models.md 6.2); a contact of lattice index ``m`` stands at ``sb =
+    q + s`` rigid pitches and on flexspline tooth ``k = p + s`` (mod ``z_g``),
+    ``q, p`` its own. ``tests/test_ke.py`` holds it to :func:`_terms`.
+    """
+    S = tab.sides[side]
+    N, z_g, z_b = tab.N, tab.z_g, tab.z_b
+    M = z_g * N
+    m = S["m"]
+    cls = m % N
+    q = (((m + M // 2) % M - M // 2) - cls) // N
+    p = (m - cls) // N
+    nt = (S["nt"][:, 0] + 1j * S["nt"][:, 1]) * np.exp(2j * pi * q / z_b)  # the normal at s = 0
+    A = np.zeros((len(m), N_WAVES), dtype=complex)
+    if "rigid" in groups:
+        tp = imp.rigid_ecc_phase + imp.rigid_install
+        T = imp.rigid_ecc * np.exp(1j * tp)
+        A_b = 0.5 * imp.rigid_runout / tab.r_b
+        # T . n + dev_b[j] a_beta, j = j_e + q + s, dev_b = A_b sin((j + 1/2) 2 pi / z_b - gamma + xi)
+        A[:, 0] += np.conj(T) * nt
+        A[:, 0] += S["a_beta"] * (-1j) * A_b * np.exp(1j * (imp.rigid_runout_phase - imp.rigid_install)
+                                                      + 2j * pi * (S["j"] + q + 0.5) / z_b)
+    if "flex" in groups:
+        g = imp.flex_install
+        A1 = 0.5 * imp.flex_runout / tab.r_g
+        Ec = imp.flex_ecc * np.exp(-1j * (imp.flex_ecc_phase + g))
+        # -dalpha[k] a_phi - drho[k] a_rho at a = 2 pi k / z_g: dalpha = Im(c_a e^{ia}), drho = Re(Ec e^{ia})
+        c_a = A1 * np.exp(1j * (imp.flex_runout_phase - g)) - (imp.flex_ecc / tab.r_g) * np.exp(-1j * (imp.flex_ecc_phase + g))
+        A[:, 1] += np.exp(2j * pi * p / z_g) * (-S["a_phi"] * (-1j) * c_a - S["a_rho"] * Ec)
+    if "cam" in groups:
+        # -c (E . n): the stationary part with the normal's wave, the flexspline-borne one turning with phi_g
+        A[:, 0] += -S["c"] * np.conj(imp.cam_fixed * np.exp(1j * imp.cam_fixed_phase)) * nt
+        A[:, 2] += -S["c"] * imp.cam_flex * np.exp(-1j * imp.cam_flex_phase) * nt
+    return A
+
+
+def harmonic_terms(tab: ContactTable, lanes: np.ndarray, A: np.ndarray, i: np.ndarray) -> np.ndarray:
+    """``Re(A[e] . w(i))`` for samples ``i`` and their lanes' contacts, ``(I, C)`` (padding: 0).
+
+    One real matrix product per lattice class: ``[Re w, -Im w] @ [Re A; Im A]``.
+    """
+    i = np.asarray(i)
+    N = tab.N
+    out = np.zeros((len(i), lanes.shape[1]))
+    W = _waves(tab, i)
+    Wr = np.concatenate([W.real, -W.imag], axis=1)
+    r_of = i % N
+    for r in np.unique(r_of):
+        rows = np.nonzero(r_of == r)[0]
+        e = lanes[r]
+        ok = e >= 0
+        Ar = A[np.where(ok, e, 0)]
+        Ar = np.concatenate([Ar.real, Ar.imag], axis=1).T * ok
+        out[rows] = Wr[rows] @ Ar
+    return out
+
+
+#: samples of one lattice class per block of :func:`lane_minimum`
+_BLOCK = 16
+
+
+def _rates(tab: ContactTable) -> np.ndarray:
+    """How fast each wave of :func:`_waves` turns from one sample of a lattice class to its next (``i + N``), rad."""
+    u = gear_ratios(tab.z_g, tab.z_b)["u_hg"]
+    wb, wg = 2 * pi * tab.sigma / tab.z_b, 2 * pi * tab.sigma / tab.z_g
+    return np.abs(np.array([wb, wg, wb - wb / u]))
+
+
+class LanePlan:
+    """What :func:`lane_minimum` needs of samples ``i`` and ``lanes`` whatever the errors: per lattice class the
+    rows in blocks of ``block``, the waves at every row and at each block's middle (built once, reused for
+    every installation angle of a scan)."""
+
+    def __init__(self, tab: ContactTable, lanes: np.ndarray, i: np.ndarray, block: int = _BLOCK):
+        i = np.asarray(i)
+        self.n_samples = len(i)
+        # a wave's term strays from the chord between the block's ends by at most |A| rate^2 (block - 1)^2 / 8
+        self.bend = _rates(tab) ** 2 * (block - 1) ** 2 / 8.0
+        self.classes = []
+        self.rows = []  # per class, (B, block) sample rows of its blocks
+        self.r = []  # per class, its residue
+        r_of = i % tab.N
+        for r in np.unique(r_of):
+            rows = np.nonzero(r_of == r)[0]  # consecutive samples of the class, in order
+            e = lanes[r]
+            e = e[e >= 0]
+            if e.size == 0:
+                continue
+            n = len(rows)
+            nb = -(-n // block)
+            rr = np.concatenate([rows, np.full(nb * block - n, rows[-1])]).reshape(nb, block)
+            W = _waves(tab, i[rr.ravel()]).reshape(nb, block, N_WAVES)
+            # the block's two ends (a padded block ends at its last real sample)
+            last = (np.minimum(np.arange(nb) * block + block, n) - 1) - np.arange(nb) * block
+            ends = np.stack([W[:, 0, :], W[np.arange(nb), last, :]], axis=1)
+            self.classes.append((rows, e, ends, np.concatenate([W.real, -W.imag], axis=2)))
+            self.rows.append(rr)
+            self.r.append(int(r))
+
+
+def lane_minimum(tab: ContactTable, lanes: np.ndarray, g: np.ndarray, A: np.ndarray, i: np.ndarray, block: int = _BLOCK,
+                 plan: LanePlan | None = None):
+    """The first contact of each sample: ``min_e g[e] + Re(A[e] . w(i))`` over its lanes, and which ``e`` it is.
+
+    Exact, and cheaper than every lane at every sample: the samples of one
+    lattice class follow each other as ``t`` steps and each wave turns by a
+    fixed angle per step (:func:`_rates`), so within a block of ``block``
+    samples a contact's value strays from the chord between its values at
+    the block's two ends by at most ``c_e = sum_f |A_ef| rate_f^2 (block -
+    1)^2 / 8``. A contact whose chord lies above the chord of the block's
+    best-bounded contact by more than both strays, at both ends (chords are
+    straight: then everywhere between), is never the smallest in that
+    block; the rest are evaluated at every sample of the block. ``plan``:
+    :class:`LanePlan` of ``lanes`` and ``i``.
+
+    Returns
+    -------
+    value : (I,) float
+        inf where a sample has no contact.
+    first : (I,) int
+        Contact index, -1 where none.
+    """
+    plan = LanePlan(tab, lanes, i, block) if plan is None else plan
+    val = np.full(plan.n_samples, np.inf)
+    first = np.full(plan.n_samples, -1, dtype=int)
+    bend = np.abs(A) @ plan.bend
+    for c, (rows, e, ends, Wr) in enumerate(plan.classes):
+        ve, cb = _ends(g, A, bend, e, ends)
+        star = np.argmin(ve.max(axis=1) + cb, axis=1)  # the lane with the lowest upper bound over the block
+        rb = np.arange(len(ve))
+        gap = ve - ve[rb, :, star][:, :, None]
+        keep = ~np.all(gap > (cb[None, :] + cb[star][:, None] + 1e-15)[:, None, :], axis=1)
+        K = int(keep.sum(axis=1).max())
+        # the kept lanes of each block first; a block with fewer fills up with others (real lanes: harmless)
+        order = np.argsort(~keep, axis=1, kind="stable")[:, :K]
+        sel = e[order]
+        Ak = A[sel]
+        v = g[sel][:, None, :] + Wr @ np.concatenate([Ak.real, Ak.imag], axis=2).transpose(0, 2, 1)
+        j = np.argmin(v, axis=2)
+        at = plan.rows[c]  # (B, block) rows, a padded block repeating its last
+        val[at] = np.take_along_axis(v, j[:, :, None], axis=2)[:, :, 0]
+        first[at] = np.take_along_axis(sel, j, axis=1)
+    return val, first
+
+
+def _ends(g, A, bend, e, ends):
+    """Every lane ``e`` at the blocks' two ends, ``(B, 2, E)``, and how far each can stray from its chord, ``(E,)``."""
+    return g[e][None, None, :] + (ends @ A[e].T).real, bend[e]
+
+
 def _lanes(tab: ContactTable, side: int, imp: Imperfections, slack: float = 1.05) -> np.ndarray:
     """Candidate contacts per lattice class (N, C), padded with -1: those that can be the first to touch.
 
