@@ -472,6 +472,8 @@ def harmonic_terms(tab: ContactTable, lanes: np.ndarray, A: np.ndarray, i: np.nd
 
 #: samples of one lattice class per block of :func:`lane_minimum`
 _BLOCK = 16
+#: stretches of samples whose waves a table keeps (:class:`LanePlan`)
+_WAVE_CACHE = 8
 
 
 def _rates(tab: ContactTable) -> np.ndarray:
@@ -483,7 +485,7 @@ def _rates(tab: ContactTable) -> np.ndarray:
 
 class LanePlan:
     """What :func:`lane_minimum` needs of samples ``i`` and ``lanes`` whatever the errors: per lattice class the
-    rows in blocks of ``block``, the waves at every row and at each block's middle (built once, reused for
+    rows in blocks of ``block``, the waves at every row and at each block's two ends (built once, reused for
     every installation angle of a scan)."""
 
     def __init__(self, tab: ContactTable, lanes: np.ndarray, i: np.ndarray, block: int = _BLOCK):
@@ -494,23 +496,36 @@ class LanePlan:
         self.classes = []
         self.rows = []  # per class, (B, block) sample rows of its blocks
         self.r = []  # per class, its residue
-        r_of = i % tab.N
-        for r in np.unique(r_of):
-            rows = np.nonzero(r_of == r)[0]  # consecutive samples of the class, in order
+        # the waves of a stretch of samples do not depend on the errors: kept with the table for the next
+        # drive of a sweep (a few MB per 2**16 samples)
+        key = (int(i[0]), len(i), block) if len(i) and np.array_equal(i, np.arange(i[0], i[0] + len(i))) else None
+        cache = tab.__dict__.setdefault("_wave_cache", {})
+        waves = cache.get(key) if key is not None else None
+        if waves is None:
+            waves = {}
+            r_of = i % tab.N
+            for r in np.unique(r_of):
+                rows = np.nonzero(r_of == r)[0]  # consecutive samples of the class, in order
+                n = len(rows)
+                nb = -(-n // block)
+                rr = np.concatenate([rows, np.full(nb * block - n, rows[-1])]).reshape(nb, block)
+                W = _waves(tab, i[rr.ravel()]).reshape(nb, block, N_WAVES)
+                # the block's two ends (a padded block ends at its last real sample)
+                last = (np.minimum(np.arange(nb) * block + block, n) - 1) - np.arange(nb) * block
+                ends = np.stack([W[:, 0, :], W[np.arange(nb), last, :]], axis=1)
+                waves[int(r)] = (rows, rr, ends, np.concatenate([W.real, -W.imag], axis=2))
+            if key is not None:
+                if len(cache) >= _WAVE_CACHE:
+                    cache.pop(next(iter(cache)))
+                cache[key] = waves
+        for r, (rows, rr, ends, Wr) in waves.items():
             e = lanes[r]
             e = e[e >= 0]
             if e.size == 0:
                 continue
-            n = len(rows)
-            nb = -(-n // block)
-            rr = np.concatenate([rows, np.full(nb * block - n, rows[-1])]).reshape(nb, block)
-            W = _waves(tab, i[rr.ravel()]).reshape(nb, block, N_WAVES)
-            # the block's two ends (a padded block ends at its last real sample)
-            last = (np.minimum(np.arange(nb) * block + block, n) - 1) - np.arange(nb) * block
-            ends = np.stack([W[:, 0, :], W[np.arange(nb), last, :]], axis=1)
-            self.classes.append((rows, e, ends, np.concatenate([W.real, -W.imag], axis=2)))
+            self.classes.append((rows, e, ends, Wr))
             self.rows.append(rr)
-            self.r.append(int(r))
+            self.r.append(r)
 
 
 def lane_minimum(tab: ContactTable, lanes: np.ndarray, g: np.ndarray, A: np.ndarray, i: np.ndarray, block: int = _BLOCK,
