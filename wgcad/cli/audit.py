@@ -193,17 +193,29 @@ def _audit_pngs(drive, result):
     e = result.entry
     name = drive.design.drive.name
     ent = result.findings["entry_crossing"].details
+    extra = {}
     if imperfect and "perfect_gaps" in ent:
-        # the perfect drive's curve: its own entry gap marked (the imperfect passages have their own picture)
-        i = int(np.nanargmin(ent["perfect_gaps"]))
-        entry_deg, entry_um = float(np.rad2deg(ent["perfect_phi"][i])), 1e3 * ent["perfect_gaps"][i]
+        # the perfect drive's curve with its own entry crossing (on the exact curves) marked, and the imperfect
+        # parts' entry gap beside it (every passage has its own picture)
+        from ..clearance.entry import entry_crossings
+
+        gaps = entry_crossings(scene, secs, exact=True)
+        i = int(np.nanargmin([g for g, _ in gaps]))
+        entry_deg, entry_um = float(np.rad2deg(gaps[i][1])), 1e3 * gaps[i][0]
+        entry_label = "perfect drive's entry gap"
+        if np.isfinite(result.entry_gap):
+            extra = {"entry2_deg": e["tooth_angle_deg"], "entry2_um": 1e3 * result.entry_gap,
+                     "entry2_label": f"imperfect parts' entry gap Delta (tooth {e.get('pinch_tooth' if e.get('kind') == 'pinch' else 'tooth')}, the smallest of "
+                                     f"{ent.get('passages', 0)} passages)"}
     else:
-        entry_deg, entry_um = e["tooth_angle_deg"], 1e3 * result.entry_gap
+        entry_deg, entry_um, entry_label = e["tooth_angle_deg"], 1e3 * result.entry_gap, "entry gap Delta"
     data = {
         "phi_deg": np.rad2deg(prof["phi"]),
         "sections": [{"z": s["z"], "working_um": 1e3 * s["working"], "nonworking_um": 1e3 * s["nonworking"]} for s in prof["sections"]],
         "entry_deg": entry_deg,
         "entry_um": entry_um,
+        "entry_label": entry_label,
+        **extra,
         "worst_label": "imperfect parts' minimum" if imperfect else "minimum",
         "worst_deg": w["tooth_angle_deg"],
         "worst_um": w["clearance_um"],

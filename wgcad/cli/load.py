@@ -77,7 +77,7 @@ def _summary(name: str, res: dict) -> str:
                  + f", largest ball Hertz pressure {top['max_ball_pressure_mpa']:.0f} MPa")
     for sec in top["sections"]:
         zones = ", ".join("-" if z is None else f"{z[0]:+.1f}..{z[1]:+.1f} deg" for z in sec["zone_deg"])
-        lines.append(f"    section z = {sec['section_z_mm']:g} mm: {sec['teeth_in_contact']} teeth in contact "
+        lines.append(f"    section z = {sec['section_z_mm']:g} mm: {sec['teeth_in_contact']} {'tooth' if sec['teeth_in_contact'] == 1 else 'teeth'} in contact "
                      f"({sec['working_flank_contacts']} working, {sec['non_working_flank_contacts']} non-working flanks), zones per wave {zones}")
     worst = max(lv["residuals"]["equilibrium"] for lv in res["levels"])
     lin = max(lv["residuals"]["linearisation_mm"] for lv in res["levels"])

@@ -261,7 +261,11 @@ def clearance_profile_figure(profile: dict, title: str):
     if np.isfinite(profile.get("entry_um", np.nan)):
         marks.append(profile["entry_um"])
         ax.plot([profile["entry_deg"]], [profile["entry_um"]], "v", color="tab:green", ms=9, zorder=5,
-                label=f"entry gap {profile['entry_um']:.2f} um at {profile['entry_deg']:+.1f}°")
+                label=profile.get("entry_label", "entry gap") + f" {profile['entry_um']:.2f} um at {profile['entry_deg']:+.1f}°")
+    if np.isfinite(profile.get("entry2_um", np.nan)):
+        marks.append(profile["entry2_um"])
+        ax.plot([profile["entry2_deg"]], [profile["entry2_um"]], "v", color="tab:purple", ms=9, zorder=5,
+                label=profile.get("entry2_label", "entry gap") + f"\n{profile['entry2_um']:.2f} um at {profile['entry2_deg']:+.1f}°")
     ax.plot([profile["worst_deg"]], [profile["worst_um"]], "o", color="tab:red", ms=8, zorder=5,
             label=profile.get("worst_label", "minimum") + f" {profile['worst_um']:.2f} um at {profile['worst_deg']:+.1f}°")
     # y: from the deepest point to above the highest marker; the curves rise to
