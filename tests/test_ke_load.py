@@ -133,3 +133,29 @@ def test_cli_design_without_bearing_exits_2(capsys):
     assert main(["ke", str(TEMPLATES / "d3_external.toml"), "--torque-nm", "80"]) == 2
     err = capsys.readouterr().err
     assert "bearing." in err and err.count("\n") == 1
+
+
+def test_install_lever_finds_the_scans_best_and_never_reports_a_worse_angle(d1):
+    # The loaded installation-angle scan with as many states per angle as the final figures: its best angle must
+    # be the lowest of the grid and of the two angles beside it (each computed here independently), never
+    # above the design's own angle; and where the rigid gear carries no error the angle does nothing, so the
+    # design's angle is the answer (lever 1), not a scan angle that is no better.
+    from wgcad.accuracy.ke_load import install_lever
+
+    drive, model = d1
+    imp = Imperfections(flex_runout=0.02, rigid_runout=0.03, rigid_runout_phase=1.0, cam_fixed=0.01)
+    n, grid = 12, 6
+    lev = install_lever(drive, imp, 300.0, model=model, samples=n, scan_samples=n, n_grid=grid)
+    ref = {}
+    for a in list(2 * np.pi * np.arange(grid) / grid):
+        ref[a] = loaded_ke(drive, imp.replace(rigid_install=a), 300.0, samples=n, model=model).ke_pp
+    k = min(ref, key=ref.get)
+    for a in (k - np.pi / grid, k + np.pi / grid):
+        ref[a] = loaded_ke(drive, imp.replace(rigid_install=a), 300.0, samples=n, model=model).ke_pp
+    assert np.allclose(lev.grid_pp, [ref[a] for a in 2 * np.pi * np.arange(grid) / grid], atol=1e-9)
+    assert abs(lev.best.ke_pp - min(min(ref.values()), lev.design.ke_pp)) < 1e-9
+    assert lev.best.ke_pp <= lev.design.ke_pp and lev.lever >= 1.0
+    assert lev.lever > 1.05  # the rigid gear's run-out against the stationary offset: the angle matters here
+    # no rigid-gear error: every angle is the same drive
+    flat = install_lever(drive, imp.replace(rigid_runout=0.0), 300.0, model=model, samples=n, scan_samples=n, n_grid=grid)
+    assert flat.best_angle == 0.0 and flat.lever == 1.0 and flat.best is flat.design

@@ -168,7 +168,8 @@ def test_workers_undo_the_nannys_malloc_tuning():
     # A Dask nanny spawns workers with MALLOC_TRIM_THRESHOLD_=65536, which turns glibc's adaptive mmap
     # threshold off: every large array is then a fresh mapping whose pages fault in anew (D2's KE ran at a third
     # of its speed on two workers, mostly in the kernel). run_batch resets the thresholds once per process:
-    # repeated 8 MB arrays must then come from the heap, with a small fraction of the page faults.
+    # repeated 1 MB arrays must then come from the heap, with a small fraction of the page faults. The child
+    # gets a worker's environment (the nanny's single-threaded BLAS too).
     import subprocess
     import sys
     import textwrap
@@ -178,17 +179,17 @@ def test_workers_undo_the_nannys_malloc_tuning():
         if sys.argv[1] == "fix":
             from wgcad.sweep.tasks import _allocator
             _allocator()
-        a = np.ones(1 << 20)  # warm-up: the heap grows once
+        a = np.ones(1 << 17)  # warm-up: the heap grows once
         del a
         f0 = resource.getrusage(resource.RUSAGE_SELF).ru_minflt
         for _ in range(40):
-            a = np.ones(1 << 20)  # 8 MB, every page touched
+            a = np.ones(1 << 17)  # 1 MB, every page touched
             del a
         print(resource.getrusage(resource.RUSAGE_SELF).ru_minflt - f0)
     """)
     import os
 
-    env = {**os.environ, "MALLOC_TRIM_THRESHOLD_": "65536"}
+    env = {**os.environ, "MALLOC_TRIM_THRESHOLD_": "65536", "OPENBLAS_NUM_THREADS": "1", "OMP_NUM_THREADS": "1"}
     faults = {}
     for mode in ("plain", "fix"):
         out = subprocess.run([sys.executable, "-c", code, mode], env=env, capture_output=True, text=True, check=True)

@@ -208,7 +208,8 @@ def install_lever(drive, imp: Imperfections, torque_nm: float, model=None, sampl
     ``scan_samples`` states each (default ``|u_hg| + 4``: a stroboscopic pass
     over every cam phase), the best refined at two angles between its
     neighbours, and the best and the design's own angle evaluated with the
-    full ``samples`` (``design``: the latter when already computed).
+    full ``samples`` (``design``: the latter when already computed); the
+    design's angle is the best unless the other is lower there.
     ``progress(done, total)`` counts load states.
     """
     import time
@@ -244,4 +245,8 @@ def install_lever(drive, imp: Imperfections, torque_nm: float, model=None, sampl
     best_angle = float(min(cands)[1]) % (2 * pi)
     best = ke_at(best_angle, samples)
     design = ke_at(imp.rigid_install, samples) if design is None else design
+    if not best.ke_pp < design.ke_pp:
+        # the scan ranks on fewer states: where its best does no better than the design's own angle on every
+        # state, the design's angle is the answer (a flat curve: the lever does nothing)
+        best_angle, best = float(imp.rigid_install) % (2 * pi), design
     return LoadedLever(float(torque_nm), grid, pp, best_angle, best, design, scan_samples, time.perf_counter() - t0)

@@ -178,7 +178,8 @@ def _loaded(args, drive, imp, res, tab, out: dict) -> list:
                 "scan_samples": lev.scan_samples, "seconds": round(lev.seconds, 3)}
             print(f"    rigid gear installation angle under {T:g} N m: best {math.degrees(lev.best_angle):.1f} deg, largest KE "
                   f"{lev.best.ke_pp * _AS:.2f} arcsec against {lev.design.ke_pp * _AS:.2f} at the design's "
-                  f"{math.degrees(imp.rigid_install):g} deg ({lev.lever:.2f} times lower; scan of {len(lev.grid)} angles with "
+                  f"{math.degrees(imp.rigid_install):g} deg ({f'{lev.lever:.2f} times lower' if lev.lever > 1 else 'no angle does better'}; "
+                  f"scan of {len(lev.grid)} angles with "
                   f"{lev.scan_samples} states each: {lev.grid_pp.min() * _AS:.1f} .. {lev.grid_pp.max() * _AS:.1f} arcsec)")
     print("  under load NOT CHECKED: the KE within a mesh period (the elastic model has states at whole mesh periods only)")
     return loaded
