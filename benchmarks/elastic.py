@@ -39,8 +39,8 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 from _timing import best_of  # noqa: E402
 
-from wgcad.deformation.elastic import build_model, solve_load  # noqa: E402
-from wgcad.deformation.elastic.sweep import torque_sweep  # noqa: E402
+from wgcad.elastic import build_model, solve_load  # noqa: E402
+from wgcad.elastic.sweep import torque_sweep  # noqa: E402
 from wgcad.clearance.engine import clearance_at_poses  # noqa: E402
 from wgcad.design import load_design  # noqa: E402
 from wgcad.drive import build_drive  # noqa: E402

@@ -28,9 +28,9 @@ ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
 
 from wgcad.accuracy import ke as K  # noqa: E402
-from wgcad.accuracy.imperfect import Imperfections  # noqa: E402
+from wgcad.placement.imperfect import Imperfections  # noqa: E402
 from wgcad.accuracy.ke_load import install_lever, loaded_ke  # noqa: E402
-from wgcad.deformation.elastic import build_model  # noqa: E402
+from wgcad.elastic import build_model  # noqa: E402
 from wgcad.design import load_design  # noqa: E402
 from wgcad.drive import build_drive  # noqa: E402
 

@@ -38,7 +38,7 @@ TEMPLATES = sorted((ROOT / "templates").glob("*.toml"))
 
 # What `wgcad audit` imports, heaviest dependencies first in the order the code reaches them
 # (clearance.distance -> shapely; numpy everywhere). scipy is not on the audit path any more
-# (deformation/laws/ellipse.py and profiles/measure.py import it only where an elliptic integral or a
+# (laws/ellipse.py and profiles/measure.py import it only where an elliptic integral or a
 # root is needed, which a default audit does not), so it has no row. Each row adds one.
 CHAIN = [
     ("python itself", []),

@@ -1,4 +1,4 @@
-"""An independent planar frame-element ring (numpy), to check the closed-form Fourier compliance of wgcad.deformation.elastic.ring."""
+"""An independent planar frame-element ring (numpy), to check the closed-form Fourier compliance of wgcad.elastic.ring."""
 
 import numpy as np
 

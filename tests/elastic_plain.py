@@ -16,9 +16,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from wgcad.deformation.elastic.cam import ball_rows, cam_excess
-from wgcad.deformation.elastic.solve import solve_contact_qp
-from wgcad.deformation.elastic.teeth import pair_contacts
+from wgcad.elastic.cam import ball_rows, cam_excess
+from wgcad.elastic.solve import solve_contact_qp
+from wgcad.elastic.teeth import pair_contacts
 from wgcad.placement import pose_from_displacements, transform
 
 FLOOR = 1e-2  # N, the force floor of the contact secants (as wgcad's)
@@ -66,7 +66,7 @@ def plain_solve(model, torque_nm: float, cam_offset_um: float = 0.0, tol: float 
     k = model.support_stiffness
     f_ext = np.array([0.0, 0.0, model.torque_sign * 1e3 * torque_nm, 0.0, 0.0])
     # start: the rim pressed onto the cam by the balls alone (wgcad's mounted state, checked by its own tests)
-    from wgcad.deformation.elastic.cam import mounted
+    from wgcad.elastic.cam import mounted
 
     mt = mounted(model, e)
     F_ball, F_teeth, keys = mt.force.copy(), np.zeros(0), np.zeros(0, dtype=int)

@@ -1,4 +1,4 @@
-"""Tests of wgcad.export.atomic: nothing half-written, nothing left behind, unwritable folders caught early."""
+"""Tests of wgcad.atomic: nothing half-written, nothing left behind, unwritable folders caught early."""
 
 import os
 import stat
@@ -6,7 +6,7 @@ import stat
 import pytest
 
 from wgcad.errors import OutputError, WgcadError
-from wgcad.export.atomic import (
+from wgcad.atomic import (
     atomic_batch,
     atomic_write,
     atomic_writer,
@@ -210,7 +210,7 @@ def _special_targets(tmp_path):
 
 @pytest.mark.parametrize("kind", ["fifo", "link", "dangling", "folder"])
 def test_special_targets_are_refused_and_left_alone(tmp_path, kind):
-    from wgcad.export.atomic import check_target
+    from wgcad.atomic import check_target
 
     target = _special_targets(tmp_path)[kind]
     before = os.lstat(target)
@@ -229,7 +229,7 @@ def test_special_targets_are_refused_and_left_alone(tmp_path, kind):
 
 @pytest.mark.parametrize("device", ["/dev/null", "/dev/full", "/dev/stdout"])
 def test_devices_are_refused_even_as_root(device):
-    from wgcad.export.atomic import check_target
+    from wgcad.atomic import check_target
 
     if not os.path.lexists(device):
         pytest.skip(f"{device} missing here")
@@ -257,7 +257,7 @@ def test_target_that_turns_into_a_fifo_before_the_commit_is_refused(tmp_path):
 # -- folders: created only when files are written, removed again when the write fails --
 
 def test_check_writable_dir_creates_nothing(tmp_path):
-    from wgcad.export.atomic import check_writable_dir
+    from wgcad.atomic import check_writable_dir
 
     check_writable_dir(tmp_path / "a" / "b" / "c")
     assert listing(tmp_path) == []
@@ -285,7 +285,7 @@ def test_failed_batch_keeps_folders_that_hold_other_files(tmp_path):
 @pytest.mark.skipif(not os.path.isdir("/proc/self"), reason="needs a proc file system")
 @pytest.mark.parametrize("folder", ["/proc", "/proc/wgcad-test/out"])
 def test_proc_is_named_as_such_not_no_such_file(folder):
-    from wgcad.export.atomic import check_writable_dir
+    from wgcad.atomic import check_writable_dir
 
     with pytest.raises(OutputError) as info:
         check_writable_dir(folder)
@@ -294,7 +294,7 @@ def test_proc_is_named_as_such_not_no_such_file(folder):
 
 
 def test_a_device_in_the_path_is_named(tmp_path):
-    from wgcad.export.atomic import check_writable_dir
+    from wgcad.atomic import check_writable_dir
 
     os.mkfifo(tmp_path / "pipe")
     with pytest.raises(OutputError, match=r"pipe is a named pipe \(FIFO\), not a folder"):
@@ -313,7 +313,7 @@ def _dead_pid():
 
 
 def test_stale_temps_of_dead_writers_are_removed_and_nothing_else(tmp_path):
-    from wgcad.export.atomic import remove_stale_temps
+    from wgcad.atomic import remove_stale_temps
 
     dead, alive = _dead_pid(), os.getpid()
     names = {

@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 from conftest import TEMPLATES, edit_toml
-from wgcad.accuracy.imperfect import Imperfections, flex_poses, rigid_poses
+from wgcad.placement.imperfect import Imperfections, flex_poses, rigid_poses
 from wgcad.audit import _sections
 from wgcad.cli import main
 from wgcad.clearance import imperfect as IM
@@ -18,6 +18,7 @@ from wgcad.constants import REFINE_TOL
 from wgcad.design import load_design
 from wgcad.drive import build_drive
 from wgcad.placement import transform
+from wgcad.report.audit import audit_json
 
 #: D2's tolerances of [S4] (docs/models.md 9), and an eccentricity of each gear
 S4 = Imperfections(flex_runout=0.075, flex_runout_phase=math.radians(260), rigid_runout=0.075, cam_cam=0.08,
@@ -36,7 +37,7 @@ def _settings(drive, step_deg, **kw):
 
 
 def test_batch_poses_are_the_reference_poses(d1):
-    # the sweep's vectorised poses against wgcad.accuracy.imperfect.flex_poses (one angle at a time)
+    # the sweep's vectorised poses against wgcad.placement.imperfect.flex_poses (one angle at a time)
     secs = [float(z) for z in _sections(d1, 3)]
     for phi_h in (0.0, 0.7, 4.1):
         k = np.arange(0, 200, 7)
@@ -91,15 +92,15 @@ def test_zero_imperfections_give_the_perfect_audit(d1):
     # the same samples, posed by another route (unfolded generator angles): equal to rounding
     assert abs(got.min_clearance - ref.min_clearance) <= 1e-9
     assert abs(got.raw["min_clearance_polygon"] - ref.raw["min_clearance_polygon"]) <= 1e-9
-    assert abs(abs(got.worst["tooth_angle_deg"]) - ref.worst["tooth_angle_deg"]) <= 1e-6
-    assert got.worst["section_z_mm"] == ref.worst["section_z_mm"]
+    assert abs(abs(audit_json(got)["worst"]["tooth_angle_deg"]) - audit_json(ref)["worst"]["tooth_angle_deg"]) <= 1e-6
+    assert audit_json(got)["worst"]["section_z_mm"] == audit_json(ref)["worst"]["section_z_mm"]
     assert got.interference == ref.interference
     # entry gap and pinch: every passage is the perfect one (the mesh period holds: one per section measured)
     assert abs(got.entry_gap - ref.entry_gap) <= REFINE_TOL
     for key in ("entry_crossing", "entry_pinch"):  # NaN where the drive has no pinch: NaN on both routes
         a, b = got.findings[key].value, ref.findings[key].value
         assert (np.isnan(a) and np.isnan(b)) or abs(a - b) <= REFINE_TOL, key
-    assert got.entry["section_z_mm"] == ref.entry["section_z_mm"]
+    assert audit_json(got)["entry"]["section_z_mm"] == audit_json(ref)["entry"]["section_z_mm"]
 
 
 def test_rigid_eccentricity_deepens_by_its_amplitude(d1):
@@ -114,10 +115,10 @@ def test_rigid_eccentricity_deepens_by_its_amplitude(d1):
     st = _settings(d1, 2.0)
     ref = audit(d1, st)
     scene = Scene(d1)
-    z = ref.worst["section_z_mm"]
+    z = audit_json(ref)["worst"]["section_z_mm"]
     # the worst sample itself, where it is (its zone: the mirror and the other wave's spots move the other way)
-    rot, shift = flex_poses(d1, Imperfections(), math.radians(ref.worst["generator_angle_deg"]),
-                            teeth=[ref.worst["tooth"]], z=z)
+    rot, shift = flex_poses(d1, Imperfections(), math.radians(audit_json(ref)["worst"]["generator_angle_deg"]),
+                            teeth=[audit_json(ref)["worst"]["tooth"]], z=z)
     det = IM.clearance_at_poses(scene, rot, shift)
     side = min(("lower", "upper"), key=lambda s: det[s][0])
     j = det["lo"] if side == "lower" else det["up"]
@@ -143,7 +144,7 @@ def test_chunks_and_bounds_change_nothing(d1):
     assert brute.counts["evaluated"] == brute.counts["samples"]
     for r in (b, brute):
         assert r.min_clearance == a.min_clearance
-        assert r.worst == a.worst
+        assert audit_json(r)["worst"] == audit_json(a)["worst"]
     assert a.counts["evaluated"] < 0.2 * brute.counts["evaluated"]
 
 
@@ -201,7 +202,7 @@ def test_bounds_hold_on_other_geometries(name, tmp_path):
     st = _settings(d, 8.0, refine=False)
     a = IM.audit_imperfect(d, st, imp)
     b = IM.audit_imperfect(d, _settings(d, 8.0, refine=False, bound=False), imp)
-    assert a.min_clearance == b.min_clearance and a.worst == b.worst
+    assert a.min_clearance == b.min_clearance and audit_json(a)["worst"] == audit_json(b)["worst"]
     assert abs(IM.audit_imperfect(d, st, Imperfections()).min_clearance - audit(d, st).min_clearance) <= 1e-9
 
 
@@ -212,7 +213,7 @@ def test_full_cycle_is_every_turn_of_the_flexspline_errors(tmp_path):
     # So the whole cycle's minimum (--turns full: 43 turns for D4's 86/88 teeth) must equal the smallest
     # of 43 one-turn audits with those installation angles - computed independently, each its own sweep.
     # The phase is chosen so that turn 0 is not the worst (measured: -1.61 um in turn 0, -2.34 um in turn 10).
-    from wgcad.accuracy.imperfect import full_cycle_turns
+    from wgcad.placement.imperfect import full_cycle_turns
     from wgcad.audit import RunSettings, run_audit
     from wgcad.kinematics import gear_ratios
 
@@ -378,7 +379,7 @@ def test_generate_places_the_deformed_assembly_with_its_errors(tmp_path):
     # too, by a fraction of it: the teeth are a fraction of the area. Left out here.)
     import shapely
 
-    from wgcad.accuracy.imperfect import cam_offset, rigid_translation
+    from wgcad.placement.imperfect import cam_offset, rigid_translation
     from wgcad.export.dxf import read_dxf
     from wgcad.kinematics import gear_ratios
 

@@ -228,7 +228,7 @@ def test_cli_import_is_light():
 
 def test_core_is_pure():
     code = (
-        "import sys, wgcad.design, wgcad.drive, wgcad.placement, wgcad.report, wgcad.profiles.gear, wgcad.deformation;"
+        "import sys, wgcad.design, wgcad.drive, wgcad.placement, wgcad.report, wgcad.profiles.gear, wgcad.laws;"
         "bad = [m for m in ('ezdxf', 'trimesh', 'manifold3d', 'fcl', 'matplotlib') if m in sys.modules]; print(bad); sys.exit(bool(bad))"
     )
     r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)

@@ -1,11 +1,11 @@
-"""Tests of wgcad.deformation.coning: linear amplitude along a cup flexspline (docs/models.md 3.1)."""
+"""Tests of wgcad.laws.coning: linear amplitude along a cup flexspline (docs/models.md 3.1)."""
 
 import math
 
 import numpy as np
 import pytest
 
-from wgcad.deformation import coned_w0, make_law
+from wgcad.laws import coned_w0, make_law
 from wgcad.errors import DesignError
 
 L, Z_H, W0 = 160.0, 12.0, 0.88  # D1: shell length 160 mm, W0 = 1.1 m

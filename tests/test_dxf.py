@@ -11,7 +11,7 @@ import pytest
 
 from wgcad.errors import InputFileError, OutputError
 from wgcad.export import EXPORTERS
-from wgcad.export.atomic import atomic_batch
+from wgcad.atomic import atomic_batch
 from wgcad.export.dxf import DxfLayer, audit_dxf, build_dxf, clean_outline, read_dxf, write_dxf
 
 # DXF stores coordinates as decimal text; ezdxf writes Python's shortest

@@ -7,10 +7,10 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from wgcad.deformation import Law
-from wgcad.deformation.elastic import LoadedLaw, build_model, solve_load
-from wgcad.deformation.elastic.state import POSITION_TOL
-from wgcad.deformation.elastic.sweep import torque_sweep
+from wgcad.laws import Law
+from wgcad.elastic import LoadedLaw, build_model, solve_load
+from wgcad.elastic.state import POSITION_TOL
+from wgcad.elastic.sweep import torque_sweep
 from wgcad.design import load_design, with_changes
 from wgcad.drive import build_drive
 
@@ -114,7 +114,7 @@ def test_rim_on_balls_at_the_four_force_angles_is_the_four_force_law():
     # clearance and the cam ground to the law, the mounted rim must take the law itself, held chiefly by those
     # four balls. Only the balls' Hertz approach (6.5 um at their ~160 N) lets the rim off the law: it sinks
     # there and rests on the neighbours too, so within two approaches of the law
-    from wgcad.deformation.elastic.cam import mounted
+    from wgcad.elastic.cam import mounted
 
     d = with_changes(load_design(D1), bearing={"internal_clearance_um": 0.0, "fit_clearance_um": 0.0, "balls": 36,
                                                "ball_diameter_mm": 9.0}, load={"ball_phase_deg": 5.0})
@@ -163,9 +163,9 @@ def test_entry_gap_wind_up_closes_it_and_the_loaded_rim_opens_it(sweep):
     # they close it, most at the inner end, where it turns negative by 3 kN m (D1, [S1])
     from dataclasses import replace
 
-    from wgcad.deformation.elastic.cam import mounted
-    from wgcad.deformation.elastic.mesh import entry_gaps
-    from wgcad.deformation.elastic.state import _merge_loads
+    from wgcad.elastic.cam import mounted
+    from wgcad.elastic.mesh import entry_gaps
+    from wgcad.elastic.state import _merge_loads
 
     m = sweep["states"][0].model
     psi0, loads0 = _merge_loads(m.tables.angles, mounted(m).loads)
@@ -254,7 +254,7 @@ def test_cli_writes_json_and_pngs(tmp_path):
 def test_entry_gap_of_the_nominal_law_matches_the_engine(model):
     # the load audit's entry (any law's poses, docs/models.md 5) on the analytic law is the no-load audit's
     from wgcad.clearance.entry import entry_passages, section_poses
-    from wgcad.deformation.elastic.mesh import entry_gaps
+    from wgcad.elastic.mesh import entry_gaps
 
     zs = [float(z) for z in model.zs]
     ref = entry_passages(model.scene, section_poses(model.scene, zs), len(zs))
@@ -267,7 +267,7 @@ def test_entry_gap_of_the_nominal_law_matches_the_engine(model):
 def test_displacements_of_many_laws_at_once_are_their_states(sweep):
     # the entry-gap search evaluates the laws of every section, wave and level together (shared ring fields
     # and nominal states); the figures must be each law's own
-    from wgcad.deformation.elastic.loaded import displacements_many
+    from wgcad.elastic.loaded import displacements_many
 
     laws = [law.shifted(p) for st in sweep["states"] for law in st.laws for p in (0.0, np.pi)]
     phis = [np.linspace(-3.0, 3.0, 41) + 0.013 * k for k in range(len(laws))]

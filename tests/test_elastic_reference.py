@@ -23,8 +23,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from wgcad.deformation.elastic import build_model, solve_load
-from wgcad.deformation.elastic.state import POSITION_TOL
+from wgcad.elastic import build_model, solve_load
+from wgcad.elastic.state import POSITION_TOL
 from wgcad.design import load_design
 from wgcad.drive import build_drive
 
@@ -71,7 +71,7 @@ def test_report_gaps_against_a_full_measurement(torque_nm):
     # clearance and leaves the others linearised; measuring every pair at the solved state must give the same
     # figures for the former, and for the latter exact gaps above the smallest open one (at 3000 N m no open
     # pair is measured at the solved poses before the report: it looks for the nearest first)
-    from wgcad.deformation.elastic.state import _geometry, _loads_on_table
+    from wgcad.elastic.state import _geometry, _loads_on_table
 
     m = _model("d1_involute")
     st = solve_load(m, torque_nm)
@@ -93,7 +93,7 @@ def test_report_gaps_against_a_full_measurement(torque_nm):
 def test_teeth_near_engagement_as_from_placed_tips():
     # _poses finds the teeth whose tips reach within RADIAL_MARGIN of the rigid tip circle from |R p + s|^2
     # expanded (no placed copies): the same teeth as placing the tip vertices, and radii equal to round-off
-    from wgcad.deformation.elastic.state import RADIAL_MARGIN, _loads_on_table, _poses
+    from wgcad.elastic.state import RADIAL_MARGIN, _loads_on_table, _poses
     from wgcad.placement import transform
 
     for name in ("d1_involute", "d1_cycloidal"):

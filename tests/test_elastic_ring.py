@@ -1,4 +1,4 @@
-"""Ring compliance (wgcad.deformation.elastic.ring): closed forms, Maxwell-Betti, definiteness, an independent FE ring."""
+"""Ring compliance (wgcad.elastic.ring): closed forms, Maxwell-Betti, definiteness, an independent FE ring."""
 
 import sys
 from pathlib import Path
@@ -6,8 +6,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from wgcad.deformation import FourForce
-from wgcad.deformation.elastic.ring import Ring, ring_kernels, series_kernels
+from wgcad.laws import FourForce
+from wgcad.elastic.ring import Ring, ring_kernels, series_kernels
 
 sys.path.insert(0, str(Path(__file__).parent))
 from elastic_fe_ring import fe_ring  # noqa: E402

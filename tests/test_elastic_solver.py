@@ -1,11 +1,11 @@
-"""The contact solver (wgcad.deformation.elastic.solve): exact mixed LCP solutions checked by enumeration."""
+"""The contact solver (wgcad.elastic.solve): exact mixed LCP solutions checked by enumeration."""
 
 import itertools
 
 import numpy as np
 import pytest
 
-from wgcad.deformation.elastic.solve import ContactSolveError, solve_contact_qp
+from wgcad.elastic.solve import ContactSolveError, solve_contact_qp
 
 
 def _random_problem(rng, m, r=3):

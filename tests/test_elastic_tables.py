@@ -1,12 +1,12 @@
-"""Ring tables of the elastic model (wgcad.deformation.elastic.tables): the same numbers as the closed-form ring."""
+"""Ring tables of the elastic model (wgcad.elastic.tables): the same numbers as the closed-form ring."""
 
 from pathlib import Path
 
 import numpy as np
 import pytest
 
-from wgcad.deformation.elastic import build_model
-from wgcad.deformation.elastic.tables import Compliance
+from wgcad.elastic import build_model
+from wgcad.elastic.tables import Compliance
 from wgcad.design import load_design
 from wgcad.drive import build_drive
 

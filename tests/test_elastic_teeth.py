@@ -1,4 +1,4 @@
-"""Tooth contacts of the elastic model (wgcad.deformation.elastic.teeth): the gaps are the clearance engine's."""
+"""Tooth contacts of the elastic model (wgcad.elastic.teeth): the gaps are the clearance engine's."""
 
 from pathlib import Path
 
@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from wgcad.clearance.engine import Scene, clearance_at_poses
-from wgcad.deformation.elastic.teeth import flank_contacts, pair_contacts
+from wgcad.elastic.teeth import flank_contacts, pair_contacts
 from wgcad.design import load_design
 from wgcad.drive import build_drive
 from wgcad.placement import tooth_pose
@@ -44,7 +44,7 @@ def test_contact_points_located_on_the_outline_as_geos_does(name):
     # both teeth (ends of the shortest segments between placed teeth, deepest vertices) on the real templates
     import shapely
 
-    from wgcad.deformation.elastic.teeth import _project
+    from wgcad.elastic.teeth import _project
     from wgcad.placement import transform
 
     drive = build_drive(load_design(ROOT / "templates" / f"{name}.toml"))

@@ -20,6 +20,7 @@ from wgcad.clearance.engine import AuditSettings, audit
 from wgcad.design import load_design, with_changes
 from wgcad.drive import build_drive
 from wgcad.placement import tooth_pose
+from wgcad.report.audit import audit_json
 
 #: 0.01 um: the acceptance of issue 8
 TOL_MM = 1e-5
@@ -134,18 +135,18 @@ def test_figures_match_a_dense_reference_at_any_chord_tolerance(name, coned, cho
     dense = Reference(design, DENSE)
     # entry gap: the clearance where the tip circle crosses the rigid tip circle
     phi_e = res.raw["entry_phi"]
-    z_e = res.entry["section_z_mm"]
+    z_e = audit_json(res)["entry"]["section_z_mm"]
     assert res.entry_gap == pytest.approx(dense.at(phi_e, z_e), abs=TOL_MM)
     # pinch: the smallest dense clearance near the reported one (golden section on 0.02 deg)
-    if res.entry["pinch_um"] is not None:
+    if audit_json(res)["entry"]["pinch_um"] is not None:
         from scipy.optimize import minimize_scalar
 
         p = res.raw["pinch_phi"]
-        z_p = res.entry["pinch_section_z_mm"]
+        z_p = audit_json(res)["entry"]["pinch_section_z_mm"]
         h = np.deg2rad(0.02)
         r = minimize_scalar(lambda x: dense.at(x, z_p), bounds=(p - h, p + h), method="bounded", options={"xatol": 1e-9})
         ref = min(r.fun, dense.at(p, z_p))
-        assert res.entry["pinch_um"] * 1e-3 == pytest.approx(ref, abs=TOL_MM + 1e-7)  # + JSON rounding
+        assert audit_json(res)["entry"]["pinch_um"] * 1e-3 == pytest.approx(ref, abs=TOL_MM + 1e-7)  # + JSON rounding
 
 
 def test_cycloidal_verdict_does_not_depend_on_the_chord_tolerance():

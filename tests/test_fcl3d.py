@@ -16,6 +16,7 @@ from wgcad.clearance.engine import Scene, tooth_clearance
 from wgcad.design import load_design
 from wgcad.drive import build_drive
 from wgcad.placement import transform
+from wgcad.report.audit import audit_json
 
 SQUARE = np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]])
 
@@ -200,16 +201,16 @@ def test_verify_worst_agrees(name):
     out = fcl3d.verify_worst(drive, result)
     # the pinch is checked where the audit finds one (D1 rebuilt: none - its gaps fall from the tip crossing
     # straight into flank engagement; D4 and the nominal teeth pinch as the tips pass)
-    has_pinch = result.entry["pinch_um"] is not None
+    has_pinch = audit_json(result)["entry"]["pinch_um"] is not None
     assert [p["what"] for p in out["pairs"]] == ["tightest"] + (["entry pinch"] if has_pinch else [])
     assert has_pinch == (name != "d1_involute")
     assert out["agree"] and all(p["agree"] for p in out["pairs"])
     assert out["summary"].startswith("agree") and "\n" not in out["summary"]
     w = out["pairs"][0]
-    assert w["tooth_angle_deg"] == pytest.approx(result.worst["tooth_angle_deg"])
+    assert w["tooth_angle_deg"] == pytest.approx(audit_json(result)["worst"]["tooth_angle_deg"])
     # the loft's sections include the audit's; the 2D check is on polygons, the audit's figure on the
     # exact curves: they differ by at most the polygon-curve difference (2 x the chord tolerance)
-    assert w["clearance_2d_um"] <= result.worst["clearance_um"] + 2.0 * result.settings["chord_tol_um"] + 1e-2
+    assert w["clearance_2d_um"] <= audit_json(result)["worst"]["clearance_um"] + 2.0 * result.settings["chord_tol_um"] + 1e-2
     if result.min_clearance < 0:
         assert w["fcl_overlap"]
     else:
@@ -229,7 +230,7 @@ def test_verify_worst_places_the_imperfect_parts(name, errors, tmp_path):
     # angle, with the errors) and the rigid teeth with theirs: its 2D figure at the audit's section is the
     # audit's own polygon figure, while the perfect drive's tooth at the same tooth angle is elsewhere
     from conftest import edit_toml
-    from wgcad.accuracy.imperfect import Imperfections, flex_poses, rigid_poses
+    from wgcad.placement.imperfect import Imperfections, flex_poses, rigid_poses
 
     text = (TEMPLATES / f"{name}.toml").read_text() + "\n[imperfections]\n"
     for key, val in errors:
@@ -245,7 +246,7 @@ def test_verify_worst_places_the_imperfect_parts(name, errors, tmp_path):
     assert pair["tooth"] == w.tooth and pair["generator_angle_deg"] == pytest.approx(np.rad2deg(w.generator_angle))
     rows = {r["rigid_tooth"]: r for r in pair["per_tooth"]}
     j = w.details["rigid_tooth"]
-    # the reference: the two posed polygons from the drive's own poses (accuracy.imperfect, no scene), in shapely
+    # the reference: the two posed polygons from the drive's own poses (placement.imperfect, no scene), in shapely
     rot, shift = flex_poses(drive, imp, w.generator_angle, teeth=np.array([w.tooth]), z=w.section_z if drive.coned else None)
     rr, rs = rigid_poses(drive, imp, teeth=np.array([j]))
     a = shapely.Polygon(transform(drive.flex.tooth_polygon(), rot, shift)[0])
@@ -262,7 +263,7 @@ def test_verify_worst_places_the_imperfect_parts(name, errors, tmp_path):
             assert rows[j]["fcl_distance_um"] == pytest.approx(ref_um, abs=1e3 * fcl3d.FCL_TOL)
     # the solid itself: its slice at the audit's section is the tooth placed with its errors (in the frame of
     # the rigid gear's centre, where the imperfect scene holds the rigid teeth)
-    from wgcad.accuracy.imperfect import rigid_translation
+    from wgcad.placement.imperfect import rigid_translation
     from wgcad.clearance.imperfect import ImperfectScene
 
     isc = ImperfectScene.from_scene(Scene(drive), imp)

@@ -11,6 +11,7 @@ from wgcad.clearance.findings import FIGURES, Finding
 from wgcad.design import load_design
 from wgcad.drive import build_drive
 from wgcad.report.audit import audit_summary, entry_json, worst_json
+from wgcad.report.audit import audit_json
 
 
 def test_report_layer_converts_units_of_a_hand_made_finding():
@@ -55,7 +56,7 @@ def test_audit_returns_one_finding_per_figure_and_the_json_is_shaped_from_them(r
     assert worst.method == ("exact" if refine else "polygon")
     # the refined figure is within the polygon-curve difference of the polygon one (2 chord tolerances)
     assert abs(worst.value - worst.polygon_value) <= 2 * drive.tol + 1e-12
-    doc = res.to_json()
+    doc = audit_json(res)
     assert doc["min_clearance_um"] == round(1e3 * worst.value, 4)
     assert doc["worst"]["tooth_angle_deg"] == round(math.degrees(worst.tooth_angle), 6)
     gap = res.findings["entry_gap"]

@@ -262,7 +262,7 @@ def test_drive_errors_in_s2_terms_are_the_drive_poses_errors(zone):
     # accuracy.drive_displacements maps an imperfect drive's errors onto [S2]'s terms: the translations (both
     # eccentricities, the cam offsets) as radial and tangential motion of the flexspline's tooth against the
     # rigid one in the zone, the run-outs along the line of action. The same errors move the posed teeth of
-    # accuracy.imperfect (flex_poses, rigid_poses); at whole mesh periods a flexspline tooth sits on the zone
+    # placement.imperfect (flex_poses, rigid_poses); at whole mesh periods a flexspline tooth sits on the zone
     # and rigid teeth flank it symmetrically, so the relative motion of the posed teeth, radial and along the
     # pitch circle, must be the mapping's, dr and dt + kin / cos(alpha). Exact for the translations; the run-out
     # of the rigid gear is read between the two flanking teeth (their mean differs from the zone's value by
@@ -272,7 +272,7 @@ def test_drive_errors_in_s2_terms_are_the_drive_poses_errors(zone):
     from pathlib import Path
 
     from wgcad.accuracy.flank_errors import drive_displacements
-    from wgcad.accuracy.imperfect import Imperfections, flex_poses, rigid_poses
+    from wgcad.placement.imperfect import Imperfections, flex_poses, rigid_poses
     from wgcad.design import load_design
     from wgcad.drive import build_drive
 

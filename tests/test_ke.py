@@ -8,7 +8,7 @@ import pytest
 from conftest import TEMPLATES, edit_toml
 from wgcad.accuracy import ke as K
 from wgcad.accuracy import ke_table
-from wgcad.accuracy.imperfect import Imperfections, flex_poses, rigid_poses, shortcuts
+from wgcad.placement.imperfect import Imperfections, flex_poses, rigid_poses, shortcuts
 from wgcad.cli import main
 from wgcad.design import load_design
 from wgcad.drive import build_drive

@@ -8,10 +8,10 @@ import pytest
 
 from conftest import TEMPLATES, edit_toml
 from wgcad.accuracy import ke as K
-from wgcad.accuracy.imperfect import Imperfections
+from wgcad.placement.imperfect import Imperfections
 from wgcad.accuracy.ke_load import loaded_ke, sample_periods
 from wgcad.cli import main
-from wgcad.deformation.elastic import build_model
+from wgcad.elastic import build_model
 from wgcad.design import load_design, with_changes
 from wgcad.drive import build_drive
 
@@ -48,7 +48,7 @@ def test_rigid_eccentricity_is_the_opposite_stationary_cam_offset():
     # with a floating rim the two must give the same state at every sample, to the solver's tolerance: the
     # rim's rotation and every tooth force.
     from wgcad.accuracy.ke_load import tooth_errors
-    from wgcad.deformation.elastic import solve_load
+    from wgcad.elastic import solve_load
 
     drive = build_drive(with_changes(load_design(TEMPLATES / "d1_involute.toml"), load={"rim_lateral_stiffness_n_per_mm": 0.0}))
     model = build_model(drive)

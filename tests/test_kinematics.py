@@ -5,7 +5,7 @@ import math
 import numpy as np
 import pytest
 
-from wgcad.deformation import Disc, ExternalRing, Harmonic
+from wgcad.laws import Disc, ExternalRing, Harmonic
 from wgcad.errors import DesignError
 from wgcad.kinematics import RingVelocities, flex_rotation, gear_ratios, ring_generator_velocities
 

@@ -1,4 +1,4 @@
-"""Tests of wgcad.deformation.laws: closed forms, invariants, and independent ring solutions."""
+"""Tests of wgcad.laws: closed forms, invariants, and independent ring solutions."""
 
 import math
 
@@ -8,7 +8,7 @@ from hypothesis import given, seed, settings
 from hypothesis import strategies as st
 from numpy.polynomial.legendre import leggauss
 
-from wgcad.deformation import (
+from wgcad.laws import (
     LAWS,
     Disc,
     Ellipse,

@@ -10,8 +10,8 @@ import shapely
 
 from wgcad.clearance.engine import AuditSettings, audit
 from wgcad.clearance.scene import Scene
-from wgcad.deformation.elastic import build_model
-from wgcad.deformation.elastic.sweep import torque_sweep
+from wgcad.elastic import build_model
+from wgcad.elastic.sweep import torque_sweep
 from wgcad.design import load_design
 from wgcad.drive import build_drive
 from wgcad.placement import tooth_pose, transform

@@ -30,7 +30,7 @@ from conftest import TEMPLATES
 from wgcad import constants
 from wgcad.clearance.distance import Template, signed_clearance
 from wgcad.clearance.engine import AuditSettings, Scene, audit
-from wgcad.deformation.laws import _FF_BETA_HI, _FF_BETA_LO
+from wgcad.laws import _FF_BETA_HI, _FF_BETA_LO
 from wgcad.design import _TABLES, parse_design
 from wgcad.drive import build_drive, tooth_spec
 from wgcad.errors import DesignError
@@ -38,6 +38,7 @@ from wgcad.placement import place_flex_teeth, tooth_angles, tooth_pose, transfor
 from wgcad.profiles import cycloid as cy
 from wgcad.profiles.gear import _fillet_fits, largest_fillet_coef
 from wgcad.report import drive_report
+from wgcad.report.audit import audit_json
 
 N_EXAMPLES = int(os.environ.get("WGCAD_STABILITY_EXAMPLES", "500"))
 AUDIT_ANGLES = np.deg2rad(np.arange(24) * 15.0)  # coarse: 24 generator angles over a revolution
@@ -267,7 +268,7 @@ def independent_clearance(drive, phi_h: float, z) -> np.ndarray:
 def check_audit(drive, n_sections: int, picks: list) -> None:
     secs = drive.sections(n_sections)
     res = audit(drive, AuditSettings(angles=AUDIT_ANGLES, sections=secs, refine=False))
-    out = res.to_json()
+    out = audit_json(res)
     json.dumps(out, allow_nan=False)
     assert math.isfinite(res.min_clearance)
     assert out["interference"] == (res.min_clearance < -res.interference_tol)

@@ -134,7 +134,7 @@ def test_cli_run_in_process_writes_results_summary_and_pictures(tmp_path, capsys
 
 def test_a_sample_that_fails_or_errors_is_counted_not_fatal(tmp_path, monkeypatch):
     # a model that gives up (a WgcadError that is not a rule) and a bug (any other exception) in two samples
-    from wgcad.deformation.elastic.solve import ContactSolveError
+    from wgcad.elastic.solve import ContactSolveError
     from wgcad.sweep import tasks
     from wgcad.sweep.runner import run_sweep
     from wgcad.sweep.store import Store
@@ -168,8 +168,8 @@ def test_a_sample_that_fails_or_errors_is_counted_not_fatal(tmp_path, monkeypatc
 def test_loaded_figures_are_the_elastic_models():
     # figures under load against the elastic model called directly (wgcad audit --torque-nm's path);
     # the torque may be written 500.0 or 500
-    from wgcad.deformation.elastic.model import build_model
-    from wgcad.deformation.elastic.sweep import torque_sweep
+    from wgcad.elastic.model import build_model
+    from wgcad.elastic.sweep import torque_sweep
     from wgcad.design import load_design
     from wgcad.drive import build_drive
     from wgcad.sweep.tasks import run_sample

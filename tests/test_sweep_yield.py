@@ -8,7 +8,7 @@ from scipy.stats import binom
 
 from conftest import TEMPLATES
 from wgcad.accuracy import ke as K
-from wgcad.accuracy.imperfect import Imperfections
+from wgcad.placement.imperfect import Imperfections
 from wgcad.design import load_design
 from wgcad.design.schema import parse_design
 from wgcad.drive import build_drive

@@ -31,7 +31,7 @@ class RunSettings:
     max_memory_mb: float | None = DEFAULT_MAX_MEMORY_MB  # refuse runs estimated above this (None: no limit)
     refine: bool = True  # figures on the exact tooth curves (issue 8)
     #: generator turns swept for an imperfect drive (None: the whole cycle,
-    #: accuracy.imperfect.full_cycle_turns); a perfect drive repeats every mesh period
+    #: placement.imperfect.full_cycle_turns); a perfect drive repeats every mesh period
     turns: int | None = 1
 
     def as_dict(self) -> dict:
@@ -83,7 +83,7 @@ def run_audit(design_path, rs: RunSettings, progress=None):
         run.update(angles=min(n, chunk_angles(design.drive.z_flex, rs.sections)), use_period=False)
     turns = 1
     if imperfect:
-        from .accuracy.imperfect import full_cycle_turns
+        from .placement.imperfect import full_cycle_turns
 
         turns = full_cycle_turns(design.drive.z_flex, design.drive.z_rigid) if rs.turns is None else rs.turns
     elif rs.turns != 1:
@@ -103,7 +103,7 @@ def run_audit(design_path, rs: RunSettings, progress=None):
         refine=rs.refine,
     )
     if imperfect:
-        from .accuracy.imperfect import Imperfections
+        from .placement.imperfect import Imperfections
         from .clearance.imperfect import audit_imperfect
 
         return drive, audit_imperfect(drive, settings, Imperfections.from_spec(design.imperfections), progress=progress)

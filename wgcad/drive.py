@@ -8,7 +8,7 @@ from math import pi
 import numpy as np
 
 from . import constants
-from .deformation import Law, coned_w0, make_law
+from .laws import Law, coned_w0, make_law
 from .design import Design
 from .design.budget import DEFAULT_MAX_MEMORY_MB, check_budget, estimate_run
 from .errors import DesignError

@@ -8,7 +8,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from wgcad.deformation.laws import Law
+from wgcad.laws import Law
 from wgcad.errors import DesignError
 
 __all__ = ["gear_ratios", "flex_rotation", "RingVelocities", "ring_generator_velocities"]
@@ -145,7 +145,7 @@ def ring_generator_velocities(
     Parameters
     ----------
     law : Law
-        Neutral-line law, normally :class:`~wgcad.deformation.ExternalRing`.
+        Neutral-line law, normally :class:`~wgcad.laws.ExternalRing`.
     phi : (...) float or array_like
         Angles from the generator major axis, rad.
     omega_h : float
@@ -161,7 +161,7 @@ def ring_generator_velocities(
 
     Examples
     --------
-    >>> from wgcad.deformation import ExternalRing
+    >>> from wgcad.laws import ExternalRing
     >>> law = ExternalRing(w0=0.9, r_m=135.0, beta=np.radians(40.0))
     >>> vel = ring_generator_velocities(law, [0.0, 1.0], 210.0, 0.9, 0.9)
     >>> vel.V_d.tolist()

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 from .audit import RunSettings, run_audit
 from .regression import baseline_figures, compare, format_drifts, load_baseline, make_baseline
+from .report.audit import audit_json
 
 __all__ = ["baseline_drifts", "assert_matches_baseline", "record_baseline"]
 
@@ -24,7 +25,7 @@ def baseline_drifts(design_path, baseline_path) -> list:
     """Recompute the design with the baseline's settings; the figures that drifted (empty when none did)."""
     doc = load_baseline(baseline_path)
     drive, result = run_audit(design_path, _settings(doc))
-    return compare(doc, baseline_figures(drive, result.to_json()))
+    return compare(doc, baseline_figures(drive, audit_json(result)))
 
 
 def assert_matches_baseline(design_path, baseline_path) -> None:
@@ -39,4 +40,4 @@ def record_baseline(design_path, settings: RunSettings | None = None) -> dict:
     rs = settings or RunSettings()
     drive, result = run_audit(design_path, rs)
     keep = {k: v for k, v in rs.as_dict().items() if k in ("step_deg", "sections", "chord_tol_um", "interference_tol_um")}
-    return make_baseline(str(design_path), keep, drive, result.to_json())
+    return make_baseline(str(design_path), keep, drive, audit_json(result))

@@ -234,7 +234,7 @@ def drive_displacements(drive, imp, phi_h, zone: float = 0.0):
     drive, split as [S2] does (docs/models.md 6.1): ``dr``, ``dt`` from the translations (both gears'
     eccentricities, the cam offsets), ``kin`` from the run-outs along the line of action.
 
-    Everything is read from the drive's own error field (:mod:`wgcad.accuracy.imperfect`): the teeth of the
+    Everything is read from the drive's own error field (:mod:`wgcad.placement.imperfect`): the teeth of the
     zone at generator angle ``phi_h`` (rad, rigid gear fixed) are the flexspline's tooth at its angle
     ``zone + phi_h - phi_g`` and the rigid gear's at ``zone + phi_h``; a run-out ``F`` deviates a tooth along
     the pitch circle by ``(F/2) sin(a + xi)``, which is ``cos(alpha)`` of that along the line of action
@@ -248,7 +248,7 @@ def drive_displacements(drive, imp, phi_h, zone: float = 0.0):
     -------
     dr, dt, kin : (...) float, mm
     """
-    from .imperfect import cam_offset, rigid_translation
+    from ..placement.imperfect import cam_offset, rigid_translation
 
     d = drive.design.drive
     phi_h = np.asarray(phi_h, dtype=np.float64)
@@ -336,7 +336,7 @@ def flank_error_table(generator_angle_deg, *, z_flex: int, z_rigid: int, pressur
 
 def write_flank_error_csv(path, header, rows) -> None:
     """Write :func:`flank_error_table`'s header and rows as CSV, atomically (``%.9g``, ``\\n`` line ends)."""
-    from wgcad.export.atomic import atomic_write  # I/O at the edge
+    from wgcad.atomic import atomic_write  # I/O at the edge
 
     lines = [",".join(header)]
     lines += [",".join(f"{float(x):.9g}" for x in row) for row in rows]

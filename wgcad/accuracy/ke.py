@@ -22,7 +22,7 @@ What is exploited (tested against the direct computation in tests/test_ke.py):
 * **linear errors**: run-out, eccentricities and the flexspline-borne and
   stationary cam offsets move the teeth by tens of micrometres; their effect
   on a contact's closing rotation is ``(u_b - u_f) . nt`` with ``nt`` stored
-  per contact (:mod:`wgcad.accuracy.contact`);
+  per contact (:mod:`wgcad.clearance.closing`);
 * **second features**: where those errors carry a contact onto another
   feature (a tip running past the end of the other's involute into its root
   fillet: D4 at the major axis) the closing rotation is the lower of the
@@ -49,13 +49,11 @@ from math import pi
 
 import numpy as np
 
-from ..clearance.distance import Template
+from ..clearance.closing import closing_direct
 from ..errors import DesignError
 from ..kinematics import gear_ratios
-from ..placement import transform
-from .contact import closing_rotation
-from .imperfect import Imperfections, flex_poses, rigid_poses
-from .ke_table import DEFAULT_N, ContactTable, LanePlan, _check, _harmonics, _lanes, contact_table, lane_minimum
+from ..placement.imperfect import Imperfections
+from .ke_table import DEFAULT_N, ContactTable, LanePlan, _harmonics, _lanes, contact_table, lane_minimum
 
 #: generator angles per pass (a few MB of temporaries per lattice class)
 _SPAN = 1 << 16
@@ -209,32 +207,6 @@ def optimize_install_angle(tab: ContactTable, imp: Imperfections, lever: str = "
     if v.min() < best_v:
         best_a, best_v = float(fine[int(np.argmin(v))]), float(v.min())
     return best_a % (2 * pi), best_v, grid, pp
-
-
-def closing_direct(drive, imp: Imperfections, phi_h: float, side: int, sections=None) -> float:
-    """Reference: the closing rotation at ``phi_h`` from the exact poses of every tooth (no table, no linearisation), rad."""
-    _check(drive)
-    d = drive.design.drive
-    z_b = d.z_rigid
-    if sections is None:
-        sections = [float(z) for z in drive.sections(3)] if drive.coned else [None]
-    flex, rigid = Template(drive.flex.tooth_polygon()), Template(drive.rigid.tooth_polygon())
-    rr, rs = rigid_poses(drive, imp)
-    best = np.inf
-    gamma_b = 2 * pi / z_b
-    for z in sections:
-        rot, shift = flex_poses(drive, imp, phi_h, z=z)
-        a = np.arctan2(shift[:, 1] + drive.r_m * np.sin(rot), shift[:, 0] + drive.r_m * np.cos(rot))
-        pts_r = np.hypot(*transform(flex.local, rot, shift).transpose(2, 0, 1))
-        # radially engaged: the tooth reaches past the rigid tip circle (docs/models.md 7, culling)
-        near = (pts_r.min(axis=1) <= drive.rigid.r_a) if drive.external else (pts_r.max(axis=1) >= drive.rigid.r_a)
-        idx = np.nonzero(near)[0]
-        lo = np.floor(a[idx] / gamma_b - 0.5).astype(int)
-        j = (lo + (1 if side > 0 else 0)) % z_b
-        con = closing_rotation(flex, rot[idx], shift[idx], rigid, rr[j], rs[j], side, 0.5 * 2 * pi / d.z_flex)
-        if con.ok.any():
-            best = min(best, float(con.delta[con.ok].min()))
-    return best
 
 
 def spectrum(res: KEResult):

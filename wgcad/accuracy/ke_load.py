@@ -1,6 +1,6 @@
 """Kinematic error under load: the elastic contact model of the imperfect drive at whole mesh periods of the generator (docs/models.md 6.3).
 
-The elastic model (:func:`wgcad.deformation.elastic.solve_load`) solves the
+The elastic model (:func:`wgcad.elastic.solve_load`) solves the
 loaded drive with the generator at angle 0. At a generator angle that is a
 whole number ``n`` of mesh periods, ``phi_h = sigma n 2 pi / z_b``, a perfect
 drive looks exactly the same in the generator's frame (docs/models.md 7):
@@ -32,7 +32,7 @@ import numpy as np
 
 from ..errors import DesignError
 from ..kinematics import gear_ratios
-from .imperfect import Imperfections, cam_offset, flex_deviations, rigid_translation
+from ..placement.imperfect import Imperfections, cam_offset, flex_deviations, rigid_translation
 
 __all__ = ["LoadedKE", "sample_periods", "tooth_errors", "loaded_ke", "LoadedLever", "install_lever", "SCAN_ANGLES"]
 
@@ -117,7 +117,7 @@ def loaded_ke(drive, imp: Imperfections, torque_nm: float, samples: int | None =
     samples : int, optional
         Load states over the flexspline revolution (default :func:`sample_periods`'s).
     model : ElasticModel, optional
-        Reused if given (:func:`wgcad.deformation.elastic.build_model`).
+        Reused if given (:func:`wgcad.elastic.build_model`).
     progress : callable, optional
         ``progress(done, total)``.
     tol : float, optional
@@ -126,7 +126,7 @@ def loaded_ke(drive, imp: Imperfections, torque_nm: float, samples: int | None =
     """
     import time
 
-    from ..deformation.elastic import build_model, solve_load
+    from ..elastic import build_model, solve_load
 
     d = drive.design.drive
     if d.fixed != "rigid":
@@ -214,7 +214,7 @@ def install_lever(drive, imp: Imperfections, torque_nm: float, model=None, sampl
     """
     import time
 
-    from ..deformation.elastic import build_model
+    from ..elastic import build_model
 
     t0 = time.perf_counter()
     model = build_model(drive) if model is None else model

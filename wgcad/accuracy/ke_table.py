@@ -18,8 +18,8 @@ from ..clearance.distance import Template
 from ..errors import DesignError
 from ..kinematics import gear_ratios
 from ..placement import tooth_pose
-from .contact import closing_rotation
-from .imperfect import Imperfections, cam_offset, coning_factor, flex_deviations, rigid_deviations, rigid_translation
+from ..clearance.closing import closing_rotation
+from ..placement.imperfect import Imperfections, cam_offset, coning_factor, flex_deviations, rigid_deviations, rigid_translation
 
 __all__ = ["ContactTable", "contact_table", "DEFAULT_N", "NT_MAX"]
 

@@ -80,25 +80,6 @@ class AuditResult:
         return self.findings["backlash"].value
 
     @property
-    def worst(self) -> dict:
-        from ..report.audit import worst_json
-
-        return worst_json(self.findings["min_clearance"])
-
-    @property
-    def entry(self) -> dict:
-        from ..report.audit import entry_json
-
-        f = self.findings
-        return entry_json(f["entry_gap"], f.get("entry_crossing", f["entry_gap"]), f["entry_pinch"], self.entry_side)
-
-    @property
-    def backlash_range(self) -> dict:
-        from ..report.audit import backlash_at_json
-
-        return backlash_at_json(self.findings["backlash"])
-
-    @property
     def entry_side(self) -> str:
         return self.settings.get("entry_side", "entry (+phi)")
 
@@ -109,12 +90,6 @@ class AuditResult:
         return {"worst_phi": f["min_clearance"].tooth_angle, "entry_phi": f["entry_gap"].tooth_angle,
                 "crossing_phi": f["entry_crossing"].tooth_angle if "entry_crossing" in f else None,
                 "pinch_phi": f["entry_pinch"].tooth_angle, "min_clearance_polygon": f["min_clearance"].polygon_value}
-
-    def to_json(self) -> dict:
-        """The JSON document (shaped in :func:`wgcad.report.audit.audit_json`)."""
-        from ..report.audit import audit_json
-
-        return audit_json(self)
 
 
 #: refinement: above this many candidate samples they are first sorted out on polygons _FINE

@@ -395,9 +395,9 @@ def imperfect_track(drive, imp, phi_h: float, tooth: int):
 
     Returns ``track(z) -> (rot (1,), shift (1, 2))``, relative to the rigid
     gear's own centre as :class:`~wgcad.clearance.imperfect.ImperfectScene`
-    holds the rigid teeth (:func:`wgcad.accuracy.imperfect.flex_poses`).
+    holds the rigid teeth (:func:`wgcad.placement.imperfect.flex_poses`).
     """
-    from ..accuracy.imperfect import flex_poses, rigid_translation
+    from ..placement.imperfect import flex_poses, rigid_translation
 
     centre = rigid_translation(imp)
 
@@ -421,7 +421,7 @@ def verify_worst(drive, result, n_sections: int = 9, imp=None) -> dict:
         Loft sections over the face width (coning); the audit's own
         sections are added, so the 2D figure covers the section the audit
         found the minimum in.
-    imp : wgcad.accuracy.imperfect.Imperfections, optional
+    imp : wgcad.placement.imperfect.Imperfections, optional
         The errors of an imperfect drive's audit
         (:func:`wgcad.clearance.imperfect.audit_imperfect`): each pair is
         then the tooth and generator angle the audit names, every part
@@ -435,7 +435,7 @@ def verify_worst(drive, result, n_sections: int = 9, imp=None) -> dict:
     """
     scene = Scene(drive)
     if imp is not None:
-        from .imperfect import ImperfectScene
+        from .imperfect_scene import ImperfectScene
 
         scene = ImperfectScene.from_scene(scene, imp)
     bw = float(drive.design.drive.face_width)
@@ -446,15 +446,14 @@ def verify_worst(drive, result, n_sections: int = 9, imp=None) -> dict:
     if imp is not None:
         return _summarise(drive, zs, [{"what": what, **_check_sample(scene, drive, imp, f, zs)}
                                       for what, f in _imperfect_targets(result)])
-    raw = getattr(result, "raw", {}) or {}
-    # unrounded angles where the engine kept them (degrees in the JSON are rounded to 1e-6)
-    targets = [("tightest", np.rad2deg(raw["worst_phi"]) if raw.get("worst_phi") is not None else result.worst["tooth_angle_deg"])]
-    if result.entry.get("pinch_tooth_angle_deg") is not None:
-        pin = raw.get("pinch_phi")
-        targets.append(("entry pinch", np.rad2deg(pin) if pin is not None else result.entry["pinch_tooth_angle_deg"]))
+    # the records' unrounded tooth angles (rad)
+    f = result.findings
+    targets = [("tightest", f["min_clearance"].tooth_angle)]
+    if np.isfinite(f["entry_pinch"].value) and f["entry_pinch"].tooth_angle is not None:
+        targets.append(("entry pinch", f["entry_pinch"].tooth_angle))
     pairs = []
-    for what, deg in targets:
-        pairs.append({"what": what, **check_tooth(scene, float(np.deg2rad(deg)), sections=zs)})
+    for what, phi in targets:
+        pairs.append({"what": what, **check_tooth(scene, float(phi), sections=zs)})
     return _summarise(drive, zs, pairs)
 
 

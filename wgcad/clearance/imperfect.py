@@ -2,7 +2,7 @@
 
 Run-out, eccentricities and a cam offset tied to a gear or the housing
 break the mesh period, the identical waves and the mirror symmetry
-(:func:`wgcad.accuracy.imperfect.shortcuts`): every sample has its own pose.
+(:func:`wgcad.placement.imperfect.shortcuts`): every sample has its own pose.
 What still saves work (docs/models.md 7, last paragraph):
 
 * **the perfect twin**: a sample's clearance is at least the perfect
@@ -29,10 +29,10 @@ from math import pi
 import numpy as np
 import shapely
 
-from ..accuracy.imperfect import (Imperfections, cam_offset, coning_factor, flex_deviations, full_cycle_turns, rigid_poses,
-                                  rigid_translation, shortcuts)
-from ..placement import pose_from_displacements, transform
+from ..placement import transform
+from ..placement.imperfect import Imperfections, flex_poses_batch, full_cycle_turns, rigid_translation, shortcuts
 from .imperfect_bounds import ErrorBound, PerfectBound, PerfectBounds, chunk_bounds
+from .imperfect_scene import ImperfectScene
 from .scene import Scene, clearance_at_poses, refine_min
 
 __all__ = ["ImperfectScene", "flex_poses_batch", "PerfectBound", "ErrorBound", "audit_imperfect", "chunk_angles", "CHUNK_SAMPLES"]
@@ -57,82 +57,6 @@ _ONE_CALL = 48
 def chunk_angles(z_g: int, sections: int, chunk_samples: int = CHUNK_SAMPLES) -> int:
     """Generator angles per chunk for ``z_g`` teeth and ``sections`` sections."""
     return max(1, chunk_samples // (z_g * max(1, sections)))
-
-
-class ImperfectScene(Scene):
-    """A :class:`Scene` whose rigid teeth carry the rigid gear's run-out, in the frame of the rigid gear's own centre.
-
-    Built from a perfect scene (templates and exact curves are shared). The
-    rigid gear's eccentric shift ``T`` is taken out of the frame: the rigid
-    teeth stay about the origin (turned by their run-out) and flexspline
-    poses are given relative to the rigid centre (:meth:`relative`), so the
-    perfect scene's neighbour search and third-tooth bound, which measure
-    angles about the origin, hold as they are. Run-out turns a tooth by at
-    most ``F_b / (2 r_b)``, far below half a pitch, so the bracketing teeth
-    stay the bracketing teeth.
-    """
-
-    @classmethod
-    def from_scene(cls, scene: Scene, imp: Imperfections) -> "ImperfectScene":
-        new = cls.__new__(cls)
-        new.__dict__.update(scene.__dict__)
-        new.imp = imp
-        new.center_b = rigid_translation(imp)
-        rot, shift = rigid_poses(scene.drive, imp)
-        new.rigid_rot, new.rigid_shift = rot, shift - new.center_b  # zero: the frame of the rigid centre
-        new.rigid_pts = transform(scene.rigid.local, rot, new.rigid_shift)
-        new.rigid_pts.setflags(write=False)
-        new.rigid_geoms = shapely.polygons(new.rigid_pts)
-        shapely.prepare(new.rigid_geoms)
-        return new
-
-    def relative(self, shift: np.ndarray) -> np.ndarray:
-        """Flexspline shifts (rigid-gear frame) in the frame of the rigid gear's own centre."""
-        return shift - self.center_b
-
-
-def flex_poses_batch(drive, imp: Imperfections, phi_h: np.ndarray, k: np.ndarray, sections: list):
-    """Poses of flexspline teeth ``k`` at generator angles ``phi_h`` in every section, as :func:`wgcad.accuracy.imperfect.flex_poses`.
-
-    Parameters
-    ----------
-    phi_h, k : (K,) float, int
-        Generator angle (rad, relative to the rigid gear) and tooth of each sample.
-    sections : list of (float or None)
-
-    Returns
-    -------
-    list over sections of ``(rot (K,), shift (K, 2))``.
-
-    For laws linear in W0 the law is evaluated once for every section
-    (a coned section's displacements are the centre's scaled by ``W0(z)/W0``).
-    """
-    d = drive.design.drive
-    z_g = d.z_flex
-    from ..kinematics import gear_ratios
-
-    phi_h = np.asarray(phi_h, dtype=float)
-    k = np.asarray(k)
-    phi_g = phi_h / gear_ratios(z_g, d.z_rigid)["u_hg"]
-    dalpha, drho = flex_deviations(imp, k, z_g, drive.flex.r)
-    phi = 2.0 * pi * k / z_g + phi_g + dalpha - phi_h
-    E = cam_offset(imp, phi_h, phi_g)
-    base = drive.law
-    shared = base.linear_in_w0 and all(z is None or drive.coned for z in sections)
-    st = base.state(phi) if shared else None
-    out = []
-    for z in sections:
-        if shared:
-            f = 1.0 if z is None else drive.law_at(z).w0 / base.w0
-            rot, shift = pose_from_displacements(phi, f * st.w, f * st.v, f * st.theta, drive.r_m, phi_h)
-        else:
-            law = base if z is None else drive.law_at(z)
-            s2 = law.state(phi)
-            rot, shift = pose_from_displacements(phi, s2.w, s2.v, s2.theta, drive.r_m, phi_h)
-        shift = shift + drho[:, None] * np.stack([np.cos(rot), np.sin(rot)], axis=-1)
-        shift += coning_factor(drive, z) * E
-        out.append((rot, shift))
-    return out
 
 
 def _evaluate_poses(scene, rot, shift) -> np.ndarray:
@@ -372,7 +296,7 @@ def audit_imperfect(drive, settings, imp: Imperfections, progress=None, chunk_sa
     span = np.array([angles[0], angles[0] + 2 * pi / scene.z_b]) if shortcuts(imp)["mesh_period"] else angles
     ent = imperfect_entry(drive, imp, isc, scene, gaps, p_pinch, span, sections, settings.refine) if crossed else {}
     # backlash of the imperfect drive at the first generator angle, middle section: the rigid turn of the
-    # flexspline between contact either way, from the exact poses (wgcad.accuracy.ke.closing_direct)
+    # flexspline between contact either way, from the exact poses (wgcad.clearance.closing.closing_direct)
     z_mid = sections[len(sections) // 2]
     bl = _backlash(drive, imp, float(angles[0]), z_mid)
     if progress is not None:
@@ -464,7 +388,7 @@ def _entry_edge(drive, imp: Imperfections, isc: "ImperfectScene", phi_h: float, 
 
 def _backlash(drive, imp: Imperfections, phi_h: float, z) -> float:
     """Dead travel (rad) of the imperfect drive at ``phi_h``: closing rotations either way; NaN if the teeth interfere."""
-    from ..accuracy.ke import closing_direct
+    from .closing import closing_direct
 
     if drive.design.drive.fixed != "rigid":
         return float("nan")

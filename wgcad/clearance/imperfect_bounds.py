@@ -13,7 +13,7 @@ from math import pi
 
 import numpy as np
 
-from ..accuracy.imperfect import Imperfections, cam_offset, coning_factor, flex_deviations, rigid_translation
+from ..placement.imperfect import Imperfections, cam_offset, coning_factor, flex_deviations, rigid_translation
 from .scene import Scene
 
 __all__ = ["PerfectBound", "PerfectBounds", "ErrorBound", "GRID_LOSS", "chunk_bounds"]

@@ -79,7 +79,7 @@ def passages(scene, p_star: float, phi_lo: float, phi_hi: float):
 
 
 def _poses(drive, imp, isc, phi_h, k, z):
-    from .imperfect import flex_poses_batch
+    from ..placement.imperfect import flex_poses_batch
 
     rot, shift = flex_poses_batch(drive, imp, phi_h, k, [z])[0]
     return rot, isc.relative(shift)
@@ -176,7 +176,7 @@ def imperfect_entry(drive, imp, isc, scene, perfect_gaps, perfect_pinch, angles,
             # many alike (the same cam phase every turn): sorted out first on polygons 8 times finer, as the
             # clearance audit does
             from ..drive import build_drive
-            from .imperfect import ImperfectScene
+            from .imperfect_scene import ImperfectScene
             from .scene import Scene
 
             fine = ImperfectScene.from_scene(Scene(build_drive(drive.design, tol=drive.tol / 8)), imp)

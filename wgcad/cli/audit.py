@@ -85,7 +85,9 @@ def cmd_audit(args) -> int:
     # the engine reports (done, total, stage); it fills the bar up to 90 % (95 % without pictures)
     work_end = 0.6 if args.plot else (0.9 if args.engine == "2d" else 0.8)
     drive, result = run_audit(args.design, rs, progress=bar.span(0.02, work_end, "clearance"))
-    res = result.to_json()
+    from ..report.audit import audit_json
+
+    res = audit_json(result)
     res["design"] = drive.design.drive.name
     res["source"] = drive.design.source
     from .common import not_modelled
@@ -100,7 +102,7 @@ def cmd_audit(args) -> int:
 
         imp = None
         if imperfect:
-            from ..accuracy.imperfect import Imperfections
+            from ..placement.imperfect import Imperfections
 
             imp = Imperfections.from_spec(drive.design.imperfections)
         res["fcl"] = verify_worst(drive, result, imp=imp)
@@ -125,7 +127,7 @@ def cmd_audit(args) -> int:
         base_text = json.dumps(doc, indent=2) + "\n"
     files = [(args.json, res_text), (args.write_baseline, base_text)]
     if any(p and p != STDOUT for p, _ in files) or args.plot:
-        from ..export.atomic import atomic_batch
+        from ..atomic import atomic_batch
 
         with atomic_batch() as batch:
             for path, text in files:
@@ -189,8 +191,10 @@ def _audit_pngs(drive, result):
     perfect_note = " (perfect drive)" if imperfect else ""
     secs = [None] if not drive.coned else [s for s in result.settings["sections_z_mm"]]
     prof = clearance_profile(scene, secs)
-    w = result.worst
-    e = result.entry
+    from ..report.audit import audit_json
+
+    doc = audit_json(result)
+    w, e = doc["worst"], doc["entry"]
     name = drive.design.drive.name
     ent = result.findings["entry_crossing"].details
     extra = {}
@@ -247,7 +251,7 @@ def _audit_pngs(drive, result):
     rot, shift = tooth_pose(scene.law(z), mat - phi_h, drive.r_m, frame_angle=phi_h)
     if imperfect:
         # the imperfect drive's own teeth, where the audit found its tightest spot
-        from ..accuracy.imperfect import Imperfections
+        from ..placement.imperfect import Imperfections
         from ..clearance.imperfect import ImperfectScene, flex_poses_batch
 
         imp = Imperfections.from_spec(drive.design.imperfections)

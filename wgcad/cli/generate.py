@@ -16,7 +16,7 @@ __all__ = ["register", "cmd_generate", "deformed_scene", "report_name"]
 def deformed_scene(drive, phi_h_abs: float, imp=None) -> dict:
     """Geometry of the deformed drive at generator angle ``phi_h_abs`` (rad, relative to the fixed member).
 
-    With ``imp`` (:class:`wgcad.accuracy.imperfect.Imperfections`, rigid gear
+    With ``imp`` (:class:`wgcad.placement.imperfect.Imperfections`, rigid gear
     fixed) every tooth of both gears sits where its errors put it
     (``flex_poses``, ``rigid_poses``), and the rim and neutral line move with
     the cam offset (docs/models.md 6.2).
@@ -35,7 +35,7 @@ def deformed_scene(drive, phi_h_abs: float, imp=None) -> dict:
         phi_h, frame = phi_h_abs - phi_b, phi_b
     _, phi = tooth_angles(d.z_flex, d.z_rigid, phi_h)
     if imp is not None:
-        from ..accuracy.imperfect import cam_offset, flex_poses, rigid_poses
+        from ..placement.imperfect import cam_offset, flex_poses, rigid_poses
 
         teeth = transform(drive.flex.period, *flex_poses(drive, imp, phi_h))
         rigid_outline = join_teeth(transform(drive.rigid.period, *rigid_poses(drive, imp)))
@@ -127,7 +127,7 @@ def cmd_generate(args) -> int:
     bar.start("loading modules")
     from ..design import load_design
     from ..drive import build_drive
-    from ..export.atomic import check_target
+    from ..atomic import check_target
     from ..report import drive_report, format_summary
 
     bar.set(0.0, "reading the design")
@@ -152,7 +152,7 @@ def cmd_generate(args) -> int:
 
             raise OutputError(f"{out / name}: is the design file itself; it would be overwritten (give another --out)")
 
-    from ..export.atomic import atomic_batch
+    from ..atomic import atomic_batch
     from ..export.dxf import DxfLayer, write_dxf
 
     step(_COST["design"], "DXF")
@@ -175,7 +175,7 @@ def cmd_generate(args) -> int:
     # gears' own DXF and STL stay nominal, the part a shop makes
     imp = None
     if design.imperfections.any and design.drive.fixed == "rigid":
-        from ..accuracy.imperfect import Imperfections
+        from ..placement.imperfect import Imperfections
 
         imp = Imperfections.from_spec(design.imperfections)
     rep["not_modelled"] = not_modelled(design, "generate", imperfections=imp is not None)

@@ -18,10 +18,10 @@ def cmd_ke(args) -> int:
     import numpy as np
 
     from ..accuracy import ke as K
-    from ..accuracy.imperfect import Imperfections, shortcuts
+    from ..placement.imperfect import Imperfections, shortcuts
     from ..design import load_design
     from ..drive import build_drive
-    from ..export.atomic import atomic_batch, ensure_writable_dir
+    from ..atomic import atomic_batch, ensure_writable_dir
 
     if args.torque_nm is not None:
         _torques(args.torque_nm)  # bad torques are refused before any work
@@ -106,7 +106,7 @@ def cmd_ke(args) -> int:
                 Path(batch.temp_path(stem.with_name(stem.name + "_install.png"))).write_bytes(
                     install_png(f"{d.name}: largest KE against installation angle", scan[0], scan[1], scan[2], scan[3], scan[0], scan[4]))
             from ..accuracy.flank_errors import ENGAGEMENTS, drive_flank_errors
-            from ..accuracy.imperfect import full_cycle_turns
+            from ..placement.imperfect import full_cycle_turns
 
             # [S2]'s model on the drive's own errors (docs/models.md 6.1) over the whole error cycle
             cyc = full_cycle_turns(d.z_flex, d.z_rigid)
@@ -132,7 +132,7 @@ def _torques(text: str) -> list:
 def _loaded(args, drive, imp, res, tab, out: dict) -> list:
     """The loaded KE at each ``--torque-nm`` (elastic model, docs/models.md 6.3): printed, added to ``out``, returned."""
     from ..accuracy.ke_load import loaded_ke
-    from ..deformation.elastic import build_model
+    from ..elastic import build_model
     from .common import Progress, want_progress
 
     torques = _torques(args.torque_nm)

@@ -36,7 +36,7 @@ def cmd_kinematics(args) -> int:
           f"(the {'rigid' if d.fixed == 'rigid' else 'flexspline'} teeth pass one pitch)")
     if not design.external:
         return EXIT_OK
-    from ..export.atomic import atomic_batch
+    from ..atomic import atomic_batch
     from ..kinematics import ring_generator_velocities
 
     out = out_dir(args, args.design)  # checked above; created with the files

@@ -89,8 +89,8 @@ def _summary(name: str, res: dict) -> str:
 
 
 def _sweep(path, torques, e_um, e_deg, sections, progress):
-    from ..deformation.elastic.model import build_model
-    from ..deformation.elastic.sweep import torque_sweep
+    from ..elastic.model import build_model
+    from ..elastic.sweep import torque_sweep
     from ..design import load_design
     from ..drive import build_drive
 
@@ -128,7 +128,7 @@ def _levels(args) -> list[float]:
 
 def run_load(args) -> int:
     """The load audit: sweep, print, write JSON and PNGs atomically; exit 1 when the entry gap closes."""
-    from ..export.atomic import atomic_batch, ensure_writable_dir
+    from ..atomic import atomic_batch, ensure_writable_dir
 
     torques = _levels(args)
     for path in (args.json, args.plot):

@@ -46,7 +46,7 @@ def check_output_file(path, *, flag: str, inputs=(), stdout_ok: bool = False) ->
     ------
     OutputError
     """
-    from ..export.atomic import check_target, check_writable_dir
+    from ..atomic import check_target, check_writable_dir
 
     p = Path(path)
     hint = f" (give {flag} - to write to standard output)" if stdout_ok else ""
@@ -63,7 +63,7 @@ def check_output_file(path, *, flag: str, inputs=(), stdout_ok: bool = False) ->
 
 def check_output_dir(path) -> Path:
     """Check an output folder (``--out``) before anything is computed; nothing is created."""
-    from ..export.atomic import check_writable_dir
+    from ..atomic import check_writable_dir
 
     return check_writable_dir(path)
 

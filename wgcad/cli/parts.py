@@ -39,7 +39,7 @@ def cmd_parts(args) -> int:
     from ..design.parts import load_parts, part_sizes
     from ..drive import build_drive
     from ..errors import GeometryError
-    from ..export.atomic import atomic_batch, ensure_writable_dir
+    from ..atomic import atomic_batch, ensure_writable_dir
     from ..export.parts import build_parts
 
     design = load_design(args.design)

@@ -118,7 +118,7 @@ def cmd_sector(args) -> int:
     import numpy as np
 
     from ..design import load_design
-    from ..export.atomic import atomic_batch, ensure_writable_dir
+    from ..atomic import atomic_batch, ensure_writable_dir
 
     design = load_design(args.design)
     out = out_dir(args, args.design)

@@ -35,7 +35,7 @@ def _scheduler(text: str) -> str:
 
 def cmd_sweep(args) -> int:
     from ..errors import DesignError, OutputError
-    from ..export.atomic import atomic_batch, check_writable_dir
+    from ..atomic import atomic_batch, check_writable_dir
     from ..sweep.spec import load_spec
     from .common import Progress, want_progress
 

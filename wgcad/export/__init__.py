@@ -2,13 +2,13 @@
 
 The DXF and STL modules import ezdxf, trimesh and manifold3d (together ~2 s
 on a cold start), so they are loaded on first use of a name that needs them
-(PEP 562 module ``__getattr__``): ``import wgcad.export.atomic`` or
+(PEP 562 module ``__getattr__``): ``import wgcad.atomic`` or
 ``wgcad --help`` stays light.
 """
 
 import importlib
 
-from wgcad.export.atomic import (
+from wgcad.atomic import (
     atomic_batch,
     atomic_write,
     atomic_writer,

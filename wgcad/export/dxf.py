@@ -14,7 +14,7 @@ from ezdxf.lldxf.validator import is_valid_layer_name
 from wgcad.errors import InputFileError
 from wgcad.constants import DUPLICATE_TOL  # noqa: F401  (re-exported for callers)
 from wgcad.export.arcs import arc_points
-from wgcad.export.atomic import atomic_writer
+from wgcad.atomic import atomic_writer
 from wgcad.export.rings import clean_outline, min_spacing
 
 __all__ = ["DxfLayer", "build_dxf", "write_dxf", "read_dxf", "audit_dxf", "clean_outline", "clean_path"]

@@ -54,7 +54,7 @@ def force_distribution_png(levels: list, title: str) -> bytes:
     Parameters
     ----------
     levels : list of dict
-        :func:`wgcad.deformation.elastic.sweep.level_summary` results.
+        :func:`wgcad.elastic.sweep.level_summary` results.
     """
     plt, fig = _fig(10.0, 6.0)
     ax = fig.add_subplot(211)

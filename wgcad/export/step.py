@@ -8,7 +8,7 @@ import re
 import numpy as np
 
 from wgcad.errors import GeometryError
-from wgcad.export.atomic import atomic_write
+from wgcad.atomic import atomic_write
 
 __all__ = ["wire_from_path", "wire_from_polygon", "bspline_wire", "circle_wire", "prism", "revolve_profile", "fuse", "cut", "drill",
            "write_step", "read_step", "solid_props", "step_text"]

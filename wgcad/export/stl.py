@@ -12,7 +12,7 @@ import trimesh
 from trimesh.exchange.stl import export_stl
 
 from wgcad.errors import GeometryError
-from wgcad.export.atomic import atomic_write
+from wgcad.atomic import atomic_write
 from wgcad.export.rings import clean_outline
 
 __all__ = ["ring_solid", "stl_bytes", "write_stl"]

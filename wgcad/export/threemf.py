@@ -10,7 +10,7 @@ from xml.etree import ElementTree as ET
 import numpy as np
 
 from wgcad.errors import InputFileError
-from wgcad.export.atomic import atomic_write
+from wgcad.atomic import atomic_write
 
 __all__ = ["threemf_bytes", "write_3mf", "read_3mf"]
 

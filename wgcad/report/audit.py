@@ -98,6 +98,7 @@ def backlash_at_json(f) -> dict:
 def audit_json(result) -> dict:
     """The JSON document of an :class:`~wgcad.clearance.engine.AuditResult` (units in the key names)."""
     r = result
+    f = r.findings
     r_b = r.settings["rigid_pitch_radius_mm"]
     finite_bl = np.isfinite(r.backlash)
     return {
@@ -105,12 +106,12 @@ def audit_json(result) -> dict:
         "entry_gap_um": round(1e3 * r.entry_gap, 4) if np.isfinite(r.entry_gap) else None,
         "backlash_arcmin": None if not finite_bl else round(float(np.rad2deg(r.backlash) * 60.0), 5),
         "backlash_um_at_pitch": None if not finite_bl else round(1e3 * r.backlash * r_b, 4),
-        "backlash_at": r.backlash_range,
+        "backlash_at": backlash_at_json(f["backlash"]),
         "backlash_unbounded": bool(np.isinf(r.backlash)),
         "interference": bool(r.interference),
         "interference_tol_um": round(1e3 * r.interference_tol, 4),
-        "worst": r.worst,
-        "entry": r.entry,
+        "worst": worst_json(f["min_clearance"]),
+        "entry": entry_json(f["entry_gap"], f.get("entry_crossing", f["entry_gap"]), f["entry_pinch"], r.entry_side),
         "settings": r.settings,
         "counts": r.counts,
         "elapsed_s": round(r.elapsed_s, 4),

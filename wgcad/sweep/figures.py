@@ -7,7 +7,7 @@ Three models, each run once per sample for all its figures:
   revolution; sees the geometry and ``[imperfections]``;
 * ``audit`` (:mod:`wgcad.clearance.engine`, docs/models.md 5): the no-load
   clearance audit of the perfect drive; sees the geometry only;
-* ``load`` (:mod:`wgcad.deformation.elastic`, docs/models.md 4.1): the
+* ``load`` (:mod:`wgcad.elastic`, docs/models.md 4.1): the
   elastic contact model at the torques named in the figure
   (``entry_gap_um@500Nm``); sees the geometry, ``[material]``,
   ``[bearing]`` and ``[load]`` (its cam offset), not ``[imperfections]``.

@@ -61,7 +61,7 @@ class Store:
     # -- the folder ----------------------------------------------------------
     def open(self) -> "Store":
         """Create the folder (or check that it holds this spec's results) and write ``sweep.json``."""
-        from ..export.atomic import atomic_write, ensure_writable_dir, remove_stale_temps
+        from ..atomic import atomic_write, ensure_writable_dir, remove_stale_temps
 
         meta = self.folder / "sweep.json"
         if meta.exists():
@@ -110,7 +110,7 @@ class Store:
     # -- writing -------------------------------------------------------------
     def write(self, a: int, b: int, columns: dict) -> Path:
         """Write samples ``[a, b)`` atomically; returns the chunk's path."""
-        from ..export.atomic import atomic_write
+        from ..atomic import atomic_write
 
         p = self.path(a, b)
         atomic_write(p, self._encode(columns))

@@ -131,7 +131,7 @@ def _drive(data, design):
 
 def _ke(payload, data, design, drive) -> dict:
     from ..accuracy import ke as K
-    from ..accuracy.imperfect import Imperfections
+    from ..placement.imperfect import Imperfections
     from ..design.imperfections import ImperfectionsSpec
 
     imp = Imperfections.from_spec(design.imperfections)
@@ -184,8 +184,8 @@ def _load(payload, data, design, drive, torques) -> dict:
 
 
 def _load_run(payload, data, design, drive, torques) -> dict:
-    from ..deformation.elastic.model import build_model
-    from ..deformation.elastic.sweep import torque_sweep
+    from ..elastic.model import build_model
+    from ..elastic.sweep import torque_sweep
 
     key = _h([_geometry_key(data), payload["load_sections"]])
     model = _cached("model", key, lambda: build_model(drive, payload["load_sections"]))

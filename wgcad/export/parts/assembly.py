@@ -6,7 +6,7 @@ import numpy as np
 
 from wgcad.errors import GeometryError
 
-from . import Part
+from .part import Part
 from .solids import circle_points, prism_m, to_trimesh
 
 __all__ = ["deformed_assembly", "N_SLICES_CONED"]

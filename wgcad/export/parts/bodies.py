@@ -11,7 +11,7 @@ from wgcad.export.arcs import fit_gear, path_area
 from wgcad.export.dxf import DxfLayer
 from wgcad.export.gear_data import data_lines, gear_data
 
-from . import Part
+from .part import Part
 from .solids import bolt_circle, circle_points, holes_m, n_segments, prism_m, revolve_m, to_trimesh
 
 __all__ = ["flexspline", "plug", "rigid", "plug_outline", "data_layer"]

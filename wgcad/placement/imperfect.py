@@ -33,7 +33,7 @@ from math import pi, radians
 import numpy as np
 
 from ..kinematics import gear_ratios
-from ..placement import tooth_pose
+from .law import pose_from_displacements, tooth_pose
 
 __all__ = [
     "Imperfections",
@@ -45,6 +45,7 @@ __all__ = [
     "cam_offset",
     "coning_factor",
     "flex_poses",
+    "flex_poses_batch",
     "rigid_poses",
 ]
 
@@ -249,3 +250,45 @@ def rigid_poses(drive, imp: Imperfections, teeth=None):
     rot = (j + 0.5) * 2.0 * pi / z_b + rigid_deviations(imp, j, z_b, drive.rigid.r)
     shift = np.broadcast_to(rigid_translation(imp), (len(rot), 2)).copy()
     return rot, shift
+
+
+def flex_poses_batch(drive, imp: Imperfections, phi_h: np.ndarray, k: np.ndarray, sections: list):
+    """Poses of flexspline teeth ``k`` at generator angles ``phi_h`` in every section, as :func:`wgcad.placement.imperfect.flex_poses`.
+
+    Parameters
+    ----------
+    phi_h, k : (K,) float, int
+        Generator angle (rad, relative to the rigid gear) and tooth of each sample.
+    sections : list of (float or None)
+
+    Returns
+    -------
+    list over sections of ``(rot (K,), shift (K, 2))``.
+
+    For laws linear in W0 the law is evaluated once for every section
+    (a coned section's displacements are the centre's scaled by ``W0(z)/W0``).
+    """
+    d = drive.design.drive
+    z_g = d.z_flex
+    phi_h = np.asarray(phi_h, dtype=float)
+    k = np.asarray(k)
+    phi_g = phi_h / gear_ratios(z_g, d.z_rigid)["u_hg"]
+    dalpha, drho = flex_deviations(imp, k, z_g, drive.flex.r)
+    phi = 2.0 * pi * k / z_g + phi_g + dalpha - phi_h
+    E = cam_offset(imp, phi_h, phi_g)
+    base = drive.law
+    shared = base.linear_in_w0 and all(z is None or drive.coned for z in sections)
+    st = base.state(phi) if shared else None
+    out = []
+    for z in sections:
+        if shared:
+            f = 1.0 if z is None else drive.law_at(z).w0 / base.w0
+            rot, shift = pose_from_displacements(phi, f * st.w, f * st.v, f * st.theta, drive.r_m, phi_h)
+        else:
+            law = base if z is None else drive.law_at(z)
+            s2 = law.state(phi)
+            rot, shift = pose_from_displacements(phi, s2.w, s2.v, s2.theta, drive.r_m, phi_h)
+        shift = shift + drho[:, None] * np.stack([np.cos(rot), np.sin(rot)], axis=-1)
+        shift += coning_factor(drive, z) * E
+        out.append((rot, shift))
+    return out

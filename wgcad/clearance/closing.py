@@ -13,18 +13,24 @@ the closing rotation by
 to first order (the gap ``(q - p) . n`` changes by ``(u_b - u_f) . n``, and a
 rotation ``s delta`` moves ``p`` by ``s delta z x p``). ``nt`` is stored per
 contact; it is what lets the KE of an imperfect drive reuse the perfect
-drive's contacts (:mod:`wgcad.accuracy.ke`).
+drive's contacts (:mod:`wgcad.accuracy.ke`). :func:`closing_direct` is
+the same from the exact poses of every tooth of an imperfect drive: the
+KE's reference and the imperfect audit's backlash.
 """
 
 from __future__ import annotations
 
+from math import pi
+
 import numpy as np
 import shapely
 
-from ..clearance.distance import Template, signed_clearance
+from ..errors import DesignError
 from ..placement import transform
+from ..placement.imperfect import Imperfections, flex_poses, rigid_poses
+from .distance import Template, signed_clearance
 
-__all__ = ["Contact", "closing_rotation"]
+__all__ = ["Contact", "closing_rotation", "closing_direct"]
 
 #: gap (mm) at which Newton's iteration stops: 1e-8 mm is 1e-10 rad of output
 #: rotation at 80 mm, 2e-5 arcsec, far below any KE figure
@@ -198,3 +204,35 @@ def closing_rotation(flex: Template, rot, shift, rigid: Template, rot_b, shift_b
         b, pp, qq, n, rate = b[fine], pp[fine], qq[fine], n[fine], rate[fine]
         p[b], q[b], nt[b] = pp, qq, n / rate[:, None]
     return Contact(delta, p, q, nt, ok)
+
+
+def closing_direct(drive, imp: Imperfections, phi_h: float, side: int, sections=None) -> float:
+    """The closing rotation at ``phi_h`` from the exact poses of every tooth (no table, no linearisation), rad.
+
+    The first of the radially engaged teeth to touch when the flexspline
+    turns towards ``side`` (rigid gear fixed), over ``sections`` (default:
+    the audit's three on a coned flexspline).
+    """
+    d = drive.design.drive
+    if d.fixed != "rigid":
+        raise DesignError("drive.fixed", f"the imperfect poses take the rigid gear as fixed (docs/models.md 6.2); got '{d.fixed}'")
+    z_b = d.z_rigid
+    if sections is None:
+        sections = [float(z) for z in drive.sections(3)] if drive.coned else [None]
+    flex, rigid = Template(drive.flex.tooth_polygon()), Template(drive.rigid.tooth_polygon())
+    rr, rs = rigid_poses(drive, imp)
+    best = np.inf
+    gamma_b = 2 * pi / z_b
+    for z in sections:
+        rot, shift = flex_poses(drive, imp, phi_h, z=z)
+        a = np.arctan2(shift[:, 1] + drive.r_m * np.sin(rot), shift[:, 0] + drive.r_m * np.cos(rot))
+        pts_r = np.hypot(*transform(flex.local, rot, shift).transpose(2, 0, 1))
+        # radially engaged: the tooth reaches past the rigid tip circle (docs/models.md 7, culling)
+        near = (pts_r.min(axis=1) <= drive.rigid.r_a) if drive.external else (pts_r.max(axis=1) >= drive.rigid.r_a)
+        idx = np.nonzero(near)[0]
+        lo = np.floor(a[idx] / gamma_b - 0.5).astype(int)
+        j = (lo + (1 if side > 0 else 0)) % z_b
+        con = closing_rotation(flex, rot[idx], shift[idx], rigid, rr[j], rs[j], side, 0.5 * 2 * pi / d.z_flex)
+        if con.ok.any():
+            best = min(best, float(con.delta[con.ok].min()))
+    return best

@@ -1,8 +1,9 @@
-"""Deformation laws of the flexspline neutral line: w, v, theta and derivatives (docs/models.md 3).
+"""Deformation laws of the flexspline neutral line: w, v, theta and derivatives (docs/models.md 3), and coning along the axis.
 
 One module per family of laws (``harmonic``, ``sectioned``: disc, external
-ring and four-force cam, ``ellipse``) on the common base (``base``); this
-module holds the registry that builds a law from design-file values.
+ring and four-force cam, ``ellipse``) on the common base (``base``), and
+``coning`` (W0 along a cup's axis); this module holds the registry that
+builds a law from design-file values.
 """
 
 from __future__ import annotations
@@ -12,6 +13,7 @@ import numpy as np  # noqa: F401  (the doctest of make_law uses it)
 from wgcad.errors import DesignError
 
 from .base import Law, RimState, _check_two_waves, _real
+from .coning import coned_w0
 from .ellipse import Ellipse
 from .harmonic import Harmonic
 from .sectioned import _FF_BETA_HI, _FF_BETA_LO, Disc, ExternalRing, FourForce  # noqa: F401  (the bands are tested)
@@ -26,6 +28,7 @@ __all__ = [
     "ExternalRing",
     "LAWS",
     "make_law",
+    "coned_w0",
 ]
 
 # --------------------------------------------------------------------------

@@ -1,4 +1,4 @@
-"""Atomic file writes: write to a temporary file in the target folder, then rename it into place (the checks of the targets live in :mod:`wgcad.export.targets`)."""
+"""Atomic file writes: write to a temporary file in the target folder, then rename it into place (the checks of the targets live in :mod:`wgcad.atomic.targets`)."""
 
 from __future__ import annotations
 

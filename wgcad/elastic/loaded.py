@@ -15,7 +15,7 @@ __all__ = ["LoadedLaw", "displacements_many"]
 
 @dataclass(frozen=True)
 class LoadedLaw(Law):
-    """Neutral line of the loaded flexspline, usable wherever a :class:`~wgcad.deformation.Law` is.
+    """Neutral line of the loaded flexspline, usable wherever a :class:`~wgcad.laws.Law` is.
 
     ``state(phi)`` = ``scale`` times the ring's response to the contact loads
     (n >= 2 modes, :class:`Ring`; the rim is round when unloaded and the

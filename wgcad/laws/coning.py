@@ -6,7 +6,7 @@ from __future__ import annotations
 import numpy as np
 
 from wgcad.errors import DesignError
-from wgcad.deformation.laws import _real
+from .base import _real
 
 __all__ = ["coned_w0"]
 

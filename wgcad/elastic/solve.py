@@ -97,7 +97,7 @@ def solve_contact_qp(M, q, A, f, active=None, tol_gap: float = 1e-12, max_iter: 
     Parameters
     ----------
     M : (m, m) float, or an object with ``cols(W)`` (the columns ``M[:, W]``), ``diag`` and ``shape``
-        (a compliance built column by column, :class:`~wgcad.deformation.elastic.tables.Compliance`).
+        (a compliance built column by column, :class:`~wgcad.elastic.tables.Compliance`).
     q : (m,) float
     A : (m, r) float
     f : (r,) float

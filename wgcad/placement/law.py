@@ -6,9 +6,9 @@ from math import pi
 
 import numpy as np
 
-from . import constants
-from .deformation import Law
-from .kinematics import flex_rotation
+from .. import constants
+from ..laws import Law
+from ..kinematics import flex_rotation
 
 __all__ = [
     "tooth_angles",

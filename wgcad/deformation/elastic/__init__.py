@@ -1,9 +1,0 @@
-"""Elastic contact model of the loaded drive: ring compliance, flexible bearing, tooth contacts, contact solver (docs/models.md 4)."""
-
-from wgcad.deformation.elastic.loaded import LoadedLaw
-from wgcad.deformation.elastic.model import ElasticModel, build_model
-from wgcad.deformation.elastic.ring import Ring
-from wgcad.deformation.elastic.solve import ContactSolveError, solve_contact_qp
-from wgcad.deformation.elastic.state import LoadState, solve_load
-
-__all__ = ["Ring", "LoadedLaw", "ElasticModel", "build_model", "LoadState", "solve_load", "ContactSolveError", "solve_contact_qp"]
