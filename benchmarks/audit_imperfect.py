@@ -60,8 +60,13 @@ def _designs(tmp: Path) -> dict:
 
 
 def _rss(design: Path, step: float) -> float:
-    p = subprocess.run([sys.executable, "-c", CHILD, "audit", str(design), "--quiet", "--step-deg", str(step)],
-                       capture_output=True, text=True, cwd=ROOT, env={**os.environ, "PYTHONPATH": str(ROOT)})
+    p = subprocess.run(
+        [sys.executable, "-c", CHILD, "audit", str(design), "--quiet", "--step-deg", str(step)],
+        capture_output=True,
+        text=True,
+        cwd=ROOT,
+        env={**os.environ, "PYTHONPATH": str(ROOT)},
+    )
     return json.loads(p.stdout.strip().splitlines()[-1])["rss_mb"]
 
 
@@ -75,8 +80,11 @@ def _traced_peak(design: Path, rs: RunSettings) -> float:
 
 def main() -> None:
     load = os.getloadavg()
-    out = {"machine": f"{platform.processor() or platform.machine()}, {os.cpu_count()} cores, Python {platform.python_version()}",
-           "load_avg_1_5_15": [round(x, 2) for x in load], "rows": []}
+    out = {
+        "machine": f"{platform.processor() or platform.machine()}, {os.cpu_count()} cores, Python {platform.python_version()}",
+        "load_avg_1_5_15": [round(x, 2) for x in load],
+        "rows": [],
+    }
     print(json.dumps({k: out[k] for k in ("machine", "load_avg_1_5_15")}), file=sys.stderr)
     with tempfile.TemporaryDirectory() as tmp:
         for name, (imperfect, perfect) in _designs(Path(tmp)).items():
@@ -87,25 +95,35 @@ def main() -> None:
                 t_poly, (_, res_poly) = best_of(lambda: run_audit(imperfect, rs_poly))
                 t_per, (_, res_per) = best_of(lambda: run_audit(perfect, rs))
                 row = {
-                    "case": name, "step_deg": step, "samples": res.counts["samples"],
-                    "audit_s": round(res.elapsed_s, 3), "audit_no_refine_s": round(res_poly.elapsed_s, 3),
+                    "case": name,
+                    "step_deg": step,
+                    "samples": res.counts["samples"],
+                    "audit_s": round(res.elapsed_s, 3),
+                    "audit_no_refine_s": round(res_poly.elapsed_s, 3),
                     "perfect_audit_s": round(res_per.elapsed_s, 3),
                     "ratio_to_perfect": round(res.elapsed_s / res_per.elapsed_s, 2),
-                    "wall_s_incl_build": round(t_imp, 3), "wall_no_refine_s_incl_build": round(t_poly, 3),
+                    "wall_s_incl_build": round(t_imp, 3),
+                    "wall_no_refine_s_incl_build": round(t_poly, 3),
                     "min_clearance_um": round(1e3 * res.min_clearance, 4),
                     "perfect_min_clearance_um": round(1e3 * res_per.min_clearance, 4),
-                    "evaluated": res.counts["evaluated"], "perfect_grid_evaluated": res.counts["perfect_evaluated"],
-                    "refined": res.counts["refined"], "chunks": res.counts["chunks"],
+                    "evaluated": res.counts["evaluated"],
+                    "perfect_grid_evaluated": res.counts["perfect_evaluated"],
+                    "refined": res.counts["refined"],
+                    "chunks": res.counts["chunks"],
                     "traced_peak_mb": round(_traced_peak(imperfect, rs), 1),
                     "process_peak_rss_mb": round(_rss(imperfect, step), 1),
                 }
                 out["rows"].append(row)
                 print(json.dumps(row), file=sys.stderr, flush=True)
-    print("| case | step, deg | samples | audit, s | without refinement, s | perfect audit, s | evaluated | peak RSS, MB | traced peak, MB |")
+    print(
+        "| case | step, deg | samples | audit, s | without refinement, s | perfect audit, s | evaluated | peak RSS, MB | traced peak, MB |"
+    )
     print("|---|---|---|---|---|---|---|---|---|")
     for r in out["rows"]:
-        print(f"| {r['case']} | {r['step_deg']} | {r['samples']} | {r['audit_s']} | {r['audit_no_refine_s']} | "
-              f"{r['perfect_audit_s']} | {r['evaluated']} | {r['process_peak_rss_mb']} | {r['traced_peak_mb']} |")
+        print(
+            f"| {r['case']} | {r['step_deg']} | {r['samples']} | {r['audit_s']} | {r['audit_no_refine_s']} | "
+            f"{r['perfect_audit_s']} | {r['evaluated']} | {r['process_peak_rss_mb']} | {r['traced_peak_mb']} |"
+        )
     dest = ROOT / "output" / "bench"
     dest.mkdir(parents=True, exist_ok=True)
     (dest / "audit_imperfect.json").write_text(json.dumps(out, indent=2))

@@ -39,11 +39,11 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 from _timing import best_of  # noqa: E402
 
-from wgcad.elastic import build_model, solve_load  # noqa: E402
-from wgcad.elastic.sweep import torque_sweep  # noqa: E402
 from wgcad.clearance.engine import clearance_at_poses  # noqa: E402
 from wgcad.design import load_design  # noqa: E402
 from wgcad.drive import build_drive  # noqa: E402
+from wgcad.elastic import build_model, solve_load  # noqa: E402
+from wgcad.elastic.sweep import torque_sweep  # noqa: E402
 from wgcad.placement import tooth_pose  # noqa: E402
 
 D1 = ROOT / "templates" / "d1_involute.toml"
@@ -84,38 +84,74 @@ def main() -> int:
     t_base, _ = best_of(baseline, 5)
     # the first state of a fresh model also measures the nominal tooth pairs (kept in model.cache)
     t_first, c_first, _ = cpu_best_of(lambda: solve_load(build_model(drive, 3), 1500.0), 1 if args.quick else 3)
-    rows = [("build the model (ring tables, bearing, scene)", t_model, None, t_model / t_base),
-            ("baseline: engine clearance of the engaging teeth, 3 sections, no load", t_base, None, 1.0),
-            ("first load state of a fresh model, 1500 N m (incl. its nominal pairs)", t_first, c_first, t_first / t_base)]
-    res = {"machine": f"{platform.processor() or platform.machine()}, {os.cpu_count()} cores, Python {platform.python_version()}",
-           "load_average": os.getloadavg(), "baseline_s": t_base, "model_s": t_model, "first_state_s": t_first, "states": {}}
+    rows = [
+        ("build the model (ring tables, bearing, scene)", t_model, None, t_model / t_base),
+        ("baseline: engine clearance of the engaging teeth, 3 sections, no load", t_base, None, 1.0),
+        ("first load state of a fresh model, 1500 N m (incl. its nominal pairs)", t_first, c_first, t_first / t_base),
+    ]
+    res = {
+        "machine": f"{platform.processor() or platform.machine()}, {os.cpu_count()} cores, Python {platform.python_version()}",
+        "load_average": os.getloadavg(),
+        "baseline_s": t_base,
+        "model_s": t_model,
+        "first_state_s": t_first,
+        "states": {},
+    }
     for T in (1500.0,) if args.quick else (0.0, 1500.0, 3000.0):
         t_state, c_state, st = cpu_best_of(lambda: solve_load(model, T), 1 if args.quick else 5)
         r = st.residuals
-        rows += [(f"one load state, {T:.0f} N m ({r['iterations']} passes)", t_state, c_state, t_state / t_base),
-                 ("  of which contact geometry", st.timing["geometry"], None, None),
-                 ("  of which compliance and contact solver", st.timing["solver"], None, None)]
-        res["states"][f"{T:g}"] = {"s": t_state, "cpu_s": c_state, "passes": r["iterations"],
-                                   "geometry_s": st.timing["geometry"], "solver_s": st.timing["solver"]}
+        rows += [
+            (f"one load state, {T:.0f} N m ({r['iterations']} passes)", t_state, c_state, t_state / t_base),
+            ("  of which contact geometry", st.timing["geometry"], None, None),
+            ("  of which compliance and contact solver", st.timing["solver"], None, None),
+        ]
+        res["states"][f"{T:g}"] = {
+            "s": t_state,
+            "cpu_s": c_state,
+            "passes": r["iterations"],
+            "geometry_s": st.timing["geometry"],
+            "solver_s": st.timing["solver"],
+        }
     if not args.quick:
         for e_um in (0.0, 40.0):
-            t_sweep, c_sweep, sw = cpu_best_of(lambda: torque_sweep(model, np.arange(0.0, 3000.1, 250.0), cam_offset_um=e_um), 3)
+            t_sweep, c_sweep, sw = cpu_best_of(
+                lambda: torque_sweep(model, np.arange(0.0, 3000.1, 250.0), cam_offset_um=e_um), 3
+            )
             geo = sum(s.timing["geometry"] for s in sw["states"])
             sol = sum(s.timing["solver"] for s in sw["states"])
             passes = sum(s.residuals["iterations"] for s in sw["states"])
-            rows += [(f"13-level sweep 0:3000:250 N m, e_h = {e_um:g} um, warm-started ({passes} passes)", t_sweep, c_sweep,
-                      t_sweep / t_base),
-                     ("  of which contact geometry", geo, None, None), ("  of which compliance and solver", sol, None, None),
-                     ("  of which entry gaps and summaries", sw["summary_s"], None, None)]
-            res[f"sweep_{e_um:g}um"] = {"s": t_sweep, "cpu_s": c_sweep, "passes": passes, "geometry_s": geo, "solver_s": sol,
-                                       "summary_s": sw["summary_s"]}
+            rows += [
+                (
+                    f"13-level sweep 0:3000:250 N m, e_h = {e_um:g} um, warm-started ({passes} passes)",
+                    t_sweep,
+                    c_sweep,
+                    t_sweep / t_base,
+                ),
+                ("  of which contact geometry", geo, None, None),
+                ("  of which compliance and solver", sol, None, None),
+                ("  of which entry gaps and summaries", sw["summary_s"], None, None),
+            ]
+            res[f"sweep_{e_um:g}um"] = {
+                "s": t_sweep,
+                "cpu_s": c_sweep,
+                "passes": passes,
+                "geometry_s": geo,
+                "solver_s": sol,
+                "summary_s": sw["summary_s"],
+            }
     if not args.quick:
         cyc = build_model(build_drive(load_design(D1_CYCLOIDAL)), 3)
         solve_load(cyc, 0.0)  # its nominal pairs, as for the involute model above
         t_sweep, c_sweep, sw = cpu_best_of(lambda: torque_sweep(cyc, np.arange(0.0, 3000.1, 250.0)), 3)
         passes = sum(s.residuals["iterations"] for s in sw["states"])
-        rows += [(f"13-level sweep 0:3000:250 N m, D1 cycloidal, e_h = 0 um ({passes} passes)", t_sweep, c_sweep,
-                  t_sweep / t_base)]
+        rows += [
+            (
+                f"13-level sweep 0:3000:250 N m, D1 cycloidal, e_h = 0 um ({passes} passes)",
+                t_sweep,
+                c_sweep,
+                t_sweep / t_base,
+            )
+        ]
         res["sweep_cycloidal_0um"] = {"s": t_sweep, "cpu_s": c_sweep, "passes": passes}
     print(f"machine: {res['machine']}; load average {res['load_average'][0]:.2f}")
     print("| step | wall s | CPU s | ratio to baseline (wall) |\n|---|---|---|---|")

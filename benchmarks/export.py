@@ -36,17 +36,15 @@ from wgcad.drive import build_drive  # noqa: E402
 OUT = ROOT / "output" / "bench"
 
 
-
-
 def bench(design_path: Path, step: bool, tmp: Path, parts_step: bool = False) -> list[dict]:
     from wgcad.cli.common import circle
     from wgcad.export.arcs import arc_deviation, fit_gear, fit_pieces
     from wgcad.export.dxf import DxfLayer, write_dxf
     from wgcad.export.parts import build_parts
-    from wgcad.profiles.band import gear_band_outline
     from wgcad.export.stl import ring_solid, write_stl
     from wgcad.export.svg import write_svg
     from wgcad.export.threemf import write_3mf
+    from wgcad.profiles.band import gear_band_outline
 
     design = load_design(design_path)
     drive = build_drive(design, tol=1e-3)
@@ -55,10 +53,21 @@ def bench(design_path: Path, step: bool, tmp: Path, parts_step: bool = False) ->
     bw = design.drive.face_width
 
     def row(fmt, what, seconds, path, **kw):
-        rows.append({"design": stem, "format": fmt, "what": what, "seconds": seconds,
-                     "bytes": path.stat().st_size if path else None, **kw})
+        rows.append(
+            {
+                "design": stem,
+                "format": fmt,
+                "what": what,
+                "seconds": seconds,
+                "bytes": path.stat().st_size if path else None,
+                **kw,
+            }
+        )
 
-    for which, gear, rim in (("flexspline", drive.flex, drive.flex_rim_radius), ("rigid", drive.rigid, drive.rigid_rim_radius)):
+    for which, gear, rim in (
+        ("flexspline", drive.flex, drive.flex_rim_radius),
+        ("rigid", drive.rigid, drive.rigid_rim_radius),
+    ):
         # generate's export: one LWPOLYLINE of the 1 um symmetric band, STL prism of it (building the
         # band is part of the time)
         p = tmp / f"{stem}_{which}_poly.dxf"
@@ -71,10 +80,22 @@ def bench(design_path: Path, step: bool, tmp: Path, parts_step: bool = False) ->
         t_w, _ = best_of(lambda: write_dxf(p, [DxfLayer("G", paths=(path,))]))
         dev = arc_deviation(fit_pieces(pieces, 1e-3, closed=False), pieces, n_per_arc=256).max()
         dev_all = arc_deviation(path, pieces, n_per_arc=64).max()
-        row("dxf arcs", which, t_fit + t_w, p, vertices=len(path.vertices), arcs=path.n_arcs,
-            max_dev_um=1e3 * max(dev, dev_all), fit_seconds=t_fit)
+        row(
+            "dxf arcs",
+            which,
+            t_fit + t_w,
+            p,
+            vertices=len(path.vertices),
+            arcs=path.n_arcs,
+            max_dev_um=1e3 * max(dev, dev_all),
+            fit_seconds=t_fit,
+        )
         rim_c = circle(rim, 1e-3)
-        mk = (lambda: ring_solid(band, [rim_c], bw)) if rim < min(gear.r_a, gear.r_f) else (lambda: ring_solid(rim_c, [band], bw))
+        mk = (
+            (lambda: ring_solid(band, [rim_c], bw))
+            if rim < min(gear.r_a, gear.r_f)
+            else (lambda: ring_solid(rim_c, [band], bw))
+        )
         t_m, mesh = best_of(mk)
         p = tmp / f"{stem}_{which}.stl"
         t_s, _ = best_of(lambda: write_stl(p, mesh))
@@ -101,7 +122,10 @@ def bench(design_path: Path, step: bool, tmp: Path, parts_step: bool = False) ->
         from wgcad.export.step import read_step, solid_props, write_step
 
         # the two toothed rings as B-rep prisms of their arc outlines (the gears alone, no booleans)
-        for which, gear, rim in (("flexspline", drive.flex, drive.flex_rim_radius), ("rigid", drive.rigid, drive.rigid_rim_radius)):
+        for which, gear, rim in (
+            ("flexspline", drive.flex, drive.flex_rim_radius),
+            ("rigid", drive.rigid, drive.rigid_rim_radius),
+        ):
             path = fit_gear(gear, 1e-3)
 
             def ring():
@@ -118,8 +142,17 @@ def bench(design_path: Path, step: bool, tmp: Path, parts_step: bool = False) ->
             from wgcad.export.arcs import path_area
 
             vol = abs(path_area(path) - np.pi * rim * rim) * bw
-            row("step", which + " ring", t_sol + t_w, p, read_seconds=t_r, check_seconds=t_c, valid=props["valid"],
-                volume_rel_err=props["volume"] / vol - 1.0, faces=sum(props["faces"].values()))
+            row(
+                "step",
+                which + " ring",
+                t_sol + t_w,
+                p,
+                read_seconds=t_r,
+                check_seconds=t_c,
+                valid=props["valid"],
+                volume_rel_err=props["volume"] / vol - 1.0,
+                faces=sum(props["faces"].values()),
+            )
     if step and parts_step:
         from wgcad.export.step import read_step, solid_props, write_step
 
@@ -129,15 +162,28 @@ def bench(design_path: Path, step: bool, tmp: Path, parts_step: bool = False) ->
             t_w, _ = best_of(lambda: write_step(p, {prt.name: solid}), n=1)
             t_r, back = best_of(lambda: read_step(p), n=1)
             t_c, props = best_of(lambda: solid_props(back[0]), n=1)
-            row("step", prt.name, t_sol + t_w, p, read_seconds=t_r, check_seconds=t_c, valid=props["valid"],
-                volume_rel_err=props["volume"] / prt.volume_mm3 - 1.0, faces=sum(props["faces"].values()))
+            row(
+                "step",
+                prt.name,
+                t_sol + t_w,
+                p,
+                read_seconds=t_r,
+                check_seconds=t_c,
+                valid=props["valid"],
+                volume_rel_err=props["volume"] / prt.volume_mm3 - 1.0,
+                faces=sum(props["faces"].values()),
+            )
     return rows
 
 
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--no-step", action="store_true", help="skip STEP")
-    ap.add_argument("--step-parts", action="store_true", help="also STEP of the whole part set (cup, plug, flanged rigid gear): slow")
+    ap.add_argument(
+        "--step-parts",
+        action="store_true",
+        help="also STEP of the whole part set (cup, plug, flanged rigid gear): slow",
+    )
     ap.add_argument("--designs", default="d1_involute,d1_cycloidal")
     args = ap.parse_args()
     rows = []
@@ -150,14 +196,18 @@ def main() -> None:
     for r in rows:
         notes = []
         if "valid" in r:
-            notes.append(f"valid={r['valid']} vol err {r['volume_rel_err']:.1e} faces {r['faces']} read {r['read_seconds']:.1f} s check {r['check_seconds']:.1f} s")
+            notes.append(
+                f"valid={r['valid']} vol err {r['volume_rel_err']:.1e} faces {r['faces']} read {r['read_seconds']:.1f} s check {r['check_seconds']:.1f} s"
+            )
         if "triangles" in r:
             notes.append(f"{r['triangles']} triangles")
         if "fit_seconds" in r:
             notes.append(f"fit {r['fit_seconds']:.3f} s")
         dev = "" if r.get("max_dev_um") is None else f"{r['max_dev_um']:.3f}"
-        lines.append(f"| {r['design']} | {r['format']} | {r['what']} | {r['seconds']:.3f} | "
-                     f"{(r['bytes'] or 0) / 1e3:.0f} | {r.get('vertices', '')} | {r.get('arcs', '')} | {dev} | {'; '.join(notes)} |")
+        lines.append(
+            f"| {r['design']} | {r['format']} | {r['what']} | {r['seconds']:.3f} | "
+            f"{(r['bytes'] or 0) / 1e3:.0f} | {r.get('vertices', '')} | {r.get('arcs', '')} | {dev} | {'; '.join(notes)} |"
+        )
     md = "\n".join(lines)
     print(md)
     (OUT / "export.md").write_text(md + "\n")

@@ -39,12 +39,27 @@ RUNS = [
     ("generate D1 0.1 um", ["generate", "--quiet", "--chord-tol-um", "0.1"], "d1_involute", dict(exports=True), 1e-4),
     ("generate D4 0.01 um", ["generate", "--quiet", "--chord-tol-um", "0.01"], "d4_discrete", dict(exports=True), 1e-5),
     ("audit D1", ["audit", "--quiet"], "d1_involute", dict(angles=720, sections=3, exports=False), 1e-3),
-    ("audit D1 step 0.05", ["audit", "--quiet", "--step-deg", "0.05"], "d1_involute",
-     dict(angles=7200, sections=3, exports=False), 1e-3),
-    ("audit D1 step 0.01, 10 sections", ["audit", "--quiet", "--step-deg", "0.01", "--sections", "10"], "d1_involute",
-     dict(angles=36000, sections=10, exports=False), 1e-3),
-    ("audit D4 no shortcuts step 0.25", ["audit", "--quiet", "--step-deg", "0.25", "--no-shortcuts"], "d4_discrete",
-     dict(angles=1440, sections=3, exports=False, use_period=False, use_waves=False, use_mirror=False, bound=False), 1e-3),
+    (
+        "audit D1 step 0.05",
+        ["audit", "--quiet", "--step-deg", "0.05"],
+        "d1_involute",
+        dict(angles=7200, sections=3, exports=False),
+        1e-3,
+    ),
+    (
+        "audit D1 step 0.01, 10 sections",
+        ["audit", "--quiet", "--step-deg", "0.01", "--sections", "10"],
+        "d1_involute",
+        dict(angles=36000, sections=10, exports=False),
+        1e-3,
+    ),
+    (
+        "audit D4 no shortcuts step 0.25",
+        ["audit", "--quiet", "--step-deg", "0.25", "--no-shortcuts"],
+        "d4_discrete",
+        dict(angles=1440, sections=3, exports=False, use_period=False, use_waves=False, use_mirror=False, bound=False),
+        1e-3,
+    ),
 ]
 
 

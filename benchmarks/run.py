@@ -38,8 +38,6 @@ OUT = ROOT / "output" / "bench"
 D1 = ROOT / "templates" / "d1_involute.toml"
 
 
-
-
 def machine() -> str:
     return f"{platform.processor() or platform.machine()}, {os.cpu_count()} cores, Python {platform.python_version()}"
 
@@ -53,10 +51,10 @@ def audit_of(drive, step_deg, k, **kw):
 def peak_memory_mb() -> float:
     """Peak RSS of a fresh process doing only the full-revolution D1 audit."""
     code = (
-        "import resource, sys; sys.path.insert(0, %r)\n"
+        f"import resource, sys; sys.path.insert(0, {str(ROOT)!r})\n"
         "from benchmarks.run import audit_of, build_drive, load_design, D1\n"
         "audit_of(build_drive(load_design(D1)), 0.5, 3)\n"
-        "print(resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0)\n" % str(ROOT)
+        "print(resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0)\n"
     )
     r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, cwd=ROOT)
     return float(r.stdout.strip().splitlines()[-1])
@@ -70,7 +68,9 @@ def bench_audit(quick: bool) -> dict:
     mesh = 360.0 / drive.design.drive.z_rigid
     angles_1p = np.deg2rad(np.arange(0.0, mesh, 0.5))
     t_1p, one = best_of(lambda: audit(drive, AuditSettings(angles=angles_1p, sections=drive.sections(3))), 5)
-    t_1pp, _ = best_of(lambda: audit(drive, AuditSettings(angles=angles_1p, sections=drive.sections(3), refine=False)), 5)
+    t_1pp, _ = best_of(
+        lambda: audit(drive, AuditSettings(angles=angles_1p, sections=drive.sections(3), refine=False)), 5
+    )
     out = {
         "machine": machine(),
         "full_revolution_s": t_fast,
@@ -102,16 +102,43 @@ def bench_shortcuts(quick: bool) -> list[dict]:
     drive = build_drive(load_design(D1))
     step = 2.0 if quick else 1.0
     t_on, on = best_of(lambda: audit_of(drive, step, 3), 3)
-    rows = [{"shortcut": "all on (baseline)", "time_s": t_on, "ratio": 1.0, "min_clearance_um": 1e3 * on.min_clearance, "change_um": 0.0}]
-    names = {"use_period": "mesh period", "use_waves": "identical waves", "use_mirror": "mirror symmetry",
-             "cull": "radial culling", "bound": "branch and bound"}
+    rows = [
+        {
+            "shortcut": "all on (baseline)",
+            "time_s": t_on,
+            "ratio": 1.0,
+            "min_clearance_um": 1e3 * on.min_clearance,
+            "change_um": 0.0,
+        }
+    ]
+    names = {
+        "use_period": "mesh period",
+        "use_waves": "identical waves",
+        "use_mirror": "mirror symmetry",
+        "cull": "radial culling",
+        "bound": "branch and bound",
+    }
     for key, label in names.items():
         t, r = best_of(lambda: audit_of(drive, step, 3, **{key: False}), 1)
-        rows.append({"shortcut": f"{label} off", "time_s": t, "ratio": t / t_on, "min_clearance_um": 1e3 * r.min_clearance,
-                     "change_um": 1e3 * abs(r.min_clearance - on.min_clearance)})
+        rows.append(
+            {
+                "shortcut": f"{label} off",
+                "time_s": t,
+                "ratio": t / t_on,
+                "min_clearance_um": 1e3 * r.min_clearance,
+                "change_um": 1e3 * abs(r.min_clearance - on.min_clearance),
+            }
+        )
     t, r = best_of(lambda: audit_of(drive, step, 3, **{k: False for k in names}), 1)
-    rows.append({"shortcut": "all off", "time_s": t, "ratio": t / t_on, "min_clearance_um": 1e3 * r.min_clearance,
-                 "change_um": 1e3 * abs(r.min_clearance - on.min_clearance)})
+    rows.append(
+        {
+            "shortcut": "all off",
+            "time_s": t,
+            "ratio": t / t_on,
+            "min_clearance_um": 1e3 * r.min_clearance,
+            "change_um": 1e3 * abs(r.min_clearance - on.min_clearance),
+        }
+    )
     return rows
 
 
@@ -130,7 +157,9 @@ def bench_chord_tol(quick: bool) -> list[dict]:
     rows = []
     tols_um = [10.0, 1.0, 0.3] if quick else [10.0, 3.0, 1.0, 0.3, 0.1, 0.03]
     for name in ("d1_involute", "d1_cycloidal"):
-        design = with_changes(load_design(ROOT / "templates" / f"{name}.toml"), generator={"cone_length": None, "generator_z": None})
+        design = with_changes(
+            load_design(ROOT / "templates" / f"{name}.toml"), generator={"cone_length": None, "generator_z": None}
+        )
         z_b = design.drive.z_rigid
         n = int(np.ceil(360.0 / z_b / 0.25))
         angles = np.arange(n) * (2 * pi / z_b) / n
@@ -145,17 +174,19 @@ def bench_chord_tol(quick: bool) -> list[dict]:
                 drive = build_drive(design, tol=tol_um * 1e-3)
                 t, res = best_of(lambda: run(drive, refine), 1 if refine else 3)
                 t_base = t_base or t
-                rows.append({
-                    "template": f"{name} ({'refined' if refine else 'polygon'})",
-                    "chord_tol_um": tol_um,
-                    "vertices_per_tooth": len(drive.flex.period),
-                    "time_s": t,
-                    "ratio": t / t_base,
-                    "min_clearance_um": 1e3 * res.min_clearance,
-                    "interference": bool(res.interference),
-                    "min_clearance_error_um": 1e3 * abs(res.min_clearance - ref.min_clearance),
-                    "entry_gap_error_um": 1e3 * abs(res.entry_gap - ref.entry_gap),
-                })
+                rows.append(
+                    {
+                        "template": f"{name} ({'refined' if refine else 'polygon'})",
+                        "chord_tol_um": tol_um,
+                        "vertices_per_tooth": len(drive.flex.period),
+                        "time_s": t,
+                        "ratio": t / t_base,
+                        "min_clearance_um": 1e3 * res.min_clearance,
+                        "interference": bool(res.interference),
+                        "min_clearance_error_um": 1e3 * abs(res.min_clearance - ref.min_clearance),
+                        "entry_gap_error_um": 1e3 * abs(res.entry_gap - ref.entry_gap),
+                    }
+                )
     return rows
 
 
@@ -165,10 +196,18 @@ def bench_process(quick: bool) -> dict:
 
     t_in, _ = best_of(lambda: run_audit(D1, RunSettings()), 1 if quick else 3)
     cmd = [sys.executable, "-m", "wgcad", "audit", str(D1), "--quiet"]
-    t_proc, _ = best_of(lambda: subprocess.run(cmd, capture_output=True, cwd=ROOT, env={**os.environ, "PYTHONPATH": str(ROOT)}), 1 if quick else 3)
+    t_proc, _ = best_of(
+        lambda: subprocess.run(cmd, capture_output=True, cwd=ROOT, env={**os.environ, "PYTHONPATH": str(ROOT)}),
+        1 if quick else 3,
+    )
     t_poly, _ = best_of(lambda: run_audit(D1, RunSettings(refine=False)), 1 if quick else 3)
-    return {"machine": machine(), "in_process_s": t_in, "in_process_polygon_only_s": t_poly, "whole_process_s": t_proc,
-            "import_and_startup_s": t_proc - t_in}
+    return {
+        "machine": machine(),
+        "in_process_s": t_in,
+        "in_process_polygon_only_s": t_poly,
+        "whole_process_s": t_proc,
+        "import_and_startup_s": t_proc - t_in,
+    }
 
 
 def bench_angle_step(quick: bool) -> list[dict]:
@@ -182,8 +221,15 @@ def bench_angle_step(quick: bool) -> list[dict]:
         for st in steps:
             t, res = best_of(lambda: audit_of(drive, st, 3), 2)
             t_base = t_base or t
-            rows.append({"template": path.stem, "step_deg": st, "time_s": t, "ratio": t / t_base,
-                         "min_clearance_error_um": 1e3 * abs(res.min_clearance - ref.min_clearance)})
+            rows.append(
+                {
+                    "template": path.stem,
+                    "step_deg": st,
+                    "time_s": t,
+                    "ratio": t / t_base,
+                    "min_clearance_error_um": 1e3 * abs(res.min_clearance - ref.min_clearance),
+                }
+            )
     return rows
 
 
@@ -196,12 +242,19 @@ def bench_sections(quick: bool) -> list[dict]:
             continue
         ref = audit_of(drive, 1.0, 61)
         t_base = None
-        for k in ([2, 3, 5] if quick else [2, 3, 5, 9, 17]):
+        for k in [2, 3, 5] if quick else [2, 3, 5, 9, 17]:
             t, res = best_of(lambda: audit_of(drive, 1.0, k), 2)
             t_base = t_base or t
-            rows.append({"template": path.stem, "sections": k, "time_s": t, "ratio": t / t_base,
-                         "min_clearance_error_um": 1e3 * abs(res.min_clearance - ref.min_clearance),
-                         "entry_gap_error_um": 1e3 * abs(res.entry_gap - ref.entry_gap)})
+            rows.append(
+                {
+                    "template": path.stem,
+                    "sections": k,
+                    "time_s": t,
+                    "ratio": t / t_base,
+                    "min_clearance_error_um": 1e3 * abs(res.min_clearance - ref.min_clearance),
+                    "entry_gap_error_um": 1e3 * abs(res.entry_gap - ref.entry_gap),
+                }
+            )
     return rows
 
 
@@ -221,19 +274,45 @@ def bench_engines(quick: bool) -> list[dict]:
     t2, c2 = best_of(lambda: tooth_clearance(sc, phis, None)["min"], 5)
     t3, res = best_of(lambda: [check_tooth(sc, float(p)) for p in phis], 1)
     diff = max(abs(r["fcl_distance_um"] - 1e3 * c) for r, c in zip(res, c2))
-    rows.append({"case": f"D4 prisms, {len(phis)} teeth", "engine": "2d", "time_s": t2, "ratio": 1.0, "difference_um": 0.0, "bound_um": 0.0,
-                 "loft_sections": 0})
-    rows.append({"case": f"D4 prisms, {len(phis)} teeth", "engine": "fcl", "time_s": t3, "ratio": t3 / t2, "difference_um": diff, "bound_um": 0.0,
-                 "loft_sections": 0})
+    rows.append(
+        {
+            "case": f"D4 prisms, {len(phis)} teeth",
+            "engine": "2d",
+            "time_s": t2,
+            "ratio": 1.0,
+            "difference_um": 0.0,
+            "bound_um": 0.0,
+            "loft_sections": 0,
+        }
+    )
+    rows.append(
+        {
+            "case": f"D4 prisms, {len(phis)} teeth",
+            "engine": "fcl",
+            "time_s": t3,
+            "ratio": t3 / t2,
+            "difference_um": diff,
+            "bound_um": 0.0,
+            "loft_sections": 0,
+        }
+    )
     d1 = build_drive(load_design(D1))
     sc1 = Scene(d1)
     phi = np.deg2rad(45.0)
     t2, _ = best_of(lambda: [tooth_clearance(sc1, np.array([phi]), z) for z in d1.sections(3)], 5)
-    for n in ([5, 9] if quick else [3, 5, 9, 17]):
+    for n in [5, 9] if quick else [3, 5, 9, 17]:
         t3, r = best_of(lambda: check_tooth(sc1, float(phi), n_sections=n), 1)
-        rows.append({"case": f"D1 coned, tooth at 45 deg, {n} loft sections", "engine": "fcl", "time_s": t3, "ratio": t3 / t2,
-                     "difference_um": abs(r["fcl_distance_um"] - r["clearance_2d_um"]), "bound_um": r["bound_um"] or 0.0,
-                     "loft_sections": n})
+        rows.append(
+            {
+                "case": f"D1 coned, tooth at 45 deg, {n} loft sections",
+                "engine": "fcl",
+                "time_s": t3,
+                "ratio": t3 / t2,
+                "difference_um": abs(r["fcl_distance_um"] - r["clearance_2d_um"]),
+                "bound_um": r["bound_um"] or 0.0,
+                "loft_sections": n,
+            }
+        )
     return rows
 
 
@@ -255,8 +334,16 @@ def bench_templates(quick: bool) -> list[dict]:
             mesh = 360.0 / drive.design.drive.z_rigid
             ang = np.deg2rad(np.arange(0.0, mesh, 0.5))
             t_1p, _ = best_of(lambda: audit(drive, AuditSettings(angles=ang, sections=drive.sections(3))), 15)
-        rows.append({"template": path.stem, "full_revolution_s": t_full, "one_period_s": t_1p,
-                     "samples": r.counts["samples"], "evaluated": r.counts["evaluated"], "min_clearance_um": 1e3 * r.min_clearance})
+        rows.append(
+            {
+                "template": path.stem,
+                "full_revolution_s": t_full,
+                "one_period_s": t_1p,
+                "samples": r.counts["samples"],
+                "evaluated": r.counts["evaluated"],
+                "min_clearance_um": 1e3 * r.min_clearance,
+            }
+        )
     return rows
 
 
@@ -300,11 +387,15 @@ def plot(rows, x, title, path, y="min_clearance_error_um"):
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--quick", action="store_true")
-    ap.add_argument("--only", choices=["audit", "process", "templates", "shortcuts", "chord", "step", "sections", "engines"])
+    ap.add_argument(
+        "--only", choices=["audit", "process", "templates", "shortcuts", "chord", "step", "sections", "engines"]
+    )
     args = ap.parse_args(argv)
     OUT.mkdir(parents=True, exist_ok=True)
     report = {"machine": machine()}
-    md = [f"# wgcad benchmarks\n\nMachine: {machine()}. Designs: the bundled templates (D1 involute where one is named).\n"]
+    md = [
+        f"# wgcad benchmarks\n\nMachine: {machine()}. Designs: the bundled templates (D1 involute where one is named).\n"
+    ]
     jobs = [
         ("audit", bench_audit, None),
         ("process", bench_process, None),
@@ -328,11 +419,23 @@ def main(argv=None) -> int:
                 plot(res, plot_spec[0], plot_spec[1], OUT / f"{name}.png")
             if name == "engines":
                 lofts = [r for r in res if r["loft_sections"]]
-                plot(lofts, "loft_sections", "FCL check of a coned D1 tooth: loft sections (label)", OUT / "engines.png", y="bound_um")
+                plot(
+                    lofts,
+                    "loft_sections",
+                    "FCL check of a coned D1 tooth: loft sections (label)",
+                    OUT / "engines.png",
+                    y="bound_um",
+                )
             keys = list(res[0])
-            (OUT / f"{name}.csv").write_text(",".join(keys) + "\n" + "\n".join(",".join(str(r[k]) for k in keys) for r in res) + "\n")
+            (OUT / f"{name}.csv").write_text(
+                ",".join(keys) + "\n" + "\n".join(",".join(str(r[k]) for k in keys) for r in res) + "\n"
+            )
         else:
-            md.append(f"## {name}\n\n" + "\n".join(f"- {k}: {v:.6g}" if isinstance(v, float) else f"- {k}: {v}" for k, v in res.items()) + "\n")
+            md.append(
+                f"## {name}\n\n"
+                + "\n".join(f"- {k}: {v:.6g}" if isinstance(v, float) else f"- {k}: {v}" for k, v in res.items())
+                + "\n"
+            )
     (OUT / "report.json").write_text(json.dumps(report, indent=2) + "\n")
     (OUT / "README.md").write_text("\n".join(md))
     print("\n".join(md))

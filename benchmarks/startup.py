@@ -97,10 +97,20 @@ def main(argv=None) -> int:
     for t in TEMPLATES:
         whole, cpu = wall([py, "-m", "wgcad", "audit", str(t), "--quiet"], n)
         inside = in_process(t, n)
-        rows.append({"template": t.stem, "whole_process_s": whole, "whole_process_cpu_s": cpu, "in_process_s": inside,
-                     "ratio": whole / inside, "start_up_s": whole - inside})
-        print(f"{t.stem:14s} whole {whole:6.3f} s (cpu {cpu:6.3f} s)  in-process {inside:6.3f} s  ratio {whole / inside:5.2f}",
-              flush=True)
+        rows.append(
+            {
+                "template": t.stem,
+                "whole_process_s": whole,
+                "whole_process_cpu_s": cpu,
+                "in_process_s": inside,
+                "ratio": whole / inside,
+                "start_up_s": whole - inside,
+            }
+        )
+        print(
+            f"{t.stem:14s} whole {whole:6.3f} s (cpu {cpu:6.3f} s)  in-process {inside:6.3f} s  ratio {whole / inside:5.2f}",
+            flush=True,
+        )
     chain, mods = [], []
     for label, add in CHAIN:
         mods = mods + add
@@ -112,7 +122,10 @@ def main(argv=None) -> int:
         row["adds_s"] = None if prev is None else row["whole_process_s"] - prev
         prev = row["whole_process_s"]
         adds = "" if row["adds_s"] is None else f"  adds {row['adds_s']:6.3f} s"
-        print(f"{row['step']:60s} {row['whole_process_s']:6.3f} s (cpu {row['whole_process_cpu_s']:6.3f} s){adds}", flush=True)
+        print(
+            f"{row['step']:60s} {row['whole_process_s']:6.3f} s (cpu {row['whole_process_cpu_s']:6.3f} s){adds}",
+            flush=True,
+        )
     load1 = os.getloadavg()
 
     OUT.mkdir(parents=True, exist_ok=True)
@@ -120,16 +133,29 @@ def main(argv=None) -> int:
         w = csv.DictWriter(fp, fieldnames=list(rows[0]))
         w.writeheader()
         w.writerows(rows)
-    md = [f"# wgcad audit start-up (best of {n})", "",
-          f"{platform.processor() or platform.machine()}, {os.cpu_count()} cores, Python {platform.python_version()}; "
-          f"load average {load0[0]:.2f} before, {load1[0]:.2f} after", "",
-          "`python -m wgcad audit TEMPLATE --quiet` (no plots): whole process against the same command in-process", "",
-          "| template | whole process, s | its CPU time, s | in-process, s | ratio | start-up (difference), s |",
-          "|---|---|---|---|---|---|"]
-    md += [f"| {r['template']} | {r['whole_process_s']:.3f} | {r['whole_process_cpu_s']:.3f} | {r['in_process_s']:.3f} "
-           f"| {r['ratio']:.2f} | {r['start_up_s']:.3f} |" for r in rows]
-    md += ["", "Import chain of `audit`: whole-process time of `python -c \"import ...\"`, one module more per row", "",
-           "| step | whole process, s | its CPU time, s | adds (wall), s |", "|---|---|---|---|"]
+    md = [
+        f"# wgcad audit start-up (best of {n})",
+        "",
+        f"{platform.processor() or platform.machine()}, {os.cpu_count()} cores, Python {platform.python_version()}; "
+        f"load average {load0[0]:.2f} before, {load1[0]:.2f} after",
+        "",
+        "`python -m wgcad audit TEMPLATE --quiet` (no plots): whole process against the same command in-process",
+        "",
+        "| template | whole process, s | its CPU time, s | in-process, s | ratio | start-up (difference), s |",
+        "|---|---|---|---|---|---|",
+    ]
+    md += [
+        f"| {r['template']} | {r['whole_process_s']:.3f} | {r['whole_process_cpu_s']:.3f} | {r['in_process_s']:.3f} "
+        f"| {r['ratio']:.2f} | {r['start_up_s']:.3f} |"
+        for r in rows
+    ]
+    md += [
+        "",
+        'Import chain of `audit`: whole-process time of `python -c "import ..."`, one module more per row',
+        "",
+        "| step | whole process, s | its CPU time, s | adds (wall), s |",
+        "|---|---|---|---|",
+    ]
     for r in chain:
         adds = "" if r["adds_s"] is None else f"{r['adds_s']:.3f}"
         md.append(f"| {r['step']} | {r['whole_process_s']:.3f} | {r['whole_process_cpu_s']:.3f} | {adds} |")

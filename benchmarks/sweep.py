@@ -122,22 +122,37 @@ def main():
     for w in (1, 2):
         info = run(spec, w, samples=n)
         res[w] = info
-        out[f"workers_{w}"] = {"samples": n, "wall_s": round(info.wall_s, 2), "samples_per_s": round(n / info.wall_s, 3),
-                               "batch": info.batch, "tasks_per_s": round(n / info.batch / info.wall_s, 3),
-                               "worker_s_per_sample": round(info.worker_s / n, 4),
-                               "worker_cpu_s_per_sample": round(info.worker_cpu_s / n, 4),
-                               "share_not_computing": round(1 - info.worker_s / (w * info.wall_s), 3), "load": load()}
+        out[f"workers_{w}"] = {
+            "samples": n,
+            "wall_s": round(info.wall_s, 2),
+            "samples_per_s": round(n / info.wall_s, 3),
+            "batch": info.batch,
+            "tasks_per_s": round(n / info.batch / info.wall_s, 3),
+            "worker_s_per_sample": round(info.worker_s / n, 4),
+            "worker_cpu_s_per_sample": round(info.worker_cpu_s / n, 4),
+            "share_not_computing": round(1 - info.worker_s / (w * info.wall_s), 3),
+            "load": load(),
+        }
     out["speedup_2_vs_1"] = round(res[1].wall_s / res[2].wall_s, 3)
     small = run(spec, 2, batch=1, samples=n)
-    out["batch_1_on_2_workers"] = {"wall_s": round(small.wall_s, 2), "tasks_per_s": round(n / small.wall_s, 2),
-                                   "vs_measured_grain": round(small.wall_s / res[2].wall_s, 3), "load": load()}
+    out["batch_1_on_2_workers"] = {
+        "wall_s": round(small.wall_s, 2),
+        "tasks_per_s": round(n / small.wall_s, 2),
+        "vs_measured_grain": round(small.wall_s / res[2].wall_s, 3),
+        "load": load(),
+    }
     rate = n / res[2].wall_s
     out["extrapolated_10000_samples_on_2_workers_min"] = round(10000 / rate / 60, 1)
     if args.full:
         info = run(spec, 2)
-        out["full_10000"] = {"wall_s": round(info.wall_s, 1), "minutes": round(info.wall_s / 60, 2), "batch": info.batch,
-                             "worker_s_per_sample": round(info.worker_s / info.computed, 4),
-                             "worker_cpu_s_per_sample": round(info.worker_cpu_s / info.computed, 4), "load": load()}
+        out["full_10000"] = {
+            "wall_s": round(info.wall_s, 1),
+            "minutes": round(info.wall_s / 60, 2),
+            "batch": info.batch,
+            "worker_s_per_sample": round(info.worker_s / info.computed, 4),
+            "worker_cpu_s_per_sample": round(info.worker_cpu_s / info.computed, 4),
+            "load": load(),
+        }
     print(json.dumps(out, indent=2))
 
 

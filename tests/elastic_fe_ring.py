@@ -24,8 +24,9 @@ def fe_ring(r, EI, n_el, loads, ea_factor=1e6):
         a, b1, b2, b3 = EA / L, 12 * EI / L**3, 6 * EI / L**2, EI / L
         k[np.ix_([0, 3], [0, 3])] = a * np.array([[1, -1], [-1, 1]])
         idx = [1, 2, 4, 5]
-        k[np.ix_(idx, idx)] = np.array([[b1, b2, -b1, b2], [b2, 4 * b3, -b2, 2 * b3],
-                                        [-b1, -b2, b1, -b2], [b2, 2 * b3, -b2, 4 * b3]])
+        k[np.ix_(idx, idx)] = np.array(
+            [[b1, b2, -b1, b2], [b2, 4 * b3, -b2, 2 * b3], [-b1, -b2, b1, -b2], [b2, 2 * b3, -b2, 4 * b3]]
+        )
         T = np.zeros((6, 6))
         R = np.array([[c, s, 0], [-s, c, 0], [0, 0, 1]])
         T[:3, :3] = R
@@ -37,7 +38,7 @@ def fe_ring(r, EI, n_el, loads, ea_factor=1e6):
     for node, pr, pt, cm in loads:
         er = np.array([np.cos(ang[node]), np.sin(ang[node])])
         et = np.array([-er[1], er[0]])
-        f[3 * node:3 * node + 2] += pr * er + pt * et
+        f[3 * node : 3 * node + 2] += pr * er + pt * et
         f[3 * node + 2] += cm
     C = np.zeros((ndof, 3))
     C[0::3, 0] = 1.0

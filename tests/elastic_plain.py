@@ -31,12 +31,18 @@ def _rim(model, psi, loads, rigid):
     phi = np.where(phi > np.pi, phi - 2 * np.pi, phi)
     w, v, th = model.ring.displacements(phi, psi, loads)
     dx, dy, rot = rigid
-    nom = [model.drive.law_at(float(z)).state(phi) if model.drive.coned else model.drive.law.state(phi) for z in model.zs]
+    nom = [
+        model.drive.law_at(float(z)).state(phi) if model.drive.coned else model.drive.law.state(phi) for z in model.zs
+    ]
     out = []
     for f, n in zip(model.scales, nom):
-        out.append((f * w + dx * np.cos(phi) + dy * np.sin(phi) - rot * n.v,
-                    f * v - dx * np.sin(phi) + dy * np.cos(phi) + rot * (model.drive.r_m + n.w),
-                    f * th + rot))
+        out.append(
+            (
+                f * w + dx * np.cos(phi) + dy * np.sin(phi) - rot * n.v,
+                f * v - dx * np.sin(phi) + dy * np.cos(phi) + rot * (model.drive.r_m + n.w),
+                f * th + rot,
+            )
+        )
     return phi, out
 
 
@@ -76,12 +82,19 @@ def plain_solve(model, torque_nm: float, cam_offset_um: float = 0.0, tol: float 
     for it in range(max_pass):
         phi, rim = _rim(model, psi_all, loads, rigid)
         rots, shifts, origins = [], [], []
-        for (w, v, th) in rim:
+        for w, v, th in rim:
             r, s = pose_from_displacements(phi, w, v, th, model.drive.r_m)
             rots.append(r)
             shifts.append(s)
-            origins.append(np.stack([(model.drive.r_m + w) * np.cos(phi) - v * np.sin(phi),
-                                     (model.drive.r_m + w) * np.sin(phi) + v * np.cos(phi)], axis=-1))
+            origins.append(
+                np.stack(
+                    [
+                        (model.drive.r_m + w) * np.cos(phi) - v * np.sin(phi),
+                        (model.drive.r_m + w) * np.sin(phi) + v * np.cos(phi),
+                    ],
+                    axis=-1,
+                )
+            )
         rot, shift, origin = np.concatenate(rots), np.concatenate(shifts), np.concatenate(origins)
         # every tooth pair whose tooth reaches near the rigid tips, measured on the exact geometry
         tips = transform(model.scene.flex_tip_local, rot, shift)
@@ -97,14 +110,16 @@ def plain_solve(model, torque_nm: float, cam_offset_um: float = 0.0, tol: float 
         ph = psi_t[tooth]
         c, s = np.cos(ph), np.sin(ph)
         rel = p - origin[t2]
-        b_t = np.stack([n[:, 0] * c + n[:, 1] * s, -n[:, 0] * s + n[:, 1] * c, rel[:, 0] * n[:, 1] - rel[:, 1] * n[:, 0]], -1)
+        b_t = np.stack(
+            [n[:, 0] * c + n[:, 1] * s, -n[:, 0] * s + n[:, 1] * c, rel[:, 0] * n[:, 1] - rel[:, 1] * n[:, 0]], -1
+        )
         A_t = np.stack([n[:, 0], n[:, 1], p[:, 0] * n[:, 1] - p[:, 1] * n[:, 0], 0 * n[:, 0], 0 * n[:, 0]], -1)
         f_t = model.scales[sec]
         width = model.widths[sec]
         # the current elastic field at each contact's angle: the linear gap is exact at the current state
         U = np.stack(model.ring.displacements(ph, psi_all, loads), axis=-1)
         q_t = gap + (b_t * (f_t[:, None] * U)).sum(axis=1) + A_t[:, :3] @ rigid
-        new_keys = (t2 * 2 + flank)
+        new_keys = t2 * 2 + flank
         Fprev = np.zeros(len(new_keys))
         if keys.size:
             m_ = dict(zip(keys.tolist(), F_teeth.tolist()))
@@ -125,8 +140,10 @@ def plain_solve(model, torque_nm: float, cam_offset_um: float = 0.0, tol: float 
         np.add.at(new_loads, idx, -(F * np.concatenate([np.ones(Z), f_t]))[:, None] * b)
         # convergence on the teeth's rim points (the fixed point of the re-linearisation)
         _, rim2 = _rim(model, psi_all, new_loads, a[:3])
-        move = max(float(np.abs(np.concatenate([r2[0] - r1[0] for r1, r2 in zip(rim, rim2)])).max()),
-                   float(np.abs(np.concatenate([r2[1] - r1[1] for r1, r2 in zip(rim, rim2)])).max()))
+        move = max(
+            float(np.abs(np.concatenate([r2[0] - r1[0] for r1, r2 in zip(rim, rim2)])).max()),
+            float(np.abs(np.concatenate([r2[1] - r1[1] for r1, r2 in zip(rim, rim2)])).max()),
+        )
         if move < tol:
             loads, rigid, F_ball, F_teeth, keys = new_loads, a[:3], F[:Z], F[Z:], new_keys
             break

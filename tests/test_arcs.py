@@ -1,10 +1,10 @@
 """Tests of wgcad.export.arcs: biarcs within the chord tolerance of the exact tooth curves (sampled along the arcs), tangent where the curve is smooth, closed and simple, and their DXF round trip."""
 
 import glob
+import math
 import os
 import shutil
 import subprocess
-import math
 from pathlib import Path
 
 import numpy as np
@@ -13,7 +13,15 @@ import shapely
 
 from wgcad.design import load_design
 from wgcad.drive import build_drive
-from wgcad.export.arcs import arc_deviation, arc_points, bulge_centres, fit_gear, fit_pieces, path_area, segment_tangents
+from wgcad.export.arcs import (
+    arc_deviation,
+    arc_points,
+    bulge_centres,
+    fit_gear,
+    fit_pieces,
+    path_area,
+    segment_tangents,
+)
 from wgcad.export.dxf import DxfLayer, audit_dxf, read_dxf, write_dxf
 from wgcad.profiles import pieces as pc
 
@@ -93,7 +101,7 @@ def test_arc_outline_is_closed_simple_and_encloses_the_gear_area(drive, which, t
     path = fit_gear(gear, TOL)
     write_dxf(tmp_path / "g.dxf", [DxfLayer("G", paths=(path,))])
     assert audit_dxf(tmp_path / "g.dxf") == 0
-    (v, b), = read_dxf(tmp_path / "g.dxf")["G"]["paths"]
+    ((v, b),) = read_dxf(tmp_path / "g.dxf")["G"]["paths"]
     assert np.array_equal(v, path.vertices) and np.array_equal(b, path.bulges)  # exact text round trip
     ring = shapely.LinearRing(arc_points(v, np.roll(v, -1, axis=0), b, 16)[:, :-1].reshape(-1, 2))
     assert ring.is_simple
@@ -108,11 +116,14 @@ def involute_piece():
     return pc.involute(0.1, 40.0, 0.05, 0.6)
 
 
-@pytest.mark.parametrize("make", [
-    involute_piece,
-    lambda: pc.cycloid("epicycloid", 40.0, 0.2, 0.0, 3.0),  # starts in a cusp (zero first derivative)
-    lambda: pc.cycloid("hypocycloid", 40.0, 0.2, 3.0, 0.0),  # ends in one
-])
+@pytest.mark.parametrize(
+    "make",
+    [
+        involute_piece,
+        lambda: pc.cycloid("epicycloid", 40.0, 0.2, 0.0, 3.0),  # starts in a cusp (zero first derivative)
+        lambda: pc.cycloid("hypocycloid", 40.0, 0.2, 3.0, 0.0),  # ends in one
+    ],
+)
 @pytest.mark.parametrize("tol", [1e-3, 1e-4, 1e-5])
 def test_single_curves_at_several_tolerances(make, tol):
     piece = make()
@@ -150,16 +161,29 @@ def test_librecad_reads_the_arc_dxf(tmp_path):
     """A real CAD program opens an arc-path gear DXF with its gear-data text and draws it (optional)."""
     drive = build_drive(load_design(Path(__file__).parent.parent / "templates" / "d4_discrete.toml"), tol=TOL)
     path = tmp_path / "rigid.dxf"
-    write_dxf(path, [DxfLayer("RIGID", paths=(fit_gear(drive.rigid, TOL),), circles=((0, 0, drive.rigid_rim_radius),)),
-                     DxfLayer("GEAR_DATA", texts=((25.0, 20.0, 0.8, "RIGID GEAR DATA"),))])
+    write_dxf(
+        path,
+        [
+            DxfLayer("RIGID", paths=(fit_gear(drive.rigid, TOL),), circles=((0, 0, drive.rigid_rim_radius),)),
+            DxfLayer("GEAR_DATA", texts=((25.0, 20.0, 0.8, "RIGID GEAR DATA"),)),
+        ],
+    )
     env = dict(os.environ, QT_QPA_PLATFORM="offscreen")
-    subprocess.run(["librecad", "dxf2pdf", "-a", "-m", str(path)], cwd=tmp_path, env=env, check=True,
-                   capture_output=True, timeout=120)
+    subprocess.run(
+        ["librecad", "dxf2pdf", "-a", "-m", str(path)],
+        cwd=tmp_path,
+        env=env,
+        check=True,
+        capture_output=True,
+        timeout=120,
+    )
     pdf = tmp_path / "rigid.pdf"
     assert pdf.exists() and pdf.stat().st_size > 10_000  # 88 teeth of arcs drawn, not an empty page
     if shutil.which("pdftoppm"):  # LibreCAD draws text as strokes: look at the pixels instead
         subprocess.run(["pdftoppm", "-gray", "-r", "40", str(pdf), str(tmp_path / "page")], check=True, timeout=60)
         import matplotlib.image as mpimg
 
-        img = mpimg.imread(next(tmp_path.glob("page*.pgm")) if list(tmp_path.glob("page*.pgm")) else next(tmp_path.glob("page*")))
+        img = mpimg.imread(
+            next(tmp_path.glob("page*.pgm")) if list(tmp_path.glob("page*.pgm")) else next(tmp_path.glob("page*"))
+        )
         assert np.mean(np.asarray(img) < 0.5 * np.max(img)) > 0.005  # lines drawn on the page

@@ -5,7 +5,6 @@ import stat
 
 import pytest
 
-from wgcad.errors import OutputError, WgcadError
 from wgcad.atomic import (
     atomic_batch,
     atomic_write,
@@ -13,6 +12,7 @@ from wgcad.atomic import (
     commit_all,
     ensure_writable_dir,
 )
+from wgcad.errors import OutputError, WgcadError
 
 
 class Boom(RuntimeError):
@@ -195,6 +195,7 @@ def test_commit_all_refuses_a_folder_as_target_before_renaming_anything(tmp_path
 
 # -- targets that are not regular files (issue 13: a rename onto /dev/null replaced the device) --
 
+
 def _special_targets(tmp_path):
     fifo = tmp_path / "fifo"
     os.mkfifo(fifo)
@@ -256,6 +257,7 @@ def test_target_that_turns_into_a_fifo_before_the_commit_is_refused(tmp_path):
 
 # -- folders: created only when files are written, removed again when the write fails --
 
+
 def test_check_writable_dir_creates_nothing(tmp_path):
     from wgcad.atomic import check_writable_dir
 
@@ -302,6 +304,7 @@ def test_a_device_in_the_path_is_named(tmp_path):
 
 
 # -- leftovers of killed runs --
+
 
 def _dead_pid():
     import subprocess

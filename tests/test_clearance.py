@@ -4,8 +4,8 @@ from math import pi
 
 import numpy as np
 import pytest
-
 from conftest import TEMPLATES
+
 from wgcad.clearance.distance import Template, signed_clearance
 from wgcad.clearance.engine import AuditSettings, Scene, audit, brute_force_min, tooth_clearance
 from wgcad.design import load_design, with_changes
@@ -25,8 +25,9 @@ def ngon(r, n):
 
 
 def pair(a, b, rot_a, sh_a, rot_b, sh_b):
-    return signed_clearance(Template(a), np.atleast_1d(rot_a), np.atleast_2d(sh_a), Template(b),
-                            np.atleast_1d(rot_b), np.atleast_2d(sh_b))[0]
+    return signed_clearance(
+        Template(a), np.atleast_1d(rot_a), np.atleast_2d(sh_a), Template(b), np.atleast_1d(rot_b), np.atleast_2d(sh_b)
+    )[0]
 
 
 # ---------------------------------------------------------------- closed forms
@@ -133,10 +134,16 @@ def test_odd_tooth_counts_interleave_the_waves(d1):
     angles = np.deg2rad(np.arange(0, 360, 4.0))
     fast = audit(odd, AuditSettings(angles=angles, sections=odd.sections(2), refine=False))
     assert fast.min_clearance == pytest.approx(brute_force_min(odd, angles, odd.sections(2)), abs=1e-11)
+
     # at one generator angle the two waves hold the same tooth angles with even counts
     # (the fold halves them) and interleaved ones with odd counts (nothing merges)
     def unique(drive, waves):
-        r = audit(drive, AuditSettings(angles=np.array([0.1]), sections=drive.sections(1), use_waves=waves, use_mirror=False, refine=False))
+        r = audit(
+            drive,
+            AuditSettings(
+                angles=np.array([0.1]), sections=drive.sections(1), use_waves=waves, use_mirror=False, refine=False
+            ),
+        )
         return r.counts["unique_tooth_angles"]
 
     assert unique(odd, True) == unique(odd, False) == 201
@@ -235,7 +242,9 @@ def test_worst_spot_is_canonical_whatever_the_shortcuts(d1):
     full = _audit(d1, 3.0, 3, **{s: False for s in SHORTCUTS})
     for key in ("tooth_angle_deg", "location", "mirror", "section_z_mm", "tooth", "generator_angle_deg"):
         assert audit_json(fast)["worst"][key] == audit_json(full)["worst"][key], key
-    assert audit_json(fast)["worst"]["tooth_angle_deg"] >= 0 and abs(audit_json(fast)["worst"]["tooth_angle_deg"]) <= 90.0
+    assert (
+        audit_json(fast)["worst"]["tooth_angle_deg"] >= 0 and abs(audit_json(fast)["worst"]["tooth_angle_deg"]) <= 90.0
+    )
     assert audit_json(fast)["worst"]["mirror"]["tooth_angle_deg"] == -audit_json(fast)["worst"]["tooth_angle_deg"]
     flanks = {"working flank", "non-working flank"}
     if audit_json(fast)["worst"]["location"] in flanks:
@@ -245,8 +254,11 @@ def test_worst_spot_is_canonical_whatever_the_shortcuts(d1):
 def test_pinch_is_found_beyond_six_degrees_of_the_crossing():
     # issue 13, D3 as first templated (textbook teeth): the working-flank clearance falls to about -150 um
     # 7.2 deg after the crossing, outside the old fixed 6 deg window ("entry pinch: none")
-    d3 = build_drive(with_changes(load_design(TEMPLATES / "d3_external.toml"), tooth={"addendum_coef": 1.0},
-                                  flexspline={"thinning": 0.0}))
+    d3 = build_drive(
+        with_changes(
+            load_design(TEMPLATES / "d3_external.toml"), tooth={"addendum_coef": 1.0}, flexspline={"thinning": 0.0}
+        )
+    )
     res = _audit(d3, 30.0, 1)
     e = audit_json(res)["entry"]
     assert e["pinch_um"] is not None and e["pinch_um"] < -100.0
@@ -258,8 +270,15 @@ def test_pinch_is_found_beyond_six_degrees_of_the_crossing():
 def test_pinch_is_looked_for_only_where_the_tips_pass():
     # issue 19, D2 as first templated (textbook teeth): the flanks wedge near the major axis (-82 um at
     # +7.9 deg); that is not the entry. The entry's dip is where the tip corners pass each other, ~67 deg
-    d2 = build_drive(with_changes(load_design(TEMPLATES / "d2.toml"), tooth={"addendum_coef": 1.0},
-                                  flexspline={"thinning": 0.0}, drive={"rotation": "ccw"}, generator={"w0_coef": 1.2}))
+    d2 = build_drive(
+        with_changes(
+            load_design(TEMPLATES / "d2.toml"),
+            tooth={"addendum_coef": 1.0},
+            flexspline={"thinning": 0.0},
+            drive={"rotation": "ccw"},
+            generator={"w0_coef": 1.2},
+        )
+    )
     res = _audit(d2, 30.0, 3)
     e = audit_json(res)["entry"]
     assert res.min_clearance < -0.08
@@ -271,7 +290,11 @@ def test_progress_moves_with_the_work(d1):
     # issue 13: fine-grained fractions of the actual work, not six fixed stages at the end
     calls = []
     angles = np.deg2rad(np.arange(0, 360, 0.5))
-    audit(d1, AuditSettings(angles=angles, sections=d1.sections(3), refine=False), progress=lambda d, t, s: calls.append((d, t, s)))
+    audit(
+        d1,
+        AuditSettings(angles=angles, sections=d1.sections(3), refine=False),
+        progress=lambda d, t, s: calls.append((d, t, s)),
+    )
     done = [d / t for d, t, _ in calls]
     assert done == sorted(done) and done[-1] == 1.0
     assert len(calls) >= 10 and len({round(x, 3) for x in done}) >= 8

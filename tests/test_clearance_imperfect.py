@@ -5,25 +5,35 @@ import math
 
 import numpy as np
 import pytest
-
 from conftest import TEMPLATES, edit_toml
-from wgcad.placement.imperfect import Imperfections, flex_poses, rigid_poses
+
 from wgcad.audit import _sections
-from wgcad.cli import main
 from wgcad.clearance import imperfect as IM
 from wgcad.clearance.engine import audit
 from wgcad.clearance.scene import Scene
 from wgcad.clearance.search import AuditSettings
+from wgcad.cli import main
 from wgcad.constants import REFINE_TOL
 from wgcad.design import load_design
 from wgcad.drive import build_drive
 from wgcad.placement import transform
+from wgcad.placement.imperfect import Imperfections, flex_poses, rigid_poses
 from wgcad.report.audit import audit_json
 
 #: D2's tolerances of [S4] (docs/models.md 9), and an eccentricity of each gear
-S4 = Imperfections(flex_runout=0.075, flex_runout_phase=math.radians(260), rigid_runout=0.075, cam_cam=0.08,
-                   cam_fixed=0.03, flex_ecc=0.01, flex_ecc_phase=1.0, rigid_ecc=0.012, rigid_ecc_phase=2.2,
-                   cam_flex=0.015, cam_flex_phase=0.3)
+S4 = Imperfections(
+    flex_runout=0.075,
+    flex_runout_phase=math.radians(260),
+    rigid_runout=0.075,
+    cam_cam=0.08,
+    cam_fixed=0.03,
+    flex_ecc=0.01,
+    flex_ecc_phase=1.0,
+    rigid_ecc=0.012,
+    rigid_ecc_phase=2.2,
+    cam_flex=0.015,
+    cam_flex_phase=0.3,
+)
 
 
 @pytest.fixture(scope="module")
@@ -54,14 +64,16 @@ def test_error_bound_holds_for_every_point(d1, seed):
     # rigid teeth it faces (lower, upper, third nearest) must never exceed it. Random errors up to the
     # [S4] amplitudes and phases; every point of the tooth polygon, measured in the rigid tooth's frame.
     rng = np.random.default_rng(seed)
-    imp = Imperfections(*(rng.uniform(0, 1) * getattr(S4, f) if not f.endswith(("phase", "install")) else rng.uniform(0, 2 * math.pi)
-                          for f in Imperfections.__dataclass_fields__))
+    imp = Imperfections(
+        *(
+            rng.uniform(0, 1) * getattr(S4, f) if not f.endswith(("phase", "install")) else rng.uniform(0, 2 * math.pi)
+            for f in Imperfections.__dataclass_fields__
+        )
+    )
     scene = Scene(d1)
-    isc = IM.ImperfectScene.from_scene(scene, imp)
     secs = [float(z) for z in _sections(d1, 3)]
     eb = IM.ErrorBound(scene, imp, secs)
     rb_rot, rb_shift = rigid_poses(d1, imp)
-    u = scene.ratios["u_hg"]
     worst = 0.0
     for phi_h in rng.uniform(0, 2 * math.pi, 6):
         k = np.arange(200)
@@ -78,7 +90,10 @@ def test_error_bound_holds_for_every_point(d1, seed):
                 d = rb_rot[j] - scene.rigid_rot[j]
                 c, s = np.cos(-d), np.sin(-d)
                 q = Pi - rb_shift[j][:, None, :]
-                back = np.stack([c[:, None] * q[..., 0] - s[:, None] * q[..., 1], s[:, None] * q[..., 0] + c[:, None] * q[..., 1]], -1)
+                back = np.stack(
+                    [c[:, None] * q[..., 0] - s[:, None] * q[..., 1], s[:, None] * q[..., 0] + c[:, None] * q[..., 1]],
+                    -1,
+                )
                 disp = np.hypot(*(back - Pp).transpose(2, 0, 1)).max(axis=1)
                 assert np.all(disp <= bound), (float((disp - bound).max()), seed)
                 worst = max(worst, float((disp / bound).max()))
@@ -117,8 +132,13 @@ def test_rigid_eccentricity_deepens_by_its_amplitude(d1):
     scene = Scene(d1)
     z = audit_json(ref)["worst"]["section_z_mm"]
     # the worst sample itself, where it is (its zone: the mirror and the other wave's spots move the other way)
-    rot, shift = flex_poses(d1, Imperfections(), math.radians(audit_json(ref)["worst"]["generator_angle_deg"]),
-                            teeth=[audit_json(ref)["worst"]["tooth"]], z=z)
+    rot, shift = flex_poses(
+        d1,
+        Imperfections(),
+        math.radians(audit_json(ref)["worst"]["generator_angle_deg"]),
+        teeth=[audit_json(ref)["worst"]["tooth"]],
+        z=z,
+    )
     det = IM.clearance_at_poses(scene, rot, shift)
     side = min(("lower", "upper"), key=lambda s: det[s][0])
     j = det["lo"] if side == "lower" else det["up"]
@@ -130,7 +150,9 @@ def test_rigid_eccentricity_deepens_by_its_amplitude(d1):
     # the rigid gear moves the other way: its eccentricity's phase is deeper + pi
     imp = Imperfections(rigid_ecc=e, rigid_ecc_phase=float(deeper + math.pi))
     got = IM.audit_imperfect(d1, st, imp)
-    assert got.min_clearance == pytest.approx(ref.min_clearance - e, abs=2 * REFINE_TOL + e * (1 - math.cos(math.radians(0.25))))
+    assert got.min_clearance == pytest.approx(
+        ref.min_clearance - e, abs=2 * REFINE_TOL + e * (1 - math.cos(math.radians(0.25)))
+    )
 
 
 def test_chunks_and_bounds_change_nothing(d1):
@@ -163,7 +185,11 @@ def test_audit_cli_honours_imperfections(tmp_path, capsys):
     assert not any("uses perfect parts" in n for n in res["not_checked"])
     assert not any("entry gap" in n and "not computed" in n for n in res["not_checked"])
     # the entry of the imperfect drive: the passage it happens in
-    assert res["entry_gap_um"] is not None and res["entry"]["tooth"] is not None and res["entry"]["generator_angle_deg"] is not None
+    assert (
+        res["entry_gap_um"] is not None
+        and res["entry"]["tooth"] is not None
+        and res["entry"]["generator_angle_deg"] is not None
+    )
     for suffix in ("profile", "vs_angle", "tightest"):
         assert (tmp_path / f"pic_{suffix}.png").stat().st_size > 10_000
     text_out = capsys.readouterr().out
@@ -182,7 +208,10 @@ def test_fixed_flexspline_keeps_the_perfect_audit_and_says_so(tmp_path):
     main(["audit", str(p), "--step-deg", "4", "--json", str(out), "--quiet", "--no-refine"])
     res = json.loads(out.read_text())
     assert "imperfections" not in res["settings"]
-    assert any("uses perfect parts (imperfect parts are modelled with a fixed rigid gear only)" in n for n in res["not_checked"])
+    assert any(
+        "uses perfect parts (imperfect parts are modelled with a fixed rigid gear only)" in n
+        for n in res["not_checked"]
+    )
 
 
 @pytest.mark.parametrize("name", ["d3_external", "d1_odd"])
@@ -197,8 +226,17 @@ def test_bounds_hold_on_other_geometries(name, tmp_path):
     else:
         design = load_design(TEMPLATES / f"{name}.toml")
     d = build_drive(design)
-    imp = Imperfections(flex_runout=0.03, rigid_runout=0.03, rigid_runout_phase=0.7, cam_cam=0.02, cam_fixed=0.015,
-                        cam_fixed_phase=2.0, flex_ecc=0.01, rigid_ecc=0.008, rigid_ecc_phase=1.1)
+    imp = Imperfections(
+        flex_runout=0.03,
+        rigid_runout=0.03,
+        rigid_runout_phase=0.7,
+        cam_cam=0.02,
+        cam_fixed=0.015,
+        cam_fixed_phase=2.0,
+        flex_ecc=0.01,
+        rigid_ecc=0.008,
+        rigid_ecc_phase=1.1,
+    )
     st = _settings(d, 8.0, refine=False)
     a = IM.audit_imperfect(d, st, imp)
     b = IM.audit_imperfect(d, _settings(d, 8.0, refine=False, bound=False), imp)
@@ -213,17 +251,23 @@ def test_full_cycle_is_every_turn_of_the_flexspline_errors(tmp_path):
     # So the whole cycle's minimum (--turns full: 43 turns for D4's 86/88 teeth) must equal the smallest
     # of 43 one-turn audits with those installation angles - computed independently, each its own sweep.
     # The phase is chosen so that turn 0 is not the worst (measured: -1.61 um in turn 0, -2.34 um in turn 10).
-    from wgcad.placement.imperfect import full_cycle_turns
     from wgcad.audit import RunSettings, run_audit
     from wgcad.kinematics import gear_ratios
+    from wgcad.placement.imperfect import full_cycle_turns
 
     base = (TEMPLATES / "d4_discrete.toml").read_text() + "\n[imperfections]\n"
-    errs = (("flex_eccentricity_um", "3.0"), ("flex_eccentricity_phase_deg", "270.0"), ("rigid_eccentricity_um", "3.0"),
-            ("cam_offset_fixed_um", "2.0"))
+    errs = (
+        ("flex_eccentricity_um", "3.0"),
+        ("flex_eccentricity_phase_deg", "270.0"),
+        ("rigid_eccentricity_um", "3.0"),
+        ("cam_offset_fixed_um", "2.0"),
+    )
 
     def design(install_deg=None):
         text = base
-        for key, val in errs + ((("flex_install_angle_deg", f"{install_deg:.12f}"),) if install_deg is not None else ()):
+        for key, val in errs + (
+            (("flex_install_angle_deg", f"{install_deg:.12f}"),) if install_deg is not None else ()
+        ):
             text = edit_toml(text, "imperfections", key, val)
         p = tmp_path / f"d4_{install_deg}.toml"
         p.write_text(text)
@@ -232,10 +276,16 @@ def test_full_cycle_is_every_turn_of_the_flexspline_errors(tmp_path):
     assert full_cycle_turns(86, 88) == 43 and full_cycle_turns(200, 202) == 100
     # polygon figures (no refinement): the same polygons at the same poses either way
     _, full = run_audit(design(), RunSettings(step_deg=2.0, turns=None, refine=False))
-    assert full.settings["generator_turns"] == 43 and full.settings["shortcuts_that_hold"]["one_generator_turn"] is False
+    assert (
+        full.settings["generator_turns"] == 43 and full.settings["shortcuts_that_hold"]["one_generator_turn"] is False
+    )
     u = gear_ratios(86, 88)["u_hg"]
-    per_turn = [run_audit(design(math.degrees(2 * math.pi * n / u) % 360.0), RunSettings(step_deg=2.0, refine=False))[1].min_clearance
-                for n in range(43)]
+    per_turn = [
+        run_audit(design(math.degrees(2 * math.pi * n / u) % 360.0), RunSettings(step_deg=2.0, refine=False))[
+            1
+        ].min_clearance
+        for n in range(43)
+    ]
     assert full.min_clearance == pytest.approx(min(per_turn), abs=1e-9)
     assert per_turn[0] > min(per_turn) + 0.5e-3  # one turn alone misses it
 
@@ -245,8 +295,12 @@ def test_one_turn_holds_every_state_without_flexspline_errors(tmp_path):
     from wgcad.audit import RunSettings, run_audit
 
     text = (TEMPLATES / "d4_discrete.toml").read_text() + "\n[imperfections]\n"
-    for key, val in (("rigid_eccentricity_um", "3.0"), ("rigid_runout_um", "4.0"), ("cam_offset_fixed_um", "2.0"),
-                     ("cam_offset_cam_um", "2.0")):
+    for key, val in (
+        ("rigid_eccentricity_um", "3.0"),
+        ("rigid_runout_um", "4.0"),
+        ("cam_offset_fixed_um", "2.0"),
+        ("cam_offset_cam_um", "2.0"),
+    ):
         text = edit_toml(text, "imperfections", key, val)
     p = tmp_path / "d4_housing.toml"
     p.write_text(text)
@@ -319,7 +373,9 @@ def test_entry_gap_of_every_passage_against_a_dense_reference(d1):
     sc = Scene(d1)
     fine = build_drive(d1.design, tol=1e-6)
     rr, rs = rigid_poses(d1, S4)
-    rigid_fine = [transform(fine.rigid.tooth_polygon(), rr[j : j + 1], rs[j : j + 1])[0] for j in range(d1.design.drive.z_rigid)]
+    rigid_fine = [
+        transform(fine.rigid.tooth_polygon(), rr[j : j + 1], rs[j : j + 1])[0] for j in range(d1.design.drive.z_rigid)
+    ]
     c = 1.0 / sc.ratios["u_hg"] - 1.0
 
     import shapely
@@ -331,7 +387,9 @@ def test_entry_gap_of_every_passage_against_a_dense_reference(d1):
 
     # the reported passage: crossing bracketed around the audit's own angle
     span = np.deg2rad(0.5)
-    ph = _reference_crossing(d1, S4, e.generator_angle - span, e.generator_angle + span, e.tooth, e.section_z, sc.r_tip_b, sc.tip_arc)
+    ph = _reference_crossing(
+        d1, S4, e.generator_angle - span, e.generator_angle + span, e.tooth, e.section_z, sc.r_tip_b, sc.tip_arc
+    )
     assert abs(ph - e.generator_angle) < 1e-7
     assert abs(e.value - ref_gap(ph, e.tooth, e.section_z)) <= REFINE_TOL + 1e-6
     # the edge it names faces the rigid tooth the reference finds closest, and the summary names it
@@ -379,21 +437,43 @@ def test_generate_places_the_deformed_assembly_with_its_errors(tmp_path):
     # too, by a fraction of it: the teeth are a fraction of the area. Left out here.)
     import shapely
 
-    from wgcad.placement.imperfect import cam_offset, rigid_translation
     from wgcad.export.dxf import read_dxf
     from wgcad.kinematics import gear_ratios
+    from wgcad.placement.imperfect import cam_offset, rigid_translation
 
-    errs = (("rigid_eccentricity_um", "20.0"), ("rigid_eccentricity_phase_deg", "30.0"),
-            ("flex_eccentricity_um", "12.0"), ("flex_eccentricity_phase_deg", "200.0"), ("cam_offset_fixed_um", "25.0"),
-            ("cam_offset_fixed_phase_deg", "100.0"), ("cam_offset_cam_um", "10.0"))
+    errs = (
+        ("rigid_eccentricity_um", "20.0"),
+        ("rigid_eccentricity_phase_deg", "30.0"),
+        ("flex_eccentricity_um", "12.0"),
+        ("flex_eccentricity_phase_deg", "200.0"),
+        ("cam_offset_fixed_um", "25.0"),
+        ("cam_offset_fixed_phase_deg", "100.0"),
+        ("cam_offset_cam_um", "10.0"),
+    )
     text = (TEMPLATES / "d1_involute.toml").read_text() + "\n[imperfections]\n"
     for key, val in errs:
         text = edit_toml(text, "imperfections", key, val)
     p = tmp_path / "d1_imp.toml"
     p.write_text(text)
-    assert main(["generate", str(p), "--out", str(tmp_path / "imp"), "--generator-angle", "40", "--no-stl", "--quiet"]) == 0
-    assert main(["generate", str(TEMPLATES / "d1_involute.toml"), "--out", str(tmp_path / "nom"), "--generator-angle", "40",
-                 "--no-stl", "--quiet"]) == 0
+    assert (
+        main(["generate", str(p), "--out", str(tmp_path / "imp"), "--generator-angle", "40", "--no-stl", "--quiet"])
+        == 0
+    )
+    assert (
+        main(
+            [
+                "generate",
+                str(TEMPLATES / "d1_involute.toml"),
+                "--out",
+                str(tmp_path / "nom"),
+                "--generator-angle",
+                "40",
+                "--no-stl",
+                "--quiet",
+            ]
+        )
+        == 0
+    )
     got = read_dxf(tmp_path / "imp" / "d1_imp_phip040_000.dxf")
     nom = read_dxf(tmp_path / "nom" / "d1_involute_phip040_000.dxf")
     imp = Imperfections.from_spec(load_design(p).imperfections)
@@ -410,9 +490,14 @@ def test_generate_places_the_deformed_assembly_with_its_errors(tmp_path):
     ecc = imp.flex_ecc * np.array([math.cos(imp.flex_ecc_phase + phi_g), math.sin(imp.flex_ecc_phase + phi_g)])
     # the flexspline's teeth: the cam offset and its eccentricity (to first order: a tooth shifted along the
     # deformed rim by e sin(...) is not exactly translated; 1 um covers it at W0/r_m ~ 1 %)
-    assert np.allclose(centroid(got, "FLEXSPLINE_DEFORMED") - centroid(nom, "FLEXSPLINE_DEFORMED"),
-                       cam_offset(imp, phi_h, phi_g) + ecc, atol=1e-3)
-    assert np.allclose(centroid(got, "NEUTRAL_LINE") - centroid(nom, "NEUTRAL_LINE"), cam_offset(imp, phi_h, phi_g), atol=1e-6)
+    assert np.allclose(
+        centroid(got, "FLEXSPLINE_DEFORMED") - centroid(nom, "FLEXSPLINE_DEFORMED"),
+        cam_offset(imp, phi_h, phi_g) + ecc,
+        atol=1e-3,
+    )
+    assert np.allclose(
+        centroid(got, "NEUTRAL_LINE") - centroid(nom, "NEUTRAL_LINE"), cam_offset(imp, phi_h, phi_g), atol=1e-6
+    )
     # the nominal parts: the gears' own DXF is the perfect one
     a = read_dxf(tmp_path / "imp" / "d1_imp.dxf")["RIGID"]["outlines"][0]
     b = read_dxf(tmp_path / "nom" / "d1_involute.dxf")["RIGID"]["outlines"][0]

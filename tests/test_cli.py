@@ -8,8 +8,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 import trimesh
-
 from conftest import TEMPLATES, edit_toml
+
 from wgcad.cli import main
 from wgcad.design import load_design
 from wgcad.drive import build_drive
@@ -99,7 +99,9 @@ def test_unwritable_output_folder(tmp_path, capsys):
     assert blocker.read_text().startswith("a regular file")
 
 
-@pytest.mark.parametrize("flag", [["--chord-tol-um", "0"], ["--chord-tol-um", "abc"], ["--generator-angle", "0,x"], ["--bogus"]])
+@pytest.mark.parametrize(
+    "flag", [["--chord-tol-um", "0"], ["--chord-tol-um", "abc"], ["--generator-angle", "0,x"], ["--bogus"]]
+)
 def test_bad_flags(tmp_path, capsys, flag):
     with pytest.raises(SystemExit) as e:
         main(["generate", str(TEMPLATES / "d4_discrete.toml"), "--out", str(tmp_path / "o"), *flag])
@@ -111,7 +113,9 @@ def test_bad_flags(tmp_path, capsys, flag):
 @pytest.fixture(scope="module")
 def d4_run(tmp_path_factory):
     out = tmp_path_factory.mktemp("d4")
-    code = main(["generate", str(TEMPLATES / "d4_discrete.toml"), "--out", str(out), "--generator-angle", "0,30", "--quiet"])
+    code = main(
+        ["generate", str(TEMPLATES / "d4_discrete.toml"), "--out", str(out), "--generator-angle", "0,30", "--quiet"]
+    )
     assert code == 0
     return out
 
@@ -132,7 +136,14 @@ def test_generate_writes_everything(d4_run):
         ]
     )
     rep = json.loads((d4_run / "d4_discrete.report.json").read_text())
-    for key in ("pitch_radius_mm", "tip_radius_mm", "root_radius_mm", "base_radius_mm", "tooth_thickness_pitch_mm", "space_width_pitch_mm"):
+    for key in (
+        "pitch_radius_mm",
+        "tip_radius_mm",
+        "root_radius_mm",
+        "base_radius_mm",
+        "tooth_thickness_pitch_mm",
+        "space_width_pitch_mm",
+    ):
         assert key in rep["flexspline"] and key in rep["rigid"]
     assert rep["drive"]["ratio_rigid_fixed"] == -43 and rep["drive"]["ratio_flexspline_fixed"] == 44
     assert {"depth_of_engagement_mm", "clearance_flex_tip_major_um", "clearance_rigid_tip_major_um"} <= set(rep["mesh"])
@@ -166,11 +177,13 @@ def test_stl_volume_is_area_times_face_width(d4_run):
 
     drive = build_drive(load_design(TEMPLATES / "d4_discrete.toml"))
     bw = drive.design.drive.face_width
-    for name, gear, rim in (("flexspline", drive.flex, drive.flex_rim_radius), ("rigid", drive.rigid, drive.rigid_rim_radius)):
+    for name, gear, rim in (
+        ("flexspline", drive.flex, drive.flex_rim_radius),
+        ("rigid", drive.rigid, drive.rigid_rim_radius),
+    ):
         mesh = trimesh.load(d4_run / f"d4_discrete_{name}.stl")
         assert mesh.is_watertight and mesh.is_volume
         from wgcad.cli import _circle
-
         from wgcad.profiles.band import gear_band_outline
 
         circle = _circle(rim, drive.tol)
@@ -191,8 +204,21 @@ def test_generate_is_deterministic(tmp_path):
     for out, seed in ((a, "1"), (b, "2")):
         env = {**os.environ, "PYTHONHASHSEED": seed}
         r = subprocess.run(
-            [sys.executable, "-m", "wgcad", "generate", str(TEMPLATES / "d4_discrete.toml"), "--out", str(out), "--generator-angle", "10", "--quiet"],
-            env=env, capture_output=True, text=True,
+            [
+                sys.executable,
+                "-m",
+                "wgcad",
+                "generate",
+                str(TEMPLATES / "d4_discrete.toml"),
+                "--out",
+                str(out),
+                "--generator-angle",
+                "10",
+                "--quiet",
+            ],
+            env=env,
+            capture_output=True,
+            text=True,
         )
         assert r.returncode == 0, r.stderr
     names = sorted(p.name for p in a.iterdir())

@@ -11,8 +11,8 @@ import time
 from pathlib import Path
 
 import pytest
-
 from conftest import TEMPLATES, edit_toml
+
 from wgcad.cli import build_parser, main
 
 ROOT = TEMPLATES.parent
@@ -28,8 +28,9 @@ def run(argv, capsys):
 def wgcad(*argv, cwd=None, env=None, **kw):
     """The installed entry point as a user runs it, in its own process."""
     e = {**os.environ, "PYTHONPATH": str(ROOT), **(env or {})}
-    return subprocess.run([sys.executable, "-m", "wgcad", *map(str, argv)], cwd=cwd, env=e,
-                          capture_output=True, text=True, **kw)
+    return subprocess.run(
+        [sys.executable, "-m", "wgcad", *map(str, argv)], cwd=cwd, env=e, capture_output=True, text=True, **kw
+    )
 
 
 def snapshot(folder: Path):
@@ -53,6 +54,7 @@ def one_line_error(code, err, *words):
 
 # -- output files that are not regular files are never replaced ---------------------------------
 
+
 def special_files(tmp_path):
     fifo = tmp_path / "fifo.json"
     os.mkfifo(fifo)
@@ -61,8 +63,14 @@ def special_files(tmp_path):
     link.symlink_to(tmp_path / "real.json")
     folder = tmp_path / "folder.json"
     folder.mkdir()
-    return {"/dev/null": Path("/dev/null"), "/dev/full": Path("/dev/full"), "/dev/stdout": Path("/dev/stdout"),
-            "fifo": fifo, "symlink": link, "folder": folder}
+    return {
+        "/dev/null": Path("/dev/null"),
+        "/dev/full": Path("/dev/full"),
+        "/dev/stdout": Path("/dev/stdout"),
+        "fifo": fifo,
+        "symlink": link,
+        "folder": folder,
+    }
 
 
 KINDS = ["/dev/null", "/dev/full", "/dev/stdout", "fifo", "symlink", "folder"]
@@ -115,6 +123,7 @@ def test_output_that_is_the_design_file_is_refused(tmp_path, capsys):
 
 # -- --json - ---------------------------------------------------------------------------------------
 
+
 def test_json_dash_writes_the_json_to_stdout_and_the_summary_to_stderr(tmp_path):
     r = wgcad("audit", D4, "--json", "-", cwd=tmp_path)
     assert r.returncode in (0, 1), r.stderr
@@ -129,15 +138,24 @@ def test_json_dash_writes_the_json_to_stdout_and_the_summary_to_stderr(tmp_path)
 
 def test_full_stdout_is_a_one_line_error():
     with open("/dev/full", "w") as full:
-        r = subprocess.run([sys.executable, "-m", "wgcad", "audit", str(D4), "--json", "-", "--quiet"],
-                           env={**os.environ, "PYTHONPATH": str(ROOT)}, stdout=full, stderr=subprocess.PIPE, text=True)
+        r = subprocess.run(
+            [sys.executable, "-m", "wgcad", "audit", str(D4), "--json", "-", "--quiet"],
+            env={**os.environ, "PYTHONPATH": str(ROOT)},
+            stdout=full,
+            stderr=subprocess.PIPE,
+            text=True,
+        )
     one_line_error(r.returncode, r.stderr, "standard output", "No space left on device")
 
 
 def test_reader_closing_the_pipe_is_a_quiet_exit():
     # `wgcad audit ... --json - | head -c 0`: the reader is gone before wgcad writes
-    p = subprocess.Popen([sys.executable, "-m", "wgcad", "audit", str(D4), "--json", "-", "--quiet"],
-                         env={**os.environ, "PYTHONPATH": str(ROOT)}, stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+    p = subprocess.Popen(
+        [sys.executable, "-m", "wgcad", "audit", str(D4), "--json", "-", "--quiet"],
+        env={**os.environ, "PYTHONPATH": str(ROOT)},
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+    )
     p.stdout.close()
     err = p.stderr.read().decode()
     assert p.wait(timeout=120) == 141 and err == ""
@@ -149,6 +167,7 @@ def test_both_to_stdout_is_refused(capsys):
 
 
 # -- internal errors ---------------------------------------------------------------------------------
+
 
 def test_internal_error_exit_3_one_line_no_traceback(tmp_path, capsys, monkeypatch):
     import wgcad.drive
@@ -165,7 +184,11 @@ def test_internal_error_exit_3_one_line_no_traceback(tmp_path, capsys, monkeypat
     assert not (tmp_path / "o").exists()
     monkeypatch.setenv("WGCAD_TRACEBACK", "1")
     code, out, err = run(["generate", D4, "--out", tmp_path / "o"], capsys)
-    assert code == 3 and "Traceback (most recent call last)" in err and err.rstrip().splitlines()[-1].startswith("wgcad: internal error")
+    assert (
+        code == 3
+        and "Traceback (most recent call last)" in err
+        and err.rstrip().splitlines()[-1].startswith("wgcad: internal error")
+    )
     monkeypatch.delenv("WGCAD_TRACEBACK")
     code, out, err = run(["--traceback", "generate", D4, "--out", tmp_path / "o"], capsys)
     assert code == 3 and "Traceback (most recent call last)" in err
@@ -177,6 +200,7 @@ def test_interference_keeps_exit_1_and_bad_input_exit_2(capsys):
 
 
 # -- several designs in one folder, re-runs ----------------------------------------------------------
+
 
 def files_of(folder: Path):
     return sorted(p.name for p in folder.iterdir() if not p.name.startswith("."))
@@ -206,11 +230,18 @@ def test_rerun_removes_only_its_own_previous_files(tmp_path, capsys):
     assert code == 0 and "removed 2 of the previous run's files" in so
     rep = json.loads((out / "d4_discrete.report.json").read_text())
     assert rep["files"] == ["d4_discrete.dxf", "d4_discrete.report.json"]
-    assert files_of(out) == ["d2.dxf", "d2.report.json", "d4_discrete.dxf", "d4_discrete.report.json",
-                             "d4_discrete_old.stl", "notes.txt"]
+    assert files_of(out) == [
+        "d2.dxf",
+        "d2.report.json",
+        "d4_discrete.dxf",
+        "d4_discrete.report.json",
+        "d4_discrete_old.stl",
+        "notes.txt",
+    ]
     # the folder holds exactly what each report lists, plus the files wgcad did not write
     assert set(files_of(out)) - {"d4_discrete_old.stl", "notes.txt"} == set(rep["files"]) | set(
-        json.loads((out / "d2.report.json").read_text())["files"])
+        json.loads((out / "d2.report.json").read_text())["files"]
+    )
 
 
 def test_rerun_keeps_a_file_changed_since_wgcad_wrote_it(tmp_path, capsys):
@@ -241,11 +272,13 @@ def test_same_name_from_another_folder_is_a_collision(tmp_path, capsys):
 
 # -- refused runs create no folder; special output folders -------------------------------------------
 
+
 def test_refused_audit_leaves_no_folder(tmp_path, capsys):
     bad = tmp_path / "bad.toml"
     bad.write_text(edit_toml(D4.read_text(), "drive", "module", "-1.0"))
-    code, out, err = run(["audit", bad, "--json", tmp_path / "new" / "deeper" / "r.json",
-                          "--plot", tmp_path / "pics" / "p"], capsys)
+    code, out, err = run(
+        ["audit", bad, "--json", tmp_path / "new" / "deeper" / "r.json", "--plot", tmp_path / "pics" / "p"], capsys
+    )
     one_line_error(code, err, "drive.module")
     assert sorted(os.listdir(tmp_path)) == ["bad.toml"]
 
@@ -259,8 +292,14 @@ def test_refused_generate_leaves_no_folder(tmp_path, capsys):
 
 
 @pytest.mark.skipif(not os.path.isdir("/proc/self"), reason="needs a proc file system")
-@pytest.mark.parametrize("cmd", [["generate", D4, "--out", "/proc"], ["kinematics", TEMPLATES / "d3_external.toml", "--out", "/proc/x"],
-                                 ["audit", D4, "--json", "/proc/wgcad.json"]])
+@pytest.mark.parametrize(
+    "cmd",
+    [
+        ["generate", D4, "--out", "/proc"],
+        ["kinematics", TEMPLATES / "d3_external.toml", "--out", "/proc/x"],
+        ["audit", D4, "--json", "/proc/wgcad.json"],
+    ],
+)
 def test_proc_as_output_gets_the_right_message(capsys, cmd):
     code, out, err = run(cmd, capsys)
     one_line_error(code, err, "proc file system")
@@ -269,12 +308,28 @@ def test_proc_as_output_gets_the_right_message(capsys, cmd):
 
 # -- interrupted runs ----------------------------------------------------------------------------------
 
+
 def _start_and_wait_for_temp(out: Path, tmp_path: Path):
     """Start a long generate and return it once its batch holds temporary files in ``out``."""
-    p = subprocess.Popen([sys.executable, "-m", "wgcad", "generate", str(TEMPLATES / "d1_involute.toml"),
-                          "--out", str(out), "--generator-angle", "0,10", "--quiet"],
-                         cwd=tmp_path, env={**os.environ, "PYTHONPATH": str(ROOT)},
-                         stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    p = subprocess.Popen(
+        [
+            sys.executable,
+            "-m",
+            "wgcad",
+            "generate",
+            str(TEMPLATES / "d1_involute.toml"),
+            "--out",
+            str(out),
+            "--generator-angle",
+            "0,10",
+            "--quiet",
+        ],
+        cwd=tmp_path,
+        env={**os.environ, "PYTHONPATH": str(ROOT)},
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
     deadline = time.monotonic() + 120
     while time.monotonic() < deadline:
         if out.is_dir() and any(n.startswith(".d1_involute.dxf.") and n.endswith(".tmp") for n in os.listdir(out)):
@@ -308,7 +363,12 @@ def test_killed_run_leftovers_are_removed_by_the_next_run(tmp_path, capsys):
     (out / "user.tmp").write_text("not wgcad's")
     code, so, se = run(["generate", TEMPLATES / "d4_discrete.toml", "--out", out, "--no-stl", "--quiet"], capsys)
     assert code == 0, se
-    assert sorted(os.listdir(out)) == [".d4_discrete.wgcad-files.json", "d4_discrete.dxf", "d4_discrete.report.json", "user.tmp"]
+    assert sorted(os.listdir(out)) == [
+        ".d4_discrete.wgcad-files.json",
+        "d4_discrete.dxf",
+        "d4_discrete.report.json",
+        "user.tmp",
+    ]
 
 
 # -- every subcommand: bad input is one line, exit 2, nothing written ---------------------------------
@@ -353,6 +413,7 @@ def test_bad_input_subprocess_one_line_exit_2_nothing_written(tmp_path, argv):
 
 # -- help texts, imports per command --------------------------------------------------------------------
 
+
 def test_every_flag_and_argument_has_help():
     import argparse
 
@@ -377,8 +438,12 @@ def _modules_after(argv):
         "heavy = ('matplotlib', 'trimesh', 'manifold3d', 'fcl', 'ezdxf', 'scipy.optimize', 'scipy.special', 'shapely');"
         "print(' '.join(m for m in heavy if m in sys.modules)); sys.exit(rc)"
     )
-    r = subprocess.run([sys.executable, "-c", code, *map(str, argv)], capture_output=True, text=True,
-                       env={**os.environ, "PYTHONPATH": str(ROOT)})
+    r = subprocess.run(
+        [sys.executable, "-c", code, *map(str, argv)],
+        capture_output=True,
+        text=True,
+        env={**os.environ, "PYTHONPATH": str(ROOT)},
+    )
     assert r.returncode in (0, 1), r.stderr
     return set(r.stdout.split())
 

@@ -5,8 +5,8 @@ import math
 import numpy as np
 import pytest
 
-from wgcad.laws import coned_w0, make_law
 from wgcad.errors import DesignError
+from wgcad.laws import coned_w0, make_law
 
 L, Z_H, W0 = 160.0, 12.0, 0.88  # D1: shell length 160 mm, W0 = 1.1 m
 

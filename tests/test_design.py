@@ -2,19 +2,18 @@
 
 import os
 import threading
+import tomllib
 from dataclasses import fields
 
 import pytest
-
 from conftest import TEMPLATES, edit_toml
+
 from wgcad.cli import main
 from wgcad.design import _TABLES, load_design, parse_design
 from wgcad.design.files import MAX_DESIGN_BYTES
 from wgcad.design.rules import Rel, context, key_meta
 from wgcad.drive import build_drive
 from wgcad.errors import DesignError, InputFileError
-
-import tomllib
 
 NAMES = ["d1_involute", "d1_cycloidal", "d2", "d3_external", "d4_discrete"]
 
@@ -76,13 +75,25 @@ def test_every_bound_refuses_just_outside(table, key, meta, side):
 
 
 HUGE = [
-    ("drive", "module", "1e12"), ("drive", "module", "1e6"), ("drive", "module", "1e-9"),
-    ("drive", "z_flex", "1000000000"), ("drive", "z_rigid", "1000000"), ("drive", "z_flex", "99999999999999"),
-    ("drive", "face_width", "1e300"), ("drive", "waves", "1000000"),
-    ("tooth", "addendum_coef", "1e39"), ("tooth", "clearance_coef", "1e39"),
-    ("flexspline", "shift", "1e39"), ("flexspline", "rim_thickness", "1e39"), ("rigid", "rim_thickness", "1e9"),
-    ("flexspline", "tip_radius", "1e39"), ("rigid", "root_radius", "1e-300"), ("flexspline", "fillet_coef", "1e9"),
-    ("generator", "w0_coef", "1e39"), ("generator", "cone_length", "1e39"), ("generator", "generator_z", "1e39"),
+    ("drive", "module", "1e12"),
+    ("drive", "module", "1e6"),
+    ("drive", "module", "1e-9"),
+    ("drive", "z_flex", "1000000000"),
+    ("drive", "z_rigid", "1000000"),
+    ("drive", "z_flex", "99999999999999"),
+    ("drive", "face_width", "1e300"),
+    ("drive", "waves", "1000000"),
+    ("tooth", "addendum_coef", "1e39"),
+    ("tooth", "clearance_coef", "1e39"),
+    ("flexspline", "shift", "1e39"),
+    ("flexspline", "rim_thickness", "1e39"),
+    ("rigid", "rim_thickness", "1e9"),
+    ("flexspline", "tip_radius", "1e39"),
+    ("rigid", "root_radius", "1e-300"),
+    ("flexspline", "fillet_coef", "1e9"),
+    ("generator", "w0_coef", "1e39"),
+    ("generator", "cone_length", "1e39"),
+    ("generator", "generator_z", "1e39"),
 ]
 
 
@@ -91,7 +102,10 @@ def test_absurd_numbers_are_one_line_errors_naming_the_field(table, key, value, 
     text = edit_toml((TEMPLATES / "d1_involute.toml").read_text(), table, key, value)
     p = tmp_path / "bad.toml"
     p.write_text(text)
-    for cmd in (["generate", p, "--out", tmp_path / "o", "--no-stl"], ["audit", p, "--json", tmp_path / "o" / "a.json"]):
+    for cmd in (
+        ["generate", p, "--out", tmp_path / "o", "--no-stl"],
+        ["audit", p, "--json", tmp_path / "o" / "a.json"],
+    ):
         code, out, err = run(cmd, capsys)
         assert code == 2
         one_line(err)
@@ -110,8 +124,10 @@ def test_z_rigid_million_on_d1_is_refused_not_reported_as_no_interference(tmp_pa
     assert "drive.z_rigid: must be in [8, 3000]" in one_line(err)
 
 
-@pytest.mark.parametrize("z_rigid,w0,field", [(2000, None, "drive.z_rigid"), (208, "1.1", "generator.w0_coef"),
-                                               (206, "1.1", None), (202, "0.05", None)])
+@pytest.mark.parametrize(
+    "z_rigid,w0,field",
+    [(2000, None, "drive.z_rigid"), (208, "1.1", "generator.w0_coef"), (206, "1.1", None), (202, "0.05", None)],
+)
 def test_teeth_that_never_meet_are_refused_in_one_line(z_rigid, w0, field, tmp_path, capsys):
     # D1 with textbook teeth (docs/models.md 2.1): flexspline tip r_a = 80 + 0.8 (1 + 3.1) = 83.28 mm, rigid tip
     # 0.4 z_rigid + 0.8 (3.2 - 1); the largest W0 over the coned face is at the open end, W0 * 160/142 (docs/models.md

@@ -7,10 +7,10 @@ import tracemalloc
 
 import numpy as np
 import pytest
-from hypothesis import HealthCheck, given, settings
-
 from conftest import ROOT, TEMPLATES
+from hypothesis import HealthCheck, given, settings
 from test_stability import designs
+
 from wgcad.cli import main
 from wgcad.design import load_design, parse_design, with_changes
 from wgcad.design.budget import DEFAULT_MAX_MEMORY_MB, check_budget, estimate_run, outline_vertices_per_tooth
@@ -44,8 +44,13 @@ def test_vertex_estimate_bounds_the_templates_outlines(name, tol_um):
 _seen = []
 
 
-@settings(derandomize=True, max_examples=int(__import__("os").environ.get("WGCAD_BUDGET_EXAMPLES", "60")), deadline=None, database=None,
-          suppress_health_check=[HealthCheck.too_slow, HealthCheck.data_too_large])
+@settings(
+    derandomize=True,
+    max_examples=int(__import__("os").environ.get("WGCAD_BUDGET_EXAMPLES", "60")),
+    deadline=None,
+    database=None,
+    suppress_health_check=[HealthCheck.too_slow, HealthCheck.data_too_large],
+)
 @given(designs())
 def _random_counts(data):
     try:
@@ -71,8 +76,11 @@ def test_vertex_estimate_bounds_random_designs():
 def test_refused_before_any_large_allocation():
     # 2998 + 3000 teeth of module 20 at a 0.001 um chord tolerance: ~5e7 vertices; judged from the design
     d = load_design(TEMPLATES / "d1_involute.toml")
-    big = with_changes(d, drive={"module": 20.0, "z_flex": 2998, "z_rigid": 3000, "face_width": 30.0},
-                       flexspline={"rim_thickness": 28.0})
+    big = with_changes(
+        d,
+        drive={"module": 20.0, "z_flex": 2998, "z_rigid": 3000, "face_width": 30.0},
+        flexspline={"rim_thickness": 28.0},
+    )
     tracemalloc.start()
     try:
         with pytest.raises(DesignError) as e:
@@ -89,7 +97,9 @@ def test_no_budget_means_no_refusal_and_the_estimate_grows_with_the_work():
     a = estimate_run(d, 1e-3, angles=720, sections=3)
     b = estimate_run(d, 1e-4, angles=720, sections=3)
     c = estimate_run(d, 1e-3, angles=7200, sections=3)
-    full = estimate_run(d, 1e-3, angles=720, sections=3, use_period=False, use_waves=False, use_mirror=False, bound=False)
+    full = estimate_run(
+        d, 1e-3, angles=720, sections=3, use_period=False, use_waves=False, use_mirror=False, bound=False
+    )
     assert a.memory_mb < b.memory_mb and a.memory_mb < c.memory_mb < full.memory_mb * 10
     assert a.memory_mb < full.memory_mb
     assert check_budget(full, None) is full
@@ -128,11 +138,16 @@ print(json.dumps({"code": code, "rss_mb": int(hwm) / 1024}))
 
 
 @pytest.mark.skipif(not __import__("os").path.exists("/proc/self/status"), reason="needs Linux /proc for the peak RSS")
-@pytest.mark.parametrize("argv,run", [
-    (["audit", "d1_involute", "--step-deg", "0.05", "--sections", "3", "--quiet"],
-     dict(angles=7200, sections=3, exports=False)),
-    (["generate", "d4_discrete", "--chord-tol-um", "0.1", "--quiet"], dict(exports=True)),
-])
+@pytest.mark.parametrize(
+    "argv,run",
+    [
+        (
+            ["audit", "d1_involute", "--step-deg", "0.05", "--sections", "3", "--quiet"],
+            dict(angles=7200, sections=3, exports=False),
+        ),
+        (["generate", "d4_discrete", "--chord-tol-um", "0.1", "--quiet"], dict(exports=True)),
+    ],
+)
 def test_memory_estimate_is_above_the_measured_peak_and_not_far(argv, run, tmp_path):
     """Peak RSS of a real run in a fresh interpreter against the estimate made from its design."""
     name = argv[1]

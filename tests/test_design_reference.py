@@ -3,6 +3,7 @@
 from dataclasses import fields
 
 from conftest import ROOT
+
 from wgcad.design import _TABLES
 from wgcad.design.reference import design_keys_markdown
 

@@ -12,8 +12,27 @@ MODELS = DOCS / "models.md"
 
 #: the numbering models.md keeps (the handbook's, so citations can be rewritten mechanically)
 REQUIRED_SECTIONS = {
-    "1", "2", "2.1", "2.2", "2.3", "3", "3.1", "3.2", "3.3", "3.4", "3.5", "3.6",
-    "4", "4.1", "5", "6", "6.1", "6.2", "7", "8", "9",
+    "1",
+    "2",
+    "2.1",
+    "2.2",
+    "2.3",
+    "3",
+    "3.1",
+    "3.2",
+    "3.3",
+    "3.4",
+    "3.5",
+    "3.6",
+    "4",
+    "4.1",
+    "5",
+    "6",
+    "6.1",
+    "6.2",
+    "7",
+    "8",
+    "9",
 }
 
 _NUM = r"\d+(?:\.\d+)*"
@@ -100,4 +119,4 @@ def test_licence_is_mit_as_pyproject_says():
     text = (ROOT / "LICENSE").read_text(encoding="utf-8")
     assert text.startswith("MIT License")
     assert "Copyright (c) 2026 the wgcad developers" in text
-    assert "THE SOFTWARE IS PROVIDED \"AS IS\", WITHOUT WARRANTY OF ANY KIND" in text
+    assert 'THE SOFTWARE IS PROVIDED "AS IS", WITHOUT WARRANTY OF ANY KIND' in text

@@ -9,9 +9,9 @@ import ezdxf
 import numpy as np
 import pytest
 
+from wgcad.atomic import atomic_batch
 from wgcad.errors import InputFileError, OutputError
 from wgcad.export import EXPORTERS
-from wgcad.atomic import atomic_batch
 from wgcad.export.dxf import DxfLayer, audit_dxf, build_dxf, clean_outline, read_dxf, write_dxf
 
 # DXF stores coordinates as decimal text; ezdxf writes Python's shortest
@@ -189,7 +189,11 @@ def test_librecad_reads_the_file(tmp_path):
     env = dict(os.environ, QT_QPA_PLATFORM="offscreen")
     subprocess.run(
         ["librecad", "dxf2pdf", "-a", "-m", str(path)],
-        cwd=tmp_path, env=env, check=True, capture_output=True, timeout=120,
+        cwd=tmp_path,
+        env=env,
+        check=True,
+        capture_output=True,
+        timeout=120,
     )
     pdf = tmp_path / "gear.pdf"
     assert pdf.exists() and pdf.stat().st_size > 1000

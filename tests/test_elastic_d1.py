@@ -7,12 +7,12 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from wgcad.laws import Law
+from wgcad.design import load_design, with_changes
+from wgcad.drive import build_drive
 from wgcad.elastic import LoadedLaw, build_model, solve_load
 from wgcad.elastic.state import POSITION_TOL
 from wgcad.elastic.sweep import torque_sweep
-from wgcad.design import load_design, with_changes
-from wgcad.drive import build_drive
+from wgcad.laws import Law
 
 ROOT = Path(__file__).resolve().parents[1]
 D1 = ROOT / "templates" / "d1_involute.toml"
@@ -116,8 +116,11 @@ def test_rim_on_balls_at_the_four_force_angles_is_the_four_force_law():
     # there and rests on the neighbours too, so within two approaches of the law
     from wgcad.elastic.cam import mounted
 
-    d = with_changes(load_design(D1), bearing={"internal_clearance_um": 0.0, "fit_clearance_um": 0.0, "balls": 36,
-                                               "ball_diameter_mm": 9.0}, load={"ball_phase_deg": 5.0})
+    d = with_changes(
+        load_design(D1),
+        bearing={"internal_clearance_um": 0.0, "fit_clearance_um": 0.0, "balls": 36, "ball_diameter_mm": 9.0},
+        load={"ball_phase_deg": 5.0},
+    )
     m = build_model(build_drive(d), 3)
     mt = mounted(m)
     psi = np.rad2deg(m.bearing.psi) % 360
@@ -171,8 +174,12 @@ def test_entry_gap_wind_up_closes_it_and_the_loaded_rim_opens_it(sweep):
     psi0, loads0 = _merge_loads(m.tables.angles, mounted(m).loads)
 
     def gaps(mod):
-        return np.array([[p.delta for p in entry_gaps(m.scene, [mod(law).shifted(ph) for ph in (0.0, np.pi) for law in st.laws])]
-                         for st in sweep["states"]])
+        return np.array(
+            [
+                [p.delta for p in entry_gaps(m.scene, [mod(law).shifted(ph) for ph in (0.0, np.pi) for law in st.laws])]
+                for st in sweep["states"]
+            ]
+        )
 
     full = gaps(lambda law: law)
     wind = gaps(lambda law: replace(law, psi=psi0, loads=loads0))
@@ -193,8 +200,13 @@ def test_cam_offset_breaks_the_waves_and_closes_the_gap_sooner(sweep, offset_swe
 
 
 def _cli(*args):
-    return subprocess.run([sys.executable, "-m", "wgcad", *args], capture_output=True, text=True, cwd=ROOT,
-                          env={"PYTHONPATH": str(ROOT), "PATH": "/usr/bin:/bin"})
+    return subprocess.run(
+        [sys.executable, "-m", "wgcad", *args],
+        capture_output=True,
+        text=True,
+        cwd=ROOT,
+        env={"PYTHONPATH": str(ROOT), "PATH": "/usr/bin:/bin"},
+    )
 
 
 def _design(tmp_path, extra_replace):
@@ -210,9 +222,11 @@ def _design(tmp_path, extra_replace):
 def test_bad_input_is_one_line_and_exit_2(tmp_path):
     r = _cli("audit", str(D1), "--torque-nm", "-5")
     assert r.returncode == 2 and r.stderr.count("\n") == 1 and "--torque-nm" in r.stderr
-    for old, new, field in (("internal_clearance_um = 26.0", "internal_clearance_um = -1.0", "bearing.internal_clearance_um"),
-                            ("youngs_modulus_gpa = 206.0", "youngs_modulus_gpa = -206.0", "material.youngs_modulus_gpa"),
-                            ("balls = 24 ", "balls = 24\nballs_typo = 3 ", "bearing.balls_typo")):
+    for old, new, field in (
+        ("internal_clearance_um = 26.0", "internal_clearance_um = -1.0", "bearing.internal_clearance_um"),
+        ("youngs_modulus_gpa = 206.0", "youngs_modulus_gpa = -206.0", "material.youngs_modulus_gpa"),
+        ("balls = 24 ", "balls = 24\nballs_typo = 3 ", "bearing.balls_typo"),
+    ):
         p = _design(tmp_path, [(old, new)])
         r = _cli("audit", str(p), "--torque-nm", "1000")
         assert r.returncode == 2, r.stderr
@@ -230,22 +244,38 @@ def test_bearing_that_cannot_carry_the_load(tmp_path):
 def test_teeth_that_never_meet(tmp_path):
     # flexspline tips cut down to 82.3 mm and W0 = 0.4 mm (0.45 mm at the open end): the tips stay 0.17 mm inside
     # the rigid tip circle (82.92 mm)
-    p = _design(tmp_path, [("fillet_coef = 0.25    # assumed (docs/models.md 2.1 default)", "fillet_coef = 0.25\ntip_radius = 82.3"),
-                           ("w0_coef = 0.97625", "w0_coef = 0.5")])
+    p = _design(
+        tmp_path,
+        [
+            ("fillet_coef = 0.25    # assumed (docs/models.md 2.1 default)", "fillet_coef = 0.25\ntip_radius = 82.3"),
+            ("w0_coef = 0.97625", "w0_coef = 0.5"),
+        ],
+    )
     r = _cli("audit", str(p), "--torque-nm", "500")
     assert r.returncode == 2 and "never" in r.stderr and r.stderr.count("\n") == 1
 
 
 def test_cli_writes_json_and_pngs(tmp_path):
     out = tmp_path / "load"
-    r = _cli("audit", str(D1), "--torque-nm", "0,500", "--json", str(tmp_path / "l.json"), "--plot", str(out), "--quiet")
+    r = _cli(
+        "audit", str(D1), "--torque-nm", "0,500", "--json", str(tmp_path / "l.json"), "--plot", str(out), "--quiet"
+    )
     assert r.returncode == 0, r.stderr
     import json
 
     doc = json.loads((tmp_path / "l.json").read_text())
     assert [lv["torque_nm"] for lv in doc["levels"]] == [0.0, 500.0]
-    for key in ("entry_gap_um", "crossing_gap_um", "entry_gap_at", "teeth_in_contact", "largest_tooth_force_n", "ball_load_n",
-                "wind_up_arcmin", "generator_torque_nm", "sections"):
+    for key in (
+        "entry_gap_um",
+        "crossing_gap_um",
+        "entry_gap_at",
+        "teeth_in_contact",
+        "largest_tooth_force_n",
+        "ball_load_n",
+        "wind_up_arcmin",
+        "generator_torque_nm",
+        "sections",
+    ):
         assert key in doc["levels"][1]
     assert (tmp_path / "load_entry_gap.png").stat().st_size > 10000
     assert (tmp_path / "load_forces.png").stat().st_size > 10000

@@ -23,18 +23,24 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from wgcad.elastic import build_model, solve_load
-from wgcad.elastic.state import POSITION_TOL
 from wgcad.design import load_design
 from wgcad.drive import build_drive
+from wgcad.elastic import build_model, solve_load
+from wgcad.elastic.state import POSITION_TOL
 
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "tests"))
 from elastic_plain import plain_solve  # noqa: E402
 
 _MODELS = {}
-CASES = [("d1_involute", 0.0, 0.0), ("d1_involute", 1000.0, 0.0), ("d1_involute", 3000.0, 0.0),
-         ("d1_involute", 1000.0, 40.0), ("d1_cycloidal", 1500.0, 0.0), ("d2", 800.0, 0.0)]
+CASES = [
+    ("d1_involute", 0.0, 0.0),
+    ("d1_involute", 1000.0, 0.0),
+    ("d1_involute", 3000.0, 0.0),
+    ("d1_involute", 1000.0, 40.0),
+    ("d1_cycloidal", 1500.0, 0.0),
+    ("d2", 800.0, 0.0),
+]
 
 
 def _model(name):
@@ -55,7 +61,10 @@ def test_fast_solver_matches_the_plain_one(name, torque_nm, offset_um):
     Fb = c["force"][c["kind"] == 0]
     assert np.abs(Fb - ref["ball_force"]).max() < 0.01 * ref["ball_force"].max()
     tooth = (c["kind"] == 1) & (c["force"] > 0)
-    got = {(int(s_), int(t), int(f)): F for s_, t, f, F in zip(c["section"][tooth], c["tooth"][tooth], c["flank"][tooth], c["force"][tooth])}
+    got = {
+        (int(s_), int(t), int(f)): F
+        for s_, t, f, F in zip(c["section"][tooth], c["tooth"][tooth], c["flank"][tooth], c["force"][tooth])
+    }
     scale = max(max(ref["tooth_force"].values(), default=0.0), 1.0)
     for key in set(got) | set(ref["tooth_force"]):
         assert abs(got.get(key, 0.0) - ref["tooth_force"].get(key, 0.0)) < 0.01 * scale, key

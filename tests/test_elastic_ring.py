@@ -6,8 +6,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from wgcad.laws import FourForce
 from wgcad.elastic.ring import Ring, ring_kernels, series_kernels
+from wgcad.laws import FourForce
 
 sys.path.insert(0, str(Path(__file__).parent))
 from elastic_fe_ring import fe_ring  # noqa: E402
@@ -88,7 +88,12 @@ def test_fourier_compliance_agrees_with_a_frame_element_ring():
     # 5e-4 leaves a factor 3.5 for the polygon and the finite axial stiffness
     ring = Ring(R_M, EI)
     n = 360
-    loads = [(0, 1000.0, 0.0, 0.0), (n // 2, 1000.0, 0.0, 0.0), (n // 8, 0.0, 500.0, 0.0), (n // 3, -300.0, 200.0, 5000.0)]
+    loads = [
+        (0, 1000.0, 0.0, 0.0),
+        (n // 2, 1000.0, 0.0, 0.0),
+        (n // 8, 0.0, 500.0, 0.0),
+        (n // 3, -300.0, 200.0, 5000.0),
+    ]
     errs = []
     for n_el in (180, 360):
         sc = n_el // n
@@ -98,8 +103,12 @@ def test_fourier_compliance_agrees_with_a_frame_element_ring():
         ang, w, v, th = fe_ring(R_M, EI, n_el, ld)
         psi = np.array([ang[k] for k, *_ in ld])
         f = ring.field(ang, psi, np.array([x[1:] for x in ld]))
-        errs.append(max(np.abs(w - f["w"]).max() / np.abs(f["w"]).max(),
-                        np.abs(v - f["v"]).max() / np.abs(f["v"]).max(),
-                        np.abs(th - f["theta"]).max() / np.abs(f["theta"]).max()))
+        errs.append(
+            max(
+                np.abs(w - f["w"]).max() / np.abs(f["w"]).max(),
+                np.abs(v - f["v"]).max() / np.abs(f["v"]).max(),
+                np.abs(th - f["theta"]).max() / np.abs(f["theta"]).max(),
+            )
+        )
     assert errs[1] < 5e-4
     assert 3.0 < errs[0] / errs[1] < 5.0  # second-order convergence: the two models agree in the limit

@@ -32,7 +32,7 @@ def _enumerate(M, q, A, f):
                 continue
             F = np.zeros(m)
             F[W] = sol[: len(W)]
-            a = sol[len(W):]
+            a = sol[len(W) :]
             g = q + M @ F - A @ a
             if F.min() >= -1e-10 and g.min() >= -1e-10 and np.abs(F * g).max() < 1e-9:
                 found.append((F, a))

@@ -5,10 +5,10 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from wgcad.elastic import build_model
-from wgcad.elastic.tables import Compliance
 from wgcad.design import load_design
 from wgcad.drive import build_drive
+from wgcad.elastic import build_model
+from wgcad.elastic.tables import Compliance
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -24,7 +24,7 @@ def test_influence_is_the_ring_block_and_symmetric(model):
     n = len(tab.angles)
     for i, j in rng.integers(0, n, size=(20, 2)):
         blk = model.ring.block(np.array(tab.angles[i] - tab.angles[j]))
-        assert np.array_equal(tab.influence[3 * i:3 * i + 3, 3 * j:3 * j + 3], blk)
+        assert np.array_equal(tab.influence[3 * i : 3 * i + 3, 3 * j : 3 * j + 3], blk)
     # Maxwell-Betti: the compliance solver reads a load's column as its row
     assert np.abs(tab.influence - tab.influence.T).max() < 1e-12 * np.abs(tab.influence).max()
 
@@ -50,7 +50,7 @@ def test_compliance_columns_are_the_dense_product(model):
     s = rng.random(m) * 1e-4
     B = np.zeros((m, tab.influence.shape[0]))
     for j in range(m):
-        B[j, 3 * idx[j]:3 * idx[j] + 3] = fb[j]
+        B[j, 3 * idx[j] : 3 * idx[j] + 3] = fb[j]
     ref = B @ tab.influence @ B.T + np.diag(s)
     C = Compliance(tab, idx, fb, s)
     scale = np.abs(ref).max()
@@ -73,4 +73,6 @@ def test_compliance_with_other_contact_compliances(model):
     ref = Compliance(tab, idx, fb, s2)
     assert np.allclose(C2.diag, ref.diag, rtol=1e-14, atol=0)
     assert np.allclose(C2.dense(), ref.dense(), rtol=1e-13, atol=1e-20)
-    assert np.allclose(C.dense(), Compliance(tab, idx, fb, s1).dense(), rtol=1e-13, atol=1e-20)  # the original unchanged
+    assert np.allclose(
+        C.dense(), Compliance(tab, idx, fb, s1).dense(), rtol=1e-13, atol=1e-20
+    )  # the original unchanged

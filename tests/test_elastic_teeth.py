@@ -6,9 +6,9 @@ import numpy as np
 import pytest
 
 from wgcad.clearance.engine import Scene, clearance_at_poses
-from wgcad.elastic.teeth import flank_contacts, pair_contacts
 from wgcad.design import load_design
 from wgcad.drive import build_drive
+from wgcad.elastic.teeth import flank_contacts, pair_contacts
 from wgcad.placement import tooth_pose
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -59,8 +59,10 @@ def test_contact_points_located_on_the_outline_as_geos_does(name):
             flex = shapely.polygons(transform(scene.flex_local, rot, shift))
             seg = shapely.get_coordinates(shapely.shortest_line(flex, scene.rigid_geoms[rigid])).reshape(-1, 2, 2)
             g = pair_contacts(scene, rot, shift, rigid)
-            for local, r, s, p in ((scene.flex_local, rot, shift, g.point),
-                                   (scene.rigid.local, scene.rigid_rot[rigid], scene.rigid_shift[rigid], seg[:, 1])):
+            for local, r, s, p in (
+                (scene.flex_local, rot, shift, g.point),
+                (scene.rigid.local, scene.rigid_rot[rigid], scene.rigid_shift[rigid], seg[:, 1]),
+            ):
                 c, sn = np.cos(r), np.sin(r)
                 d = p - s
                 q = np.stack([c * d[:, 0] + sn * d[:, 1], -sn * d[:, 0] + c * d[:, 1]], axis=-1)

@@ -14,8 +14,8 @@ from math import pi
 import numpy as np
 import pytest
 import shapely
-
 from conftest import TEMPLATES
+
 from wgcad.clearance.engine import AuditSettings, audit
 from wgcad.design import load_design, with_changes
 from wgcad.drive import build_drive
@@ -117,9 +117,16 @@ def _reference_min(design, angles, sections, coarse_tol):
     return min(dense.at(phi, z) for v, phi, z in vals if v <= lo + 4 * coarse_tol)
 
 
-CASES = [("d1_involute", False, 1.0), ("d1_involute", False, 3.0), ("d1_involute", False, 10.0),
-         ("d1_cycloidal", False, 1.0), ("d1_cycloidal", False, 3.0), ("d1_cycloidal", False, 10.0),
-         ("d1_involute", True, 1.0), ("d1_cycloidal", True, 1.0)]
+CASES = [
+    ("d1_involute", False, 1.0),
+    ("d1_involute", False, 3.0),
+    ("d1_involute", False, 10.0),
+    ("d1_cycloidal", False, 1.0),
+    ("d1_cycloidal", False, 3.0),
+    ("d1_cycloidal", False, 10.0),
+    ("d1_involute", True, 1.0),
+    ("d1_cycloidal", True, 1.0),
+]
 
 
 @pytest.mark.parametrize("name,coned,chord_um", CASES)
@@ -144,7 +151,9 @@ def test_figures_match_a_dense_reference_at_any_chord_tolerance(name, coned, cho
         p = res.raw["pinch_phi"]
         z_p = audit_json(res)["entry"]["pinch_section_z_mm"]
         h = np.deg2rad(0.02)
-        r = minimize_scalar(lambda x: dense.at(x, z_p), bounds=(p - h, p + h), method="bounded", options={"xatol": 1e-9})
+        r = minimize_scalar(
+            lambda x: dense.at(x, z_p), bounds=(p - h, p + h), method="bounded", options={"xatol": 1e-9}
+        )
         ref = min(r.fun, dense.at(p, z_p))
         assert audit_json(res)["entry"]["pinch_um"] * 1e-3 == pytest.approx(ref, abs=TOL_MM + 1e-7)  # + JSON rounding
 

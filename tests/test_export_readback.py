@@ -10,8 +10,8 @@ import numpy as np
 import pytest
 import shapely
 import trimesh
-
 from conftest import ROOT, TEMPLATES, edit_toml
+
 from wgcad.cli import main
 from wgcad.export.dxf import audit_dxf, read_dxf
 
@@ -64,7 +64,10 @@ def check_outputs(out):
 @pytest.mark.parametrize("name", ALL)
 def test_every_generated_file_of_every_template_reads_back(name, tmp_path):
     out = tmp_path / name
-    assert main(["generate", str(TEMPLATES / f"{name}.toml"), "--out", str(out), "--generator-angle", "37.5", "--quiet"]) == 0
+    assert (
+        main(["generate", str(TEMPLATES / f"{name}.toml"), "--out", str(out), "--generator-angle", "37.5", "--quiet"])
+        == 0
+    )
     assert check_outputs(out) == 4  # design DXF, two STLs, the deformed-state DXF
 
 
@@ -104,7 +107,9 @@ def test_random_designs_read_back(tmp_path):
         path.write_text(random_design(rng, base))
         out = tmp_path / f"r{k}"
         try:
-            code = main(["generate", str(path), "--out", str(out), "--generator-angle", "15", "--quiet", "--chord-tol-um", "5"])
+            code = main(
+                ["generate", str(path), "--out", str(out), "--generator-angle", "15", "--quiet", "--chord-tol-um", "5"]
+            )
         except DesignError:
             continue
         if code == 2:  # refused with a one-line error (e.g. pointed teeth): nothing to read back
@@ -139,8 +144,15 @@ def test_dxf_bytes_do_not_depend_on_the_hash_seed(tmp_path):
     procs = []
     for seed in range(20):
         env = {**os.environ, "PYTHONHASHSEED": str(seed), "PYTHONPATH": str(ROOT)}
-        procs.append(subprocess.Popen([sys.executable, "-c", SEED_SCRIPT, str(tmp_path / f"s{seed}.dxf")], env=env,
-                                      stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True))
+        procs.append(
+            subprocess.Popen(
+                [sys.executable, "-c", SEED_SCRIPT, str(tmp_path / f"s{seed}.dxf")],
+                env=env,
+                stdout=subprocess.PIPE,
+                stderr=subprocess.PIPE,
+                text=True,
+            )
+        )
         if len(procs) % 4 == 0:  # a few at a time: two cores
             for p in procs[-4:]:
                 p.wait()

@@ -41,6 +41,7 @@ def tm(mesh):
 
 # (a) solids ------------------------------------------------------------------
 
+
 def test_prism_solids_are_closed_with_the_prism_volume(d4):
     bw = d4.drive.design.drive.face_width
     assert not d4.drive.coned
@@ -76,12 +77,16 @@ def test_coned_loft_is_closed_and_passes_through_the_sections(d1):
 
 # (b) FCL against closed forms -------------------------------------------------
 
-@pytest.mark.parametrize("offset, z, expected", [
-    ((1.5, 0.25), (0.0, 1.0), 0.5),  # face to face
-    ((2.0, 2.5), (0.0, 1.0), np.hypot(1.0, 1.5)),  # edge to edge
-    ((0.0, 0.0), (1.75, 3.0), 0.75),  # stacked along z
-    ((1.3, -1.4), (1.2, 2.0), np.sqrt(0.3**2 + 0.4**2 + 0.2**2)),  # corner to corner
-])
+
+@pytest.mark.parametrize(
+    "offset, z, expected",
+    [
+        ((1.5, 0.25), (0.0, 1.0), 0.5),  # face to face
+        ((2.0, 2.5), (0.0, 1.0), np.hypot(1.0, 1.5)),  # edge to edge
+        ((0.0, 0.0), (1.75, 3.0), 0.75),  # stacked along z
+        ((1.3, -1.4), (1.2, 2.0), np.sqrt(0.3**2 + 0.4**2 + 0.2**2)),  # corner to corner
+    ],
+)
 def test_fcl_distance_of_boxes(offset, z, expected):
     d, ov = fcl3d.fcl_distance(box(0.0, 0.0), box(*offset, *z))
     assert not ov and d == pytest.approx(expected, abs=1e-9)
@@ -116,6 +121,7 @@ def test_loft_finds_a_minimum_between_sections():
 
 
 # (c) no coning: FCL is the 2D clearance ----------------------------------------
+
 
 def test_d4_fcl_equals_2d(d4):
     phi = np.deg2rad(np.arange(30.0, 61.0, 7.5))
@@ -154,6 +160,7 @@ def test_d4_penetration_is_an_overlap(d4):
 
 
 # (d) coning: FCL within the stated bound below the 2D minimum over the sections ----
+
 
 def test_d1_fcl_within_bound(d1):
     phis = np.deg2rad([-60.0, -40.0, 30.0, 45.0, 60.0])
@@ -195,6 +202,7 @@ def test_d1_loft_error_orders(d1):
 
 # (e) the audit's pairs -----------------------------------------------------------
 
+
 @pytest.mark.parametrize("name", ["d4_discrete", "d1_involute", "d1_involute_nominal"])
 def test_verify_worst_agrees(name):
     drive, result = run_audit(TEMPLATES / f"{name}.toml", RunSettings(step_deg=1.0))
@@ -210,7 +218,10 @@ def test_verify_worst_agrees(name):
     assert w["tooth_angle_deg"] == pytest.approx(audit_json(result)["worst"]["tooth_angle_deg"])
     # the loft's sections include the audit's; the 2D check is on polygons, the audit's figure on the
     # exact curves: they differ by at most the polygon-curve difference (2 x the chord tolerance)
-    assert w["clearance_2d_um"] <= audit_json(result)["worst"]["clearance_um"] + 2.0 * result.settings["chord_tol_um"] + 1e-2
+    assert (
+        w["clearance_2d_um"]
+        <= audit_json(result)["worst"]["clearance_um"] + 2.0 * result.settings["chord_tol_um"] + 1e-2
+    )
     if result.min_clearance < 0:
         assert w["fcl_overlap"]
     else:
@@ -218,18 +229,29 @@ def test_verify_worst_agrees(name):
     json.dumps(out)
 
 
-@pytest.mark.parametrize("name, errors", [
-    # D4 (prisms) is apart by 1.8 um: half a micrometre of rigid eccentricity keeps it apart
-    ("d4_discrete", (("rigid_eccentricity_um", "0.5"), ("rigid_eccentricity_phase_deg", "30.0"))),
-    # D1 (coned) interferes at the tips far from the major axis; errors of [S4]'s order move it by ~10 um
-    ("d1_involute", (("rigid_eccentricity_um", "15.0"), ("rigid_eccentricity_phase_deg", "40.0"),
-                     ("cam_offset_fixed_um", "10.0"), ("flex_runout_um", "20.0"))),
-])
+@pytest.mark.parametrize(
+    "name, errors",
+    [
+        # D4 (prisms) is apart by 1.8 um: half a micrometre of rigid eccentricity keeps it apart
+        ("d4_discrete", (("rigid_eccentricity_um", "0.5"), ("rigid_eccentricity_phase_deg", "30.0"))),
+        # D1 (coned) interferes at the tips far from the major axis; errors of [S4]'s order move it by ~10 um
+        (
+            "d1_involute",
+            (
+                ("rigid_eccentricity_um", "15.0"),
+                ("rigid_eccentricity_phase_deg", "40.0"),
+                ("cam_offset_fixed_um", "10.0"),
+                ("flex_runout_um", "20.0"),
+            ),
+        ),
+    ],
+)
 def test_verify_worst_places_the_imperfect_parts(name, errors, tmp_path):
     # the 3D check of an imperfect audit builds the tooth the audit names (its tooth at its generator
     # angle, with the errors) and the rigid teeth with theirs: its 2D figure at the audit's section is the
     # audit's own polygon figure, while the perfect drive's tooth at the same tooth angle is elsewhere
     from conftest import edit_toml
+
     from wgcad.placement.imperfect import Imperfections, flex_poses, rigid_poses
 
     text = (TEMPLATES / f"{name}.toml").read_text() + "\n[imperfections]\n"
@@ -247,7 +269,9 @@ def test_verify_worst_places_the_imperfect_parts(name, errors, tmp_path):
     rows = {r["rigid_tooth"]: r for r in pair["per_tooth"]}
     j = w.details["rigid_tooth"]
     # the reference: the two posed polygons from the drive's own poses (placement.imperfect, no scene), in shapely
-    rot, shift = flex_poses(drive, imp, w.generator_angle, teeth=np.array([w.tooth]), z=w.section_z if drive.coned else None)
+    rot, shift = flex_poses(
+        drive, imp, w.generator_angle, teeth=np.array([w.tooth]), z=w.section_z if drive.coned else None
+    )
     rr, rs = rigid_poses(drive, imp, teeth=np.array([j]))
     a = shapely.Polygon(transform(drive.flex.tooth_polygon(), rot, shift)[0])
     b = shapely.Polygon(transform(drive.rigid.tooth_polygon(), rr, rs)[0])
@@ -263,13 +287,15 @@ def test_verify_worst_places_the_imperfect_parts(name, errors, tmp_path):
             assert rows[j]["fcl_distance_um"] == pytest.approx(ref_um, abs=1e3 * fcl3d.FCL_TOL)
     # the solid itself: its slice at the audit's section is the tooth placed with its errors (in the frame of
     # the rigid gear's centre, where the imperfect scene holds the rigid teeth)
-    from wgcad.placement.imperfect import rigid_translation
     from wgcad.clearance.imperfect import ImperfectScene
+    from wgcad.placement.imperfect import rigid_translation
 
     isc = ImperfectScene.from_scene(Scene(drive), imp)
     z_w = w.section_z if drive.coned else 0.0
     zs = np.unique([0.0, z_w, float(drive.design.drive.face_width)])
-    V, _ = fcl3d.flex_tooth_solid(isc, 0.0, sections=zs, track=fcl3d.imperfect_track(drive, imp, w.generator_angle, w.tooth))
+    V, _ = fcl3d.flex_tooth_solid(
+        isc, 0.0, sections=zs, track=fcl3d.imperfect_track(drive, imp, w.generator_angle, w.tooth)
+    )
     slice_ = V[np.abs(V[:, 2] - z_w) < 1e-12, :2]
     ref = transform(drive.flex.tooth_polygon(), rot, shift)[0] - rigid_translation(imp)
     gap = np.hypot(*(ref[:, None, :] - slice_[None, :, :]).transpose(2, 0, 1)).min(axis=1)
@@ -280,7 +306,9 @@ def test_verify_worst_places_the_imperfect_parts(name, errors, tmp_path):
 
 
 def test_core_does_not_import_fcl():
-    code = ("import sys, wgcad.clearance.engine, wgcad.audit, wgcad.clearance;"
-            "bad = [m for m in ('fcl', 'manifold3d', 'trimesh') if m in sys.modules]; print(bad); sys.exit(bool(bad))")
+    code = (
+        "import sys, wgcad.clearance.engine, wgcad.audit, wgcad.clearance;"
+        "bad = [m for m in ('fcl', 'manifold3d', 'trimesh') if m in sys.modules]; print(bad); sys.exit(bool(bad))"
+    )
     r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
     assert r.returncode == 0, r.stdout + r.stderr

@@ -6,11 +6,11 @@ import sys
 
 import numpy as np
 import pytest
+from conftest import ROOT, TEMPLATES
 from PIL import Image
 
 import wgcad.export.figures as F
 import wgcad.export.imperfect_figures as IF
-from conftest import ROOT, TEMPLATES
 from wgcad.cli import main
 
 NAMES = sorted(p.stem for p in TEMPLATES.glob("*.toml"))
@@ -52,7 +52,9 @@ def pictures(tmp_path_factory):
             current["name"] = name
             t = str(TEMPLATES / f"{name}.toml")
             angles = ANGLES.get(name, "30")
-            assert main(["generate", t, "--no-stl", "--generator-angle", angles, "--out", str(out / name), "--quiet"]) == 0
+            assert (
+                main(["generate", t, "--no-stl", "--generator-angle", angles, "--out", str(out / name), "--quiet"]) == 0
+            )
             # a coarse audit: the pictures' curves come from the per-tooth profile, not from the audit's step
             assert main(["audit", t, "--step-deg", "6", "--plot", str(out / name / name), "--quiet"]) in (0, 1)
             if name == "d3_external":
@@ -84,13 +86,19 @@ def _display_points(line, n_sub: int = 40) -> np.ndarray:
 
 
 def _inside(pts: np.ndarray, bbox, shrink: float = 1.0) -> np.ndarray:
-    return ((pts[:, 0] > bbox.x0 + shrink) & (pts[:, 0] < bbox.x1 - shrink)
-            & (pts[:, 1] > bbox.y0 + shrink) & (pts[:, 1] < bbox.y1 - shrink))
+    return (
+        (pts[:, 0] > bbox.x0 + shrink)
+        & (pts[:, 0] < bbox.x1 - shrink)
+        & (pts[:, 1] > bbox.y0 + shrink)
+        & (pts[:, 1] < bbox.y1 - shrink)
+    )
 
 
 def test_module_imports_without_matplotlib():
-    code = ("import sys, wgcad.export.figures, wgcad.cli.kinematics; "
-            "bad = [m for m in sys.modules if m.split('.')[0] == 'matplotlib']; print(bad); assert not bad")
+    code = (
+        "import sys, wgcad.export.figures, wgcad.cli.kinematics; "
+        "bad = [m for m in sys.modules if m.split('.')[0] == 'matplotlib']; print(bad); assert not bad"
+    )
     r = subprocess.run([sys.executable, "-c", code], cwd=ROOT, capture_output=True, text=True)
     assert r.returncode == 0, r.stdout + r.stderr
 
@@ -298,9 +306,12 @@ def test_velocities_say_what_each_curve_is_and_hide_none(pictures):
             symbols.add(sym.split("=")[0].strip())
         lo, hi = ax.get_ylim()
         for i, a in enumerate(lines):
-            for b in lines[i + 1:]:
+            for b in lines[i + 1 :]:
                 if np.max(np.abs(np.asarray(a.get_ydata()) - np.asarray(b.get_ydata()))) < 0.01 * (hi - lo):
                     # coinciding curves: the later one dashed and thinner so the first shows around it
-                    assert b.get_linestyle() != a.get_linestyle() and b.get_linewidth() < a.get_linewidth(), (a.get_label(), b.get_label())
+                    assert b.get_linestyle() != a.get_linestyle() and b.get_linewidth() < a.get_linewidth(), (
+                        a.get_label(),
+                        b.get_label(),
+                    )
     for s in ("V_w", "V_v", "V_vK", "V_dw", "V_dv", "V_sl", "V_d", "dtheta/dt"):
         assert s in symbols, s

@@ -4,21 +4,32 @@ import math
 
 import numpy as np
 import pytest
-
 from conftest import TEMPLATES
+
 from wgcad.clearance.engine import AuditSettings, audit
 from wgcad.clearance.findings import FIGURES, Finding
 from wgcad.design import load_design
 from wgcad.drive import build_drive
-from wgcad.report.audit import audit_summary, entry_json, worst_json
-from wgcad.report.audit import audit_json
+from wgcad.report.audit import audit_json, audit_summary, entry_json, worst_json
 
 
 def test_report_layer_converts_units_of_a_hand_made_finding():
-    f = Finding("min_clearance", -0.0123456, "exact", tooth_angle=math.radians(5.0), section_z=30.0,
-                location="working flank", generator_angle=math.radians(39.5), tooth=25, polygon_value=-0.0125,
-                details={"mirror": (math.radians(-5.0), "non-working flank"), "sample_tooth_angle": math.radians(-5.0),
-                         "overlap_area": 1.5e-4})
+    f = Finding(
+        "min_clearance",
+        -0.0123456,
+        "exact",
+        tooth_angle=math.radians(5.0),
+        section_z=30.0,
+        location="working flank",
+        generator_angle=math.radians(39.5),
+        tooth=25,
+        polygon_value=-0.0125,
+        details={
+            "mirror": (math.radians(-5.0), "non-working flank"),
+            "sample_tooth_angle": math.radians(-5.0),
+            "overlap_area": 1.5e-4,
+        },
+    )
     w = worst_json(f)
     assert w["clearance_um"] == -12.3456 and w["polygon_clearance_um"] == -12.5
     assert w["tooth_angle_deg"] == 5.0 and w["mirror"] == {"tooth_angle_deg": -5.0, "location": "non-working flank"}
@@ -29,12 +40,25 @@ def test_report_layer_converts_units_of_a_hand_made_finding():
     e = entry_json(gap, crossing, pinch, "entry (+phi)")
     assert e["tooth_angle_deg"] is None and e["pinch_um"] is None and e["tip_to_tip_risk"] is False
     assert e["crossing_um"] is None and e["kind"] is None
-    gap = Finding("entry_gap", -1.5e-3, "exact", tooth_angle=math.radians(-47.5), section_z=30.0, location="tip",
-                  details={"edge": "working", "kind": "crossing"})
-    crossing = Finding("entry_crossing", -1.5e-3, "exact", tooth_angle=math.radians(-47.5), section_z=30.0,
-                       details={"edge": "working"})
+    gap = Finding(
+        "entry_gap",
+        -1.5e-3,
+        "exact",
+        tooth_angle=math.radians(-47.5),
+        section_z=30.0,
+        location="tip",
+        details={"edge": "working", "kind": "crossing"},
+    )
+    crossing = Finding(
+        "entry_crossing", -1.5e-3, "exact", tooth_angle=math.radians(-47.5), section_z=30.0, details={"edge": "working"}
+    )
     e = entry_json(gap, crossing, pinch, "entry (-phi)")
-    assert e["tooth_angle_deg"] == -47.5 and e["crossing_um"] == -1.5 and e["edge"] == "working" and e["kind"] == "crossing"
+    assert (
+        e["tooth_angle_deg"] == -47.5
+        and e["crossing_um"] == -1.5
+        and e["edge"] == "working"
+        and e["kind"] == "crossing"
+    )
 
 
 def test_unknown_figure_or_method_is_refused():

@@ -38,8 +38,9 @@ def _random_ecc(**zero):
 
 def test_zero_errors_give_zero():
     phi = np.linspace(-20.0, 20.0, 1001)
-    res = flank_errors_over_rotation(phi, 200, 202, Eccentricities(), ALPHA, ALPHA_W,
-                                     flex_start=0.3, rigid_start=-1.1, zone=math.pi)
+    res = flank_errors_over_rotation(
+        phi, 200, 202, Eccentricities(), ALPHA, ALPHA_W, flex_start=0.3, rigid_start=-1.1, zone=math.pi
+    )
     for e in ENGAGEMENTS:
         assert res[e].dR.shape == phi.shape
         assert np.all(res[e].dR == 0.0) and np.all(res[e].dT == 0.0)
@@ -50,8 +51,13 @@ def test_double_flank_radial_error_independent_of_kinematic_eccentricities():
     geo = dict(flex_geometric=0.02, rigid_geometric=0.035)
     base = flank_errors_over_rotation(phi, 200, 202, Eccentricities(**geo), ALPHA, ALPHA_W)["double"]
     for _ in range(5):
-        ecc = Eccentricities(**geo, flex_kinematic=RNG.uniform(0, 0.08), rigid_kinematic=RNG.uniform(0, 0.08),
-                             flex_phase=RNG.uniform(-4, 4), rigid_phase=RNG.uniform(-4, 4))
+        ecc = Eccentricities(
+            **geo,
+            flex_kinematic=RNG.uniform(0, 0.08),
+            rigid_kinematic=RNG.uniform(0, 0.08),
+            flex_phase=RNG.uniform(-4, 4),
+            rigid_phase=RNG.uniform(-4, 4),
+        )
         res = flank_errors_over_rotation(phi, 200, 202, ecc, ALPHA, ALPHA_W)
         np.testing.assert_array_equal(res["double"].dR, base.dR)
         # ... while the tangential error and the single-flank radial error do see them
@@ -87,8 +93,9 @@ def test_each_term_at_its_order_in_the_spectrum(z_g, z_b):
         "rigid_kinematic": ({"double": (0.0, e / cw), "single_left": (e / sw, e / cw)}, bin_rigid),
     }
     for name, (amps, k) in cases.items():
-        res = flank_errors_over_rotation(phi, z_g, z_b, Eccentricities(**{name: e}), ALPHA, ALPHA_W,
-                                         flex_start=0.7, rigid_start=-0.4)
+        res = flank_errors_over_rotation(
+            phi, z_g, z_b, Eccentricities(**{name: e}), ALPHA, ALPHA_W, flex_start=0.7, rigid_start=-0.4
+        )
         for eng, (a_r, a_t) in amps.items():
             for comp, amp in (("dR", a_r), ("dT", a_t)):
                 spec = _spectrum(getattr(res[eng], comp))
@@ -145,16 +152,24 @@ def test_double_flank_against_eccentric_gear_centres(zone):
     phi = np.linspace(0.0, 2 * np.pi * 100, 4001)
     diffs = []
     for scale in (1.0, 0.5):
-        ecc = Eccentricities(flex_geometric=0.075 * scale, rigid_geometric=0.05 * scale,
-                             flex_kinematic=0.04 * scale, rigid_kinematic=0.06 * scale,
-                             flex_phase=1.1, rigid_phase=-2.3)
+        ecc = Eccentricities(
+            flex_geometric=0.075 * scale,
+            rigid_geometric=0.05 * scale,
+            flex_kinematic=0.04 * scale,
+            rigid_kinematic=0.06 * scale,
+            flex_phase=1.1,
+            rigid_phase=-2.3,
+        )
         dR, dT, n_left = _geometric_double_flank(phi, z_g, z_b, m, ecc, zone)
         ty, tb = gear_angles(phi, z_g, z_b)
         model = flank_errors(ty, tb, ecc, ALPHA, ALPHA_W, "double", zone)
         # the model is the first-order term: the exact ray-circle crossing differs by
         # at most e^2 / (2 r) per gear, scaled by sin(alpha)/sin(alpha_w)
-        bound = math.sin(ALPHA) / math.sin(ALPHA_W) * (
-            ecc.flex_geometric**2 / (2 * m * z_g / 2) + ecc.rigid_geometric**2 / (2 * m * z_b / 2))
+        bound = (
+            math.sin(ALPHA)
+            / math.sin(ALPHA_W)
+            * (ecc.flex_geometric**2 / (2 * m * z_g / 2) + ecc.rigid_geometric**2 / (2 * m * z_b / 2))
+        )
         err = np.max(np.abs(model.dR - dR))
         assert err <= 1.001 * bound
         # tangential displacements of a translated circle are linear: rounding only. The two
@@ -188,12 +203,18 @@ def test_single_flank_matches_the_printed_form():
     ty = RNG.uniform(-7, 7, 300)
     tb = RNG.uniform(-7, 7, 300)
     a, aw = ALPHA, ALPHA_W
-    dR = (ecc.flex_geometric * np.sin(ty + a) + ecc.flex_kinematic * np.sin(ty + ecc.flex_phase)
-          + ecc.rigid_geometric * np.sin(tb + a) + ecc.rigid_kinematic * np.sin(tb + ecc.rigid_phase)) / math.sin(aw)
-    dT = (math.cos(a) * (ecc.flex_geometric * np.sin(ty) + ecc.rigid_geometric * np.sin(tb))
-          + ecc.flex_kinematic * np.sin(ty + ecc.flex_phase)
-          + math.sin(a) * (ecc.flex_geometric * np.cos(ty) + ecc.rigid_geometric * np.cos(tb))
-          + ecc.rigid_kinematic * np.sin(tb + ecc.rigid_phase)) / math.cos(aw)
+    dR = (
+        ecc.flex_geometric * np.sin(ty + a)
+        + ecc.flex_kinematic * np.sin(ty + ecc.flex_phase)
+        + ecc.rigid_geometric * np.sin(tb + a)
+        + ecc.rigid_kinematic * np.sin(tb + ecc.rigid_phase)
+    ) / math.sin(aw)
+    dT = (
+        math.cos(a) * (ecc.flex_geometric * np.sin(ty) + ecc.rigid_geometric * np.sin(tb))
+        + ecc.flex_kinematic * np.sin(ty + ecc.flex_phase)
+        + math.sin(a) * (ecc.flex_geometric * np.cos(ty) + ecc.rigid_geometric * np.cos(tb))
+        + ecc.rigid_kinematic * np.sin(tb + ecc.rigid_phase)
+    ) / math.cos(aw)
     res = flank_errors(ty, tb, ecc, a, aw, "single_left")
     np.testing.assert_allclose(res.dR, dR, rtol=0, atol=1e-15)
     np.testing.assert_allclose(res.dT, dT, rtol=0, atol=1e-15)
@@ -218,13 +239,16 @@ def test_results_are_read_only_and_broadcast():
         res.dR[0, 0] = 1.0
 
 
-@pytest.mark.parametrize("kwargs, field", [
-    (dict(ecc=dict(flex_geometric=-0.01)), "eccentricity.flex_geometric"),
-    (dict(ecc=dict(rigid_kinematic=float("nan"))), "eccentricity.rigid_kinematic"),
-    (dict(alpha=0.0), "tooth.pressure_angle_deg"),
-    (dict(alpha_w=math.radians(95)), "working_pressure_angle_deg"),
-    (dict(engagement="triple"), "engagement"),
-])
+@pytest.mark.parametrize(
+    "kwargs, field",
+    [
+        (dict(ecc=dict(flex_geometric=-0.01)), "eccentricity.flex_geometric"),
+        (dict(ecc=dict(rigid_kinematic=float("nan"))), "eccentricity.rigid_kinematic"),
+        (dict(alpha=0.0), "tooth.pressure_angle_deg"),
+        (dict(alpha_w=math.radians(95)), "working_pressure_angle_deg"),
+        (dict(engagement="triple"), "engagement"),
+    ],
+)
 def test_bad_input_names_the_field(kwargs, field):
     args = dict(alpha=ALPHA, alpha_w=ALPHA_W, engagement="double")
     ecc_kw = kwargs.pop("ecc", {})
@@ -238,8 +262,16 @@ def test_bad_input_names_the_field(kwargs, field):
 
 def test_csv_rows_round_trip(tmp_path):
     deg = np.linspace(0, 360, 37)
-    header, rows = flank_error_table(deg, z_flex=200, z_rigid=202, pressure_angle_deg=20, working_pressure_angle_deg=28,
-                                     flex_geometric_um=30, rigid_kinematic_um=20, rigid_phase_deg=45)
+    header, rows = flank_error_table(
+        deg,
+        z_flex=200,
+        z_rigid=202,
+        pressure_angle_deg=20,
+        working_pressure_angle_deg=28,
+        flex_geometric_um=30,
+        rigid_kinematic_um=20,
+        rigid_phase_deg=45,
+    )
     assert header[0] == "generator_angle_deg" and all(h.endswith("_um") for h in header[1:])
     assert len(header) == 1 + 2 * len(ENGAGEMENTS) and len(rows) == len(deg)
     path = tmp_path / "flank.csv"
@@ -250,9 +282,14 @@ def test_csv_rows_round_trip(tmp_path):
     got = np.array(back[1:], dtype=float)
     np.testing.assert_allclose(got, np.array(rows), rtol=1e-8, atol=1e-9)
     # the micrometre table agrees with the mm model
-    ref = flank_errors_over_rotation(np.radians(deg), 200, 202,
-                                     Eccentricities(flex_geometric=0.03, rigid_kinematic=0.02, rigid_phase=math.pi / 4),
-                                     ALPHA, ALPHA_W)
+    ref = flank_errors_over_rotation(
+        np.radians(deg),
+        200,
+        202,
+        Eccentricities(flex_geometric=0.03, rigid_kinematic=0.02, rigid_phase=math.pi / 4),
+        ALPHA,
+        ALPHA_W,
+    )
     np.testing.assert_allclose(got[:, header.index("double_dT_um")], 1e3 * ref["double"].dT, rtol=1e-8, atol=1e-9)
     assert not [p for p in tmp_path.iterdir() if p.name != "flank.csv"]  # no temporary left behind
 
@@ -272,15 +309,29 @@ def test_drive_errors_in_s2_terms_are_the_drive_poses_errors(zone):
     from pathlib import Path
 
     from wgcad.accuracy.flank_errors import drive_displacements
-    from wgcad.placement.imperfect import Imperfections, flex_poses, rigid_poses
     from wgcad.design import load_design
     from wgcad.drive import build_drive
+    from wgcad.placement.imperfect import Imperfections, flex_poses, rigid_poses
 
     drive = build_drive(load_design(Path(__file__).resolve().parents[1] / "templates" / "d2.toml"))
-    imp = Imperfections(flex_runout=0.075, flex_runout_phase=1.1, rigid_runout=0.075, rigid_runout_phase=-0.7,
-                        flex_ecc=0.01, flex_ecc_phase=0.3, rigid_ecc=0.012, rigid_ecc_phase=2.5, cam_cam=0.08,
-                        cam_cam_phase=1.57, cam_fixed=0.03, cam_fixed_phase=0.4, cam_flex=0.02, cam_flex_phase=2.0,
-                        rigid_install=0.6, flex_install=-0.2)
+    imp = Imperfections(
+        flex_runout=0.075,
+        flex_runout_phase=1.1,
+        rigid_runout=0.075,
+        rigid_runout_phase=-0.7,
+        flex_ecc=0.01,
+        flex_ecc_phase=0.3,
+        rigid_ecc=0.012,
+        rigid_ecc_phase=2.5,
+        cam_cam=0.08,
+        cam_cam_phase=1.57,
+        cam_fixed=0.03,
+        cam_fixed_phase=0.4,
+        cam_flex=0.02,
+        cam_flex_phase=2.0,
+        rigid_install=0.6,
+        flex_install=-0.2,
+    )
     d = drive.design.drive
     z_g, z_b = d.z_flex, d.z_rigid
     sigma = 1 if d.rotation == "ccw" else -1
@@ -299,8 +350,15 @@ def test_drive_errors_in_s2_terms_are_the_drive_poses_errors(zone):
         moved = []
         for im in (imp, Imperfections()):
             rot, shift = flex_poses(drive, im, phi_h, teeth=np.array([k]))
-            moved.append(np.array([math.cos(rot[0]) * p[0] - math.sin(rot[0]) * p[1],
-                                   math.sin(rot[0]) * p[0] + math.cos(rot[0]) * p[1]]) + shift[0])
+            moved.append(
+                np.array(
+                    [
+                        math.cos(rot[0]) * p[0] - math.sin(rot[0]) * p[1],
+                        math.sin(rot[0]) * p[0] + math.cos(rot[0]) * p[1],
+                    ]
+                )
+                + shift[0]
+            )
         df = moved[0] - moved[1]
         # the two rigid teeth flanking the zone: their mean motion at the pitch radius
         j = int(np.floor(Z / (2 * math.pi / z_b) - 0.5)) % z_b
@@ -313,5 +371,9 @@ def test_drive_errors_in_s2_terms_are_the_drive_poses_errors(zone):
         rel = df - db
         dr, dt, kin = drive_displacements(drive, imp, phi_h, zone)
         assert abs(float(rel @ er) - float(dr)) < tol, (n, float(rel @ er), float(dr))
-        assert abs(float(rel @ et) - float(dt + kin / math.cos(alpha))) < tol, (n, float(rel @ et), float(dt + kin / math.cos(alpha)))
+        assert abs(float(rel @ et) - float(dt + kin / math.cos(alpha))) < tol, (
+            n,
+            float(rel @ et),
+            float(dt + kin / math.cos(alpha)),
+        )
         assert np.hypot(*rel) > 0.05  # the errors do move the teeth by tens of micrometres here

@@ -12,20 +12,19 @@ thousands for a soak.
 
 import math
 import os
+import tomllib
 from dataclasses import fields
 from pathlib import Path
 
 import pytest
+from conftest import TEMPLATES
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from conftest import TEMPLATES
 from wgcad.cli import main
 from wgcad.design import _TABLES, load_design
 from wgcad.drive import build_drive
 from wgcad.errors import DesignError, InputFileError, WgcadError
-
-import tomllib
 
 N_EXAMPLES = int(os.environ.get("WGCAD_FUZZ_EXAMPLES", "120"))
 NAMES = ["d1_involute", "d1_cycloidal", "d2", "d3_external", "d4_discrete"]
@@ -77,15 +76,19 @@ def test_the_writer_round_trips_the_templates():
 # ----------------------------------------------------------------------------- mutations
 _numbers = st.one_of(
     st.sampled_from([0, -1, 1, 2, 7, 8, 9, 3000, 3001, 10**5, 10**6, 10**9, 10**12, 10**39, -(10**39), 2**63 - 1]),
-    st.sampled_from([0.0, -0.0, 1e-300, -1e-9, 1e-6, 0.5, 1e5, 1e6, 1e9, 1e12, 1e39, 1e308, -1e308,
-                     math.inf, -math.inf, math.nan]),
+    st.sampled_from(
+        [0.0, -0.0, 1e-300, -1e-9, 1e-6, 0.5, 1e5, 1e6, 1e9, 1e12, 1e39, 1e308, -1e308, math.inf, -math.inf, math.nan]
+    ),
     st.floats(allow_nan=True, allow_infinity=True),
     st.integers(-(10**40), 10**40),
 )
 _others = st.one_of(
-    st.text(max_size=30), st.booleans(), st.lists(st.integers(), max_size=3),
+    st.text(max_size=30),
+    st.booleans(),
+    st.lists(st.integers(), max_size=3),
     st.integers(1, 60).map(lambda n: [1] if n == 1 else [[1]] * 2),
-    st.just({"a": 1}), st.just(["x", 1.5]),
+    st.just({"a": 1}),
+    st.just(["x", 1.5]),
 )
 
 
@@ -94,15 +97,33 @@ def mutants(draw):
     name = draw(st.sampled_from(NAMES))
     data = {k: dict(v) if isinstance(v, dict) else v for k, v in TEMPLATE_DATA[name].items()}
     for _ in range(draw(st.integers(1, 3))):
-        kind = draw(st.sampled_from(["scale", "number", "other", "drop_key", "add_key", "drop_table",
-                                     "add_table", "table_value", "schema_key"]))
+        kind = draw(
+            st.sampled_from(
+                [
+                    "scale",
+                    "number",
+                    "other",
+                    "drop_key",
+                    "add_key",
+                    "drop_table",
+                    "add_table",
+                    "table_value",
+                    "schema_key",
+                ]
+            )
+        )
         tables = [t for t in data if isinstance(data[t], dict)]
         if not tables:
             break
         t = draw(st.sampled_from(tables))
         keys = list(data[t])
         k = draw(st.sampled_from(keys)) if keys else None
-        if kind == "scale" and k is not None and isinstance(data[t][k], (int, float)) and not isinstance(data[t][k], bool):
+        if (
+            kind == "scale"
+            and k is not None
+            and isinstance(data[t][k], (int, float))
+            and not isinstance(data[t][k], bool)
+        ):
             f = draw(st.sampled_from([1e3, 1e6, 1e-3, -1.0, 10.0, 0.1, 1.5]))
             v = data[t][k] * f
             data[t][k] = int(v) if isinstance(data[t][k], int) and abs(v) < 1e300 else v
@@ -166,9 +187,21 @@ def _one(tmp_root: Path, case, run_cli: bool):
     STATS["cli"] += 1
     out = tmp_root / f"out{idx}"
     common = ["--max-memory-mb", str(BUDGET_MB), "--chord-tol-um", str(CHORD_TOL_UM)]
-    for argv in (["generate", str(path), "--out", str(out / "g"), "--no-stl", "--quiet", *common],
-                 ["audit", str(path), "--step-deg", "10", "--sections", "2", "--quiet",
-                  "--json", str(out / "a" / "audit.json"), *common]):
+    for argv in (
+        ["generate", str(path), "--out", str(out / "g"), "--no-stl", "--quiet", *common],
+        [
+            "audit",
+            str(path),
+            "--step-deg",
+            "10",
+            "--sections",
+            "2",
+            "--quiet",
+            "--json",
+            str(out / "a" / "audit.json"),
+            *common,
+        ],
+    ):
         code = main(argv)  # anything but a WgcadError escapes here and fails the test
         assert code in (0, 1, 2), (argv, code)
         sub = out / ("g" if argv[0] == "generate" else "a")
@@ -185,8 +218,13 @@ def test_mutated_templates_build_or_refuse_in_one_line(tmp_path, capsys):
         STATS[key] = 0
     counter = {"n": 0}
 
-    @settings(derandomize=True, max_examples=N_EXAMPLES, deadline=None, database=None,
-              suppress_health_check=[HealthCheck.too_slow, HealthCheck.data_too_large, HealthCheck.filter_too_much])
+    @settings(
+        derandomize=True,
+        max_examples=N_EXAMPLES,
+        deadline=None,
+        database=None,
+        suppress_health_check=[HealthCheck.too_slow, HealthCheck.data_too_large, HealthCheck.filter_too_much],
+    )
     @given(mutants())
     def sweep(case):
         counter["n"] += 1
@@ -204,11 +242,20 @@ def test_mutated_templates_build_or_refuse_in_one_line(tmp_path, capsys):
 
 
 # ----------------------------------------------------------------------------- the cases issue 13 listed, pinned
-@pytest.mark.parametrize("table,key,value", [
-    ("drive", "z_flex", 10**39), ("drive", "z_rigid", 10**39), ("drive", "module", 1e39), ("drive", "module", 1e12),
-    ("drive", "z_flex", 10**5), ("drive", "z_rigid", 10**9), ("drive", "module", 1e9), ("drive", "module", 1e6),
-    ("drive", "z_rigid", 10**6),
-])
+@pytest.mark.parametrize(
+    "table,key,value",
+    [
+        ("drive", "z_flex", 10**39),
+        ("drive", "z_rigid", 10**39),
+        ("drive", "module", 1e39),
+        ("drive", "module", 1e12),
+        ("drive", "z_flex", 10**5),
+        ("drive", "z_rigid", 10**9),
+        ("drive", "module", 1e9),
+        ("drive", "module", 1e6),
+        ("drive", "z_rigid", 10**6),
+    ],
+)
 def test_issue_13_cases_are_one_line_refusals(table, key, value, tmp_path, capsys):
     data = {k: dict(v) for k, v in TEMPLATE_DATA["d1_involute"].items()}
     data[table][key] = value

@@ -5,8 +5,8 @@ import math
 import numpy as np
 import pytest
 import shapely
-
 from conftest import TEMPLATES
+
 from wgcad.design import load_design
 from wgcad.drive import build_drive
 from wgcad.export.gear_data import data_lines, gear_data, inv, inv_inverse
@@ -49,8 +49,11 @@ def test_span_closed_form_matches_a_caliper_on_the_outline(drive):
         assert proj.max() - proj.min() == pytest.approx(span["W_mm"], abs=MEAS_TOL)
         # the textbook form: m cos a ((k - 0.5) pi + z inv a) + 2 x m sin a - thinning cos a
         sp = g.spec
-        book = sp.module * math.cos(sp.alpha) * ((k - 0.5) * math.pi + z * inv(sp.alpha)) \
-            + 2 * sp.shift * sp.module * math.sin(sp.alpha) - sp.thinning * math.cos(sp.alpha)
+        book = (
+            sp.module * math.cos(sp.alpha) * ((k - 0.5) * math.pi + z * inv(sp.alpha))
+            + 2 * sp.shift * sp.module * math.sin(sp.alpha)
+            - sp.thinning * math.cos(sp.alpha)
+        )
         assert span["W_mm"] == pytest.approx(book, abs=1e-9)
 
 
@@ -78,6 +81,14 @@ def test_pin_dimension_pins_touch_both_flanks(drive):
 def test_data_lines_name_every_figure(drive):
     lines = data_lines("flexspline", gear_data(drive.flex, 1e-3))
     text = "\n".join(lines)
-    for word in ("module m", "teeth z", "profile shift", "pressure angle", "tip diameter", "root diameter",
-                 "pitch diameter", "outline tolerance = 1 um"):
+    for word in (
+        "module m",
+        "teeth z",
+        "profile shift",
+        "pressure angle",
+        "tip diameter",
+        "root diameter",
+        "pitch diameter",
+        "outline tolerance = 1 um",
+    ):
         assert word in text

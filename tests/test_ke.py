@@ -4,14 +4,14 @@ import math
 
 import numpy as np
 import pytest
-
 from conftest import TEMPLATES, edit_toml
+
 from wgcad.accuracy import ke as K
 from wgcad.accuracy import ke_table
-from wgcad.placement.imperfect import Imperfections, flex_poses, rigid_poses, shortcuts
 from wgcad.cli import main
 from wgcad.design import load_design
 from wgcad.drive import build_drive
+from wgcad.placement.imperfect import Imperfections, flex_poses, rigid_poses, shortcuts
 
 AS = 180.0 / math.pi * 3600.0
 
@@ -50,15 +50,19 @@ def test_perfect_parts_mesh_periodic_and_small(d2, table0):
     assert 0.0 < res.ke_pp * AS < 2.0
 
 
-@pytest.mark.parametrize("imp", [
-    Imperfections(),
-    Imperfections(rigid_runout=2e-3, rigid_runout_phase=0.4),
-    Imperfections(flex_runout=2e-3, flex_runout_phase=1.1),
-    Imperfections(rigid_ecc=1e-3, rigid_ecc_phase=0.5),
-    Imperfections(flex_ecc=1e-3, flex_ecc_phase=2.0),
-    Imperfections(cam_fixed=1e-3, cam_fixed_phase=0.7, cam_flex=1e-3),
-    Imperfections(cam_cam=3e-3, cam_cam_phase=0.4, rigid_runout=1e-3, flex_runout=1e-3),
-], ids=["perfect", "rigid_runout", "flex_runout", "rigid_ecc", "flex_ecc", "cam_fixed_flex", "cam_cam_mix"])
+@pytest.mark.parametrize(
+    "imp",
+    [
+        Imperfections(),
+        Imperfections(rigid_runout=2e-3, rigid_runout_phase=0.4),
+        Imperfections(flex_runout=2e-3, flex_runout_phase=1.1),
+        Imperfections(rigid_ecc=1e-3, rigid_ecc_phase=0.5),
+        Imperfections(flex_ecc=1e-3, flex_ecc_phase=2.0),
+        Imperfections(cam_fixed=1e-3, cam_fixed_phase=0.7, cam_flex=1e-3),
+        Imperfections(cam_cam=3e-3, cam_cam_phase=0.4, rigid_runout=1e-3, flex_runout=1e-3),
+    ],
+    ids=["perfect", "rigid_runout", "flex_runout", "rigid_ecc", "flex_ecc", "cam_fixed_flex", "cam_cam_mix"],
+)
 def test_table_and_linear_errors_match_the_direct_computation(d2, table0, imp):
     # The fast KE (contacts tabulated once on the lattice, errors added through each contact's
     # sensitivity) against exact poses of every tooth and a fresh contact search. Errors of 1-3 um:
@@ -79,7 +83,9 @@ def test_one_eccentricity_gives_the_hand_estimate(d2, table0):
     # therefore of the order of e / (r cos alpha) = 2.7'' for e = 1 um, at order |u_hg| = 100
     # (once per generator turn) or twice that (the first zone to touch rectifies it).
     e = 1e-3
-    res = K.kinematic_error(d2, Imperfections(rigid_ecc=e), table=K.contact_table(d2, Imperfections(rigid_ecc=e), 8, sections=[None]))
+    res = K.kinematic_error(
+        d2, Imperfections(rigid_ecc=e), table=K.contact_table(d2, Imperfections(rigid_ecc=e), 8, sections=[None])
+    )
     hand = e / (d2.rigid.r * math.cos(math.radians(20.0)))
     intr = K.kinematic_error(d2, Imperfections(), table=table0, samples=8 * 202).ke_pp
     assert 0.5 * hand < res.ke_pp - intr < 2.5 * hand
@@ -109,7 +115,12 @@ def test_install_angle_optimiser_against_a_brute_force_scan(d2):
 
 
 def test_shortcuts_that_hold():
-    assert shortcuts(Imperfections()) == {**shortcuts(Imperfections()), "mesh_period": True, "identical_waves": True, "mirror_symmetry": True}
+    assert shortcuts(Imperfections()) == {
+        **shortcuts(Imperfections()),
+        "mesh_period": True,
+        "identical_waves": True,
+        "mirror_symmetry": True,
+    }
     s = shortcuts(Imperfections(cam_cam=0.01))
     assert s["mesh_period"] and not s["identical_waves"] and s["mirror_symmetry"]
     s = shortcuts(Imperfections(cam_cam=0.01, cam_cam_phase=0.5))
@@ -130,12 +141,19 @@ def test_poses_of_an_imperfect_drive(d2):
     np.testing.assert_allclose(f1[1] - f0[1], np.tile([0.03, 0.0], (200, 1)), atol=1e-13)
 
 
-@pytest.mark.parametrize("key,value,msg", [
-    ("rigid_runout_um", "-5.0", "imperfections.rigid_runout_um: must be in [0, m/4"),
-    ("flex_runout_phase_deg", "400.0", "imperfections.flex_runout_phase_deg: must be in [-360, 360]"),
-    ("cam_offset_cam_um", "900.0", "imperfections.cam_offset_cam_um: must be in [0, m/4 (in um) = 200] um, got 900"),
-    ("runout_um", "5.0", "imperfections.runout_um: unknown key"),
-])
+@pytest.mark.parametrize(
+    "key,value,msg",
+    [
+        ("rigid_runout_um", "-5.0", "imperfections.rigid_runout_um: must be in [0, m/4"),
+        ("flex_runout_phase_deg", "400.0", "imperfections.flex_runout_phase_deg: must be in [-360, 360]"),
+        (
+            "cam_offset_cam_um",
+            "900.0",
+            "imperfections.cam_offset_cam_um: must be in [0, m/4 (in um) = 200] um, got 900",
+        ),
+        ("runout_um", "5.0", "imperfections.runout_um: unknown key"),
+    ],
+)
 def test_bad_imperfections_exit_2(tmp_path, capsys, key, value, msg):
     text = edit_toml((TEMPLATES / "d2_imperfect.toml").read_text(), "imperfections", key, value)
     (tmp_path / "bad.toml").write_text(text)
@@ -168,8 +186,11 @@ def _zone0(tab):
     return tab
 
 
-@pytest.mark.parametrize("error", [dict(flex_ecc=1.0, flex_ecc_phase=0.3), dict(flex_runout=2.0, flex_runout_phase=1.1)],
-                         ids=["flex eccentricity", "flex run-out"])
+@pytest.mark.parametrize(
+    "error",
+    [dict(flex_ecc=1.0, flex_ecc_phase=0.3), dict(flex_runout=2.0, flex_runout_phase=1.1)],
+    ids=["flex eccentricity", "flex run-out"],
+)
 def test_contact_ke_agrees_with_the_double_flank_formula_to_first_order(d2, error):
     # docs/models.md 6.1: in double-flank engagement [S2]'s dT is the mesh's tangential motion that takes up the
     # errors in a zone (the radial parts cancel between the flanks). The contact model's double-flank position
@@ -210,8 +231,13 @@ def test_contact_normals_do_not_depend_on_the_search_path():
     imp = Imperfections.from_spec(drive.design.imperfections)
     tab = K.contact_table(drive, imp, 8, sections=[None])
     a = K.kinematic_error(drive, imp, table=tab)
-    for i, side, arr in ((59, 1, a.delta_w), (74, 1, a.delta_w), (82, 1, a.delta_w), (1041, -1, a.delta_n),
-                         (158450, 1, a.delta_w)):
+    for i, side, arr in (
+        (59, 1, a.delta_w),
+        (74, 1, a.delta_w),
+        (82, 1, a.delta_w),
+        (1041, -1, a.delta_n),
+        (158450, 1, a.delta_w),
+    ):
         ref = K.closing_direct(drive, imp, a.phi_h[i], side * tab.side_w, sections=[None])
         assert abs(arr[i] - ref) * AS < 1.0, (i, arr[i] * AS, ref * AS)
 
@@ -227,8 +253,10 @@ def test_deep_overlaps_are_flagged_where_the_linear_model_fails():
     for z in (0.0, 16.0):
         tab = K.contact_table(drive, imp, 8, sections=[z])
         res = K.kinematic_error(drive, imp, table=tab, samples=8 * 202 * 4)
-        errs = [abs(res.delta_n[i] - K.closing_direct(drive, imp, res.phi_h[i], -tab.side_w, sections=[z])) * AS
-                for i in (101, 1733, 2900, 5631 % len(res.ke), 6001)]
+        errs = [
+            abs(res.delta_n[i] - K.closing_direct(drive, imp, res.phi_h[i], -tab.side_w, sections=[z])) * AS
+            for i in (101, 1733, 2900, 5631 % len(res.ke), 6001)
+        ]
         worst[z] = (res.deep_overlap_fraction, max(errs))
     assert worst[0.0][0] == 1.0 and worst[0.0][1] > 100.0
     assert worst[16.0][0] == 0.0 and worst[16.0][1] < 2.0
@@ -264,7 +292,9 @@ def test_a_tip_running_into_the_root_fillet_is_followed_by_the_table():
     # largest (40, 15, 20 um); 0.1'' is the tolerance (the linear model's second-order residual at these
     # errors, cf. the D2 tests above).
     drive = build_drive(load_design(TEMPLATES / "d4_discrete.toml"))
-    imp = Imperfections(rigid_runout=12.191382894030646e-3, flex_ecc=4.115553110055613e-3, cam_fixed=7.163634705787521e-3)
+    imp = Imperfections(
+        rigid_runout=12.191382894030646e-3, flex_ecc=4.115553110055613e-3, cam_fixed=7.163634705787521e-3
+    )
     big = imp.replace(rigid_runout=40e-3, flex_ecc=15e-3, cam_fixed=20e-3)
     for tab in (K.contact_table(drive, imp), K.contact_table(drive, big)):
         res = K.kinematic_error(drive, imp, table=tab)
@@ -274,8 +304,15 @@ def test_a_tip_running_into_the_root_fillet_is_followed_by_the_table():
                 assert abs(arr[i] - ref) * AS < 0.1, (i, side, arr[i] * AS, ref * AS)
 
 
-@pytest.mark.parametrize("name, scale, pruned", [("d2_imperfect", 1.0, False), ("d2_imperfect", 0.4, True),
-                                                 ("d2_imperfect_nominal", 1.0, True), ("d4_discrete", None, False)])
+@pytest.mark.parametrize(
+    "name, scale, pruned",
+    [
+        ("d2_imperfect", 1.0, False),
+        ("d2_imperfect", 0.4, True),
+        ("d2_imperfect_nominal", 1.0, True),
+        ("d4_discrete", None, False),
+    ],
+)
 def test_pruned_table_gives_the_exhaustive_ke(name, scale, pruned):
     # the table searches for second features only the pairs that can be first (ke_table._can_be_first,
     # a bound on every line's change over the error amplitudes) and starts each search where the pair's
@@ -285,12 +322,27 @@ def test_pruned_table_gives_the_exhaustive_ke(name, scale, pruned):
     # on D4, 0 on D2; 1e-3'' is the tolerance)
     drive = build_drive(load_design(_path(name)))
     if scale is None:  # D4 with errors of the sweep's order (tests/test_sweep_yield.py)
-        imp = Imperfections(flex_runout=0.02, flex_runout_phase=math.radians(260), rigid_runout=0.02, cam_cam=0.01,
-                            cam_fixed=0.008, rigid_ecc=0.004, rigid_ecc_phase=2.2, flex_ecc=0.003, flex_ecc_phase=1.0)
+        imp = Imperfections(
+            flex_runout=0.02,
+            flex_runout_phase=math.radians(260),
+            rigid_runout=0.02,
+            cam_cam=0.01,
+            cam_fixed=0.008,
+            rigid_ecc=0.004,
+            rigid_ecc_phase=2.2,
+            flex_ecc=0.003,
+            flex_ecc_phase=1.0,
+        )
     else:
         full = Imperfections.from_spec(drive.design.imperfections)
-        imp = full.replace(flex_runout=scale * full.flex_runout, rigid_runout=scale * full.rigid_runout,
-                           cam_fixed=scale * full.cam_fixed, rigid_ecc=0.01 * scale, rigid_ecc_phase=1.0, flex_ecc=0.005 * scale)
+        imp = full.replace(
+            flex_runout=scale * full.flex_runout,
+            rigid_runout=scale * full.rigid_runout,
+            cam_fixed=scale * full.cam_fixed,
+            rigid_ecc=0.01 * scale,
+            rigid_ecc_phase=1.0,
+            flex_ecc=0.005 * scale,
+        )
     fast = K.contact_table(drive, imp)
     ref = K.contact_table(drive, imp, exhaustive=True)
     if pruned:  # the pruning was exercised
@@ -310,9 +362,20 @@ def test_lanes_drop_only_contacts_that_are_never_first(name, monkeypatch):
     # with its group's best through both contacts' sensitivities (second features included). The KE with
     # every contact of the class as a candidate must be the same, sample by sample.
     drive = build_drive(load_design(TEMPLATES / f"{name}.toml"))
-    imp = (Imperfections.from_spec(drive.design.imperfections) if name == "d2_imperfect" else
-           Imperfections(flex_runout=0.02, rigid_runout=0.02, cam_cam=0.01, cam_fixed=0.008, rigid_ecc=0.004,
-                         rigid_ecc_phase=2.2, flex_ecc=0.003, flex_ecc_phase=1.0))
+    imp = (
+        Imperfections.from_spec(drive.design.imperfections)
+        if name == "d2_imperfect"
+        else Imperfections(
+            flex_runout=0.02,
+            rigid_runout=0.02,
+            cam_cam=0.01,
+            cam_fixed=0.008,
+            rigid_ecc=0.004,
+            rigid_ecc_phase=2.2,
+            flex_ecc=0.003,
+            flex_ecc_phase=1.0,
+        )
+    )
     tab = K.contact_table(drive, imp)
     I = 4096
     a = K.kinematic_error(drive, imp, table=tab, samples=I)
@@ -333,9 +396,24 @@ def test_lanes_drop_only_contacts_that_are_never_first(name, monkeypatch):
     np.testing.assert_array_equal(a.delta_n, b.delta_n)
 
 
-ALL_ERRORS = dict(flex_runout=0.075, flex_runout_phase=1.3, rigid_runout=0.06, rigid_runout_phase=-0.4, rigid_ecc=0.009,
-                  rigid_ecc_phase=-1.1, flex_ecc=0.012, flex_ecc_phase=0.7, cam_cam=0.08, cam_cam_phase=0.5, cam_flex=0.015,
-                  cam_flex_phase=2.0, cam_fixed=0.03, cam_fixed_phase=1.6, rigid_install=0.4, flex_install=-0.9)
+ALL_ERRORS = dict(
+    flex_runout=0.075,
+    flex_runout_phase=1.3,
+    rigid_runout=0.06,
+    rigid_runout_phase=-0.4,
+    rigid_ecc=0.009,
+    rigid_ecc_phase=-1.1,
+    flex_ecc=0.012,
+    flex_ecc_phase=0.7,
+    cam_cam=0.08,
+    cam_cam_phase=0.5,
+    cam_flex=0.015,
+    cam_flex_phase=2.0,
+    cam_fixed=0.03,
+    cam_fixed_phase=1.6,
+    rigid_install=0.4,
+    flex_install=-0.9,
+)
 
 
 @pytest.mark.parametrize("name", ["d2_imperfect", "d4_discrete"])

@@ -5,15 +5,15 @@ import math
 
 import numpy as np
 import pytest
-
 from conftest import TEMPLATES, edit_toml
+
 from wgcad.accuracy import ke as K
-from wgcad.placement.imperfect import Imperfections
 from wgcad.accuracy.ke_load import loaded_ke, sample_periods
 from wgcad.cli import main
-from wgcad.elastic import build_model
 from wgcad.design import load_design, with_changes
 from wgcad.drive import build_drive
+from wgcad.elastic import build_model
+from wgcad.placement.imperfect import Imperfections
 
 AS = 180.0 / math.pi * 3600.0
 #: the elastic solve's position tolerance in these tests, mm: 1e-5 mm is 1.25e-7 rad of rim rotation at 80 mm
@@ -50,7 +50,9 @@ def test_rigid_eccentricity_is_the_opposite_stationary_cam_offset():
     from wgcad.accuracy.ke_load import tooth_errors
     from wgcad.elastic import solve_load
 
-    drive = build_drive(with_changes(load_design(TEMPLATES / "d1_involute.toml"), load={"rim_lateral_stiffness_n_per_mm": 0.0}))
+    drive = build_drive(
+        with_changes(load_design(TEMPLATES / "d1_involute.toml"), load={"rim_lateral_stiffness_n_per_mm": 0.0})
+    )
     model = build_model(drive)
     e, psi = 0.015, 0.7
     ia = Imperfections(rigid_ecc=e, rigid_ecc_phase=psi)
@@ -85,7 +87,9 @@ def test_load_sharing_averages_the_errors(d1, tmp_path):
     # these errors at 24 samples: 23.3'' no load at the same angles, 18.1'' at 100 N m (4-6 contacts), 1.86'' at
     # 500 N m (17-19), 1.74'' at 3000 N m (44-47).
     drive, model = d1
-    imp = Imperfections(flex_runout=0.02, flex_runout_phase=math.radians(260), rigid_runout=0.02, cam_fixed=0.01, rigid_ecc=0.01)
+    imp = Imperfections(
+        flex_runout=0.02, flex_runout_phase=math.radians(260), rigid_runout=0.02, cam_fixed=0.01, rigid_ecc=0.01
+    )
     tab = K.contact_table(drive, imp)
     res = K.kinematic_error(drive, imp, table=tab)
     L = loaded_ke(drive, imp, 500.0, samples=24, model=model)
@@ -107,7 +111,23 @@ def _d1_with_errors(tmp_path):
 def test_cli_torque_flag(tmp_path, capsys):
     p = _d1_with_errors(tmp_path)
     out = tmp_path / "ke.json"
-    assert main(["ke", str(p), "--torque-nm", "500", "--load-samples", "6", "--json", str(out), "--plot", str(tmp_path / "k")]) == 0
+    assert (
+        main(
+            [
+                "ke",
+                str(p),
+                "--torque-nm",
+                "500",
+                "--load-samples",
+                "6",
+                "--json",
+                str(out),
+                "--plot",
+                str(tmp_path / "k"),
+            ]
+        )
+        == 0
+    )
     doc = json.loads(out.read_text())
     (row,) = doc["loaded"]
     assert row["torque_nm"] == 500.0 and row["samples"] == 6 and row["ke_pp_arcsec"] >= 0
@@ -116,8 +136,14 @@ def test_cli_torque_flag(tmp_path, capsys):
     assert "under 500 N m" in text and "NOT CHECKED" in text
 
 
-@pytest.mark.parametrize("args, field", [(["--torque-nm", "0"], "--torque-nm"), (["--torque-nm", "x"], "--torque-nm"),
-                                         (["--load-samples", "1", "--torque-nm", "10"], "--load-samples")])
+@pytest.mark.parametrize(
+    "args, field",
+    [
+        (["--torque-nm", "0"], "--torque-nm"),
+        (["--torque-nm", "x"], "--torque-nm"),
+        (["--load-samples", "1", "--torque-nm", "10"], "--load-samples"),
+    ],
+)
 def test_cli_bad_load_flags_exit_2(tmp_path, capsys, args, field):
     p = _d1_with_errors(tmp_path)
     try:
@@ -157,5 +183,7 @@ def test_install_lever_finds_the_scans_best_and_never_reports_a_worse_angle(d1):
     assert lev.best.ke_pp <= lev.design.ke_pp and lev.lever >= 1.0
     assert lev.lever > 1.05  # the rigid gear's run-out against the stationary offset: the angle matters here
     # no rigid-gear error: every angle is the same drive
-    flat = install_lever(drive, imp.replace(rigid_runout=0.0), 300.0, model=model, samples=n, scan_samples=n, n_grid=grid)
+    flat = install_lever(
+        drive, imp.replace(rigid_runout=0.0), 300.0, model=model, samples=n, scan_samples=n, n_grid=grid
+    )
     assert flat.best_angle == 0.0 and flat.lever == 1.0 and flat.best is flat.design

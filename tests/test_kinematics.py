@@ -5,9 +5,9 @@ import math
 import numpy as np
 import pytest
 
-from wgcad.laws import Disc, ExternalRing, Harmonic
 from wgcad.errors import DesignError
 from wgcad.kinematics import RingVelocities, flex_rotation, gear_ratios, ring_generator_velocities
+from wgcad.laws import Disc, ExternalRing, Harmonic
 
 
 def test_ratios_internal_deformation_200_202():
@@ -55,8 +55,13 @@ def test_mesh_period_one_pitch_each(z_g, z_b):
 
 @pytest.mark.parametrize(
     "args,field",
-    [((200, 200), "drive.z_rigid"), ((0, 202), "drive.z_flex"), ((200, 202.0), "drive.z_rigid"),
-     ((True, 202), "drive.z_flex"), ((200, -2), "drive.z_rigid")],
+    [
+        ((200, 200), "drive.z_rigid"),
+        ((0, 202), "drive.z_flex"),
+        ((200, 202.0), "drive.z_rigid"),
+        ((True, 202), "drive.z_flex"),
+        ((200, -2), "drive.z_rigid"),
+    ],
 )
 def test_ratio_rejects(args, field):
     with pytest.raises(DesignError) as exc:
@@ -88,9 +93,13 @@ def test_velocities_against_time_finite_differences(law):
         def f(tt):
             s = law.state(OMEGA * tt)
             return {
-                "w": s.w, "v": s.v, "theta": s.theta,
-                "wK": s.w + H_C / 2, "vK": s.v + H_C / 2 * s.theta,
+                "w": s.w,
+                "v": s.v,
+                "theta": s.theta,
+                "wK": s.w + H_C / 2,
+                "vK": s.v + H_C / 2 * s.theta,
             }[name]
+
         return f
 
     # 4th-order stencil in phi: truncation ~1e-12 W0, rounding ~3e-13/1e-3
@@ -99,9 +108,7 @@ def test_velocities_against_time_finite_differences(law):
     tol = 1e-9 * OMEGA * law.w0
     for name, got in (("w", vel.V_w), ("v", vel.V_v), ("wK", vel.V_wK), ("vK", vel.V_vK)):
         np.testing.assert_allclose(_fd_time(field(name), t, h), got, rtol=0, atol=tol, err_msg=name)
-    np.testing.assert_allclose(
-        _fd_time(field("theta"), t, h), vel.dtheta_dt, rtol=0, atol=tol / law.r_m
-    )
+    np.testing.assert_allclose(_fd_time(field("theta"), t, h), vel.dtheta_dt, rtol=0, atol=tol / law.r_m)
 
 
 def test_washer_velocities_and_sliding():

@@ -8,6 +8,7 @@ from hypothesis import given, seed, settings
 from hypothesis import strategies as st
 from numpy.polynomial.legendre import leggauss
 
+from wgcad.errors import DesignError
 from wgcad.laws import (
     LAWS,
     Disc,
@@ -19,7 +20,6 @@ from wgcad.laws import (
     RimState,
     make_law,
 )
-from wgcad.errors import DesignError
 
 EPS = np.finfo(float).eps
 R_M = 80.0  # D1/D2-like: m 0.8, z_g 200
@@ -254,7 +254,7 @@ def test_derivatives_against_finite_differences(key):
     if edges.size:  # keep the stencil off the beta kinks (w''' jumps there)
         phi = phi[np.min(np.abs(phi[:, None] - edges[None, :]), axis=1) > 3 * h]
     s = scaled(law.state(phi), law)
-    get = lambda f: (lambda p: scaled(law.state(p), law)[f])  # noqa: E731
+    get = lambda f: lambda p: scaled(law.state(p), law)[f]  # noqa: E731
     # 4th-order stencil: truncation h^4/30 |f^(5)| <= 3e-14 * 3^5 W0 ~ 1e-11 W0;
     # rounding 1.5 eps |f| / h with |f| up to r_m (the ellipse's w = |P| - r_m,
     # and theta * r_m) ~ 3e-11 mm. 1e-9 W0 (~1 nm) leaves margin and fails
@@ -267,9 +267,7 @@ def test_harmonic_theta_example_of_theory():
     # docs/models.md 3.1: w = W0 cos 2phi gives theta = (3 W0 / (2 r_m)) sin 2phi
     law = CASES["harmonic2"]
     phi = np.linspace(-3, 3, 31)
-    np.testing.assert_allclose(
-        law.state(phi).theta, 1.5 * W0 / R_M * np.sin(2 * phi), rtol=0, atol=1e-16
-    )
+    np.testing.assert_allclose(law.state(phi).theta, 1.5 * W0 / R_M * np.sin(2 * phi), rtol=0, atol=1e-16)
 
 
 @pytest.mark.parametrize("key", ["four_force35", "four_force60", "disc40"])
@@ -351,8 +349,16 @@ def _disc_series(beta, phi):
 
 
 INDEPENDENT = [
-    ("four_force", 10), ("four_force", 35), ("four_force", 40), ("four_force", 60), ("four_force", 80),
-    ("disc", 10), ("disc", 30), ("disc", 40), ("disc", 60), ("disc", 80),
+    ("four_force", 10),
+    ("four_force", 35),
+    ("four_force", 40),
+    ("four_force", 60),
+    ("four_force", 80),
+    ("disc", 10),
+    ("disc", 30),
+    ("disc", 40),
+    ("disc", 60),
+    ("disc", 80),
 ]
 
 

@@ -88,8 +88,10 @@ def test_imports_point_down():
             if a is None or b is None or a == b:
                 continue
             if not FLOOR[b] < FLOOR[a]:
-                bad.append(f"{files[mod].relative_to(ROOT.parent)}:{line} imports {target} (floor {FLOOR[b]}, {b}) "
-                           f"from floor {FLOOR[a]} ({a})")
+                bad.append(
+                    f"{files[mod].relative_to(ROOT.parent)}:{line} imports {target} (floor {FLOOR[b]}, {b}) "
+                    f"from floor {FLOOR[a]} ({a})"
+                )
     assert not bad, "imports that do not point down:\n" + "\n".join(sorted(bad))
 
 

@@ -4,15 +4,24 @@ from math import cos, pi, sin, tan
 
 import numpy as np
 import pytest
+from conftest import TEMPLATES
 from scipy.optimize import minimize_scalar
 
-from conftest import TEMPLATES
 from wgcad.design import load_design
 from wgcad.drive import build_drive
 from wgcad.profiles import cycloid as cy
 from wgcad.profiles.gear import ToothSpec, make_gear, rotate
-from wgcad.profiles.measure import (concave_radii, flank_zone, pins_closed_form, pins_numerical, span_closed_form,
-                                    span_k_rule, span_numerical, thickness_at, workshop_figures)
+from wgcad.profiles.measure import (
+    concave_radii,
+    flank_zone,
+    pins_closed_form,
+    pins_numerical,
+    span_closed_form,
+    span_k_rule,
+    span_numerical,
+    thickness_at,
+    workshop_figures,
+)
 
 NAMES = ["d1_involute", "d1_cycloidal", "d2", "d3_external", "d4_discrete"]
 #: chord tolerance of the outlines the numerical checks use, mm: their vertices lie on the exact
@@ -97,8 +106,9 @@ def test_cycloidal_span_numerical_against_the_exact_curve(gear):
     for curve, mirror, radius in ((cy.epicycloid, True, gear.r_a), (cy.hypocycloid, False, gear.r_f)):
         epi = curve is cy.epicycloid
         top = float(cy.roll_angle_at_radius(r, rho, radius, epi))
-        res = minimize_scalar(lambda p: -y(p, curve, mirror), bounds=(0.0, top), method="bounded",
-                              options={"xatol": 1e-12})
+        res = minimize_scalar(
+            lambda p: -y(p, curve, mirror), bounds=(0.0, top), method="bounded", options={"xatol": 1e-12}
+        )
         best = max(best, -res.fun)
     w_exact = 2 * best  # symmetric group
     w_num, _ = span_numerical(make_gear(sp, FINE), k)

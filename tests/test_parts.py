@@ -1,20 +1,17 @@
 """Tests of the part set (wgcad parts): every export read back and checked against the 2D areas, the plug against the law's neutral line, bad sizes refused with nothing written."""
 
 import re
-import subprocess
-import sys
 
 import numpy as np
 import pytest
 import shapely
 import trimesh
-
 from conftest import TEMPLATES, edit_toml
+
 from wgcad.cli import main
 from wgcad.design import load_design
 from wgcad.design.parts import PartsSpec, load_parts, part_sizes
 from wgcad.drive import build_drive
-from wgcad.errors import DesignError
 from wgcad.export.dxf import audit_dxf, read_dxf
 from wgcad.export.parts import build_parts
 from wgcad.export.parts.bodies import plug_outline
@@ -69,20 +66,23 @@ def test_default_sizes_are_derived_and_reported():
     assert given.cup_bolt_count == 6
 
 
-@pytest.mark.parametrize("line, field", [
-    ("cup_bolt_circle_diameter = 200.0", "parts.cup_bolt_circle_diameter"),  # outside the cup bore
-    ("cup_bolt_circle_diameter = 4.5", "parts.cup_bolt_circle_diameter"),  # cuts into the hub bore
-    ("cup_bolt_count = 60\ncup_bolt_hole_diameter = 1.0", "parts.cup_bolt_count"),  # holes overlap
-    ("diaphragm_thickness = 40.0", "parts.diaphragm_thickness"),  # thicker than the cup behind the rim
-    ("bearing_thickness = 7.5", "parts.bearing_thickness"),  # no plug left inside the bearing
-    ("plug_bore_diameter = 20.0", "parts.plug_bore_diameter"),  # bore larger than the plug
-    ("flange_bolt_circle_diameter = 300.0", "parts.flange_bolt_circle_diameter"),
-    ("shell_thickness = 5.0", "parts.shell_thickness"),
-    ("cup_lenght = 5.0", "parts.cup_lenght"),
-    ("cup_length = -5.0", "parts.cup_length"),
-    ("cup_length = 1e300", "parts.cup_length"),  # above the stated 10 m bound
-    ("flange_bolt_count = 100000", "parts.flange_bolt_count"),
-])
+@pytest.mark.parametrize(
+    "line, field",
+    [
+        ("cup_bolt_circle_diameter = 200.0", "parts.cup_bolt_circle_diameter"),  # outside the cup bore
+        ("cup_bolt_circle_diameter = 4.5", "parts.cup_bolt_circle_diameter"),  # cuts into the hub bore
+        ("cup_bolt_count = 60\ncup_bolt_hole_diameter = 1.0", "parts.cup_bolt_count"),  # holes overlap
+        ("diaphragm_thickness = 40.0", "parts.diaphragm_thickness"),  # thicker than the cup behind the rim
+        ("bearing_thickness = 7.5", "parts.bearing_thickness"),  # no plug left inside the bearing
+        ("plug_bore_diameter = 20.0", "parts.plug_bore_diameter"),  # bore larger than the plug
+        ("flange_bolt_circle_diameter = 300.0", "parts.flange_bolt_circle_diameter"),
+        ("shell_thickness = 5.0", "parts.shell_thickness"),
+        ("cup_lenght = 5.0", "parts.cup_lenght"),
+        ("cup_length = -5.0", "parts.cup_length"),
+        ("cup_length = 1e300", "parts.cup_length"),  # above the stated 10 m bound
+        ("flange_bolt_count = 100000", "parts.flange_bolt_count"),
+    ],
+)
 def test_bad_sizes_one_line_error_exit_2_nothing_written(tmp_path, capsys, line, field):
     design = small_design(tmp_path, line)
     out = tmp_path / "out"
@@ -193,7 +193,22 @@ def test_dxf_and_svg_of_the_parts(small_run):
 
 def test_polyline_style_and_format_choice(tmp_path):
     design = small_design(tmp_path)
-    assert main(["parts", str(design), "--out", str(tmp_path / "o"), "--format", "dxf", "--dxf-style", "polyline", "--quiet"]) == 0
+    assert (
+        main(
+            [
+                "parts",
+                str(design),
+                "--out",
+                str(tmp_path / "o"),
+                "--format",
+                "dxf",
+                "--dxf-style",
+                "polyline",
+                "--quiet",
+            ]
+        )
+        == 0
+    )
     names = sorted(p.name for p in (tmp_path / "o").iterdir())
     assert names == ["parts.json", "small_flexspline.dxf", "small_plug.dxf", "small_rigid.dxf"]
     back = read_dxf(tmp_path / "o" / "small_flexspline.dxf")

@@ -4,11 +4,11 @@ from math import pi
 
 import numpy as np
 import pytest
-
 from conftest import TEMPLATES
-from wgcad.laws import Ellipse, FourForce, Harmonic
+
 from wgcad.design import load_design
 from wgcad.drive import build_drive
+from wgcad.laws import Ellipse, FourForce, Harmonic
 from wgcad.placement import deformed_curve, place_flex_teeth, place_points, place_points_first_order, tooth_angles
 
 

@@ -108,12 +108,8 @@ def test_every_tooth_symmetric_and_outline_valid(case):
     assert n * z == len(o)
     gam = 2 * pi / z
     for k in (0, 1, z // 2, z - 1):
-        seg = o[k * n : (k + 1) * n]
         a = -k * gam
         c, s = np.cos(a), np.sin(a)
-        loc = seg @ np.array([[c, s], [-s, c]])
-        loc = np.vstack([loc, loc[:1] @ np.eye(2)])  # mirror axis through the tooth centre
-        mirrored = loc * [1, -1]
         # each tooth's points, mirrored about its centre line, are its points reversed
         period = np.vstack([o[k * n : (k + 1) * n], o[((k + 1) % z) * n]]) @ np.array([[c, s], [-s, c]])
         np.testing.assert_allclose(period[::-1] * [1, -1], period, atol=1e-9)
@@ -204,9 +200,13 @@ def test_cycloid_vertices_on_closed_form(internal):
         phi = np.arccos(np.clip(cphi, -1, 1))
         th = rho * phi / r
         if Ri >= r:
-            p = np.array([(r + rho) * np.cos(th) - rho * np.cos(th + phi), (r + rho) * np.sin(th) - rho * np.sin(th + phi)])
+            p = np.array(
+                [(r + rho) * np.cos(th) - rho * np.cos(th + phi), (r + rho) * np.sin(th) - rho * np.sin(th + phi)]
+            )
         else:
-            p = np.array([(r - rho) * np.cos(th) + rho * np.cos(th - phi), (r - rho) * np.sin(th) + rho * np.sin(th - phi)])
+            p = np.array(
+                [(r - rho) * np.cos(th) + rho * np.cos(th - phi), (r - rho) * np.sin(th) + rho * np.sin(th - phi)]
+            )
         a = np.arctan2(p[1], p[0])
         toward_centre = (Ri >= r) != internal
         expected = pi / (2 * z) - a if toward_centre else pi / (2 * z) + a

@@ -4,10 +4,10 @@ import io
 import math
 import re
 
+from conftest import TEMPLATES
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from conftest import TEMPLATES
 from wgcad.cli.progress import Progress, format_seconds
 
 PCT = re.compile(r"\]\s+(\d+) %")
@@ -27,7 +27,7 @@ def percentages(text):
 
 
 numbers = st.one_of(
-    st.integers(-10**12, 10**12),
+    st.integers(-(10**12), 10**12),
     st.floats(allow_nan=True, allow_infinity=True),
     st.none(),
     st.text(max_size=3),

@@ -14,15 +14,15 @@ every bundled tooth form and deformation kind.
 import numpy as np
 import pytest
 import shapely
-
 from conftest import TEMPLATES
+from test_exact import dense_pair  # the same shapely reference as the audit-level test
+
 from wgcad.clearance.distance import Template
 from wgcad.clearance.scene import Scene, clearance_at_poses
 from wgcad.constants import REFINE_TOL
 from wgcad.design import load_design
 from wgcad.drive import build_drive
 from wgcad.placement import transform
-from test_exact import dense_pair  # the same shapely reference as the audit-level test
 
 #: the dense polygons' own error: 2 x their chord tolerance (one per tooth)
 DENSE_TOL = 1e-7

@@ -5,8 +5,8 @@ import subprocess
 import sys
 
 import pytest
-
 from conftest import TEMPLATES, edit_toml
+
 from wgcad.cli import main
 from wgcad.regression import compare, load_baseline
 from wgcad.testing import assert_matches_baseline, baseline_drifts, record_baseline
@@ -51,10 +51,20 @@ def run(argv, capsys):
 
 
 def test_audit_clean_design_exits_0_and_writes_json_and_plots(tmp_path, capsys):
-    code, so, se = run(["audit", TEMPLATES / "d4_discrete.toml", "--json", tmp_path / "r.json", "--plot", tmp_path / "d4"], capsys)
+    code, so, se = run(
+        ["audit", TEMPLATES / "d4_discrete.toml", "--json", tmp_path / "r.json", "--plot", tmp_path / "d4"], capsys
+    )
     assert code == 0, se
     res = json.loads((tmp_path / "r.json").read_text())
-    for key in ("min_clearance_um", "entry_gap_um", "backlash_arcmin", "interference", "worst", "settings", "elapsed_s"):
+    for key in (
+        "min_clearance_um",
+        "entry_gap_um",
+        "backlash_arcmin",
+        "interference",
+        "worst",
+        "settings",
+        "elapsed_s",
+    ):
         assert key in res
     assert res["interference"] is False and res["min_clearance_um"] > 0 and res["backlash_arcmin"] > 0
     s = res["settings"]
@@ -65,7 +75,9 @@ def test_audit_clean_design_exits_0_and_writes_json_and_plots(tmp_path, capsys):
 
 
 def test_audit_interference_exits_1(tmp_path, capsys):
-    code, so, se = run(["audit", TEMPLATES / "d1_involute_nominal.toml", "--step-deg", "5", "--json", tmp_path / "r.json"], capsys)
+    code, so, se = run(
+        ["audit", TEMPLATES / "d1_involute_nominal.toml", "--step-deg", "5", "--json", tmp_path / "r.json"], capsys
+    )
     res = json.loads((tmp_path / "r.json").read_text())
     assert code == 1 and res["interference"] and "INTERFERENCE" in so
     assert res["worst"]["section_z_mm"] == 0.0  # coning: the open end is the deepest
@@ -83,15 +95,18 @@ def test_write_then_check_baseline_and_drift_exit_code(tmp_path, capsys):
     assert code == 1 and "drifted beyond tolerance" in so and "rigid.outline_area_mm2" in so
 
 
-@pytest.mark.parametrize("flags,words", [
-    (["--sections", "0"], "--sections"),
-    (["--step-deg", "0"], "--step-deg"),
-    (["--engine", "3d"], "--engine"),
-    (["--baseline", "missing.json"], "baseline file not found"),
-    (["--angles", "10", "--step-deg", "1"], "not allowed with"),
-    (["--angles", "0"], "--angles"),
-    (["--angles", "-5"], "--angles"),
-])
+@pytest.mark.parametrize(
+    "flags,words",
+    [
+        (["--sections", "0"], "--sections"),
+        (["--step-deg", "0"], "--step-deg"),
+        (["--engine", "3d"], "--engine"),
+        (["--baseline", "missing.json"], "baseline file not found"),
+        (["--angles", "10", "--step-deg", "1"], "not allowed with"),
+        (["--angles", "0"], "--angles"),
+        (["--angles", "-5"], "--angles"),
+    ],
+)
 def test_audit_bad_flags(tmp_path, capsys, flags, words):
     try:
         code = main(["audit", str(TEMPLATES / "d4_discrete.toml"), "--json", str(tmp_path / "r.json"), *flags])
@@ -103,6 +118,9 @@ def test_audit_bad_flags(tmp_path, capsys, flags, words):
 
 
 def test_progress_bar_goes_to_stderr(tmp_path):
-    r = subprocess.run([sys.executable, "-m", "wgcad", "audit", str(TEMPLATES / "d4_discrete.toml"), "--step-deg", "5", "--progress"],
-                       capture_output=True, text=True)
+    r = subprocess.run(
+        [sys.executable, "-m", "wgcad", "audit", str(TEMPLATES / "d4_discrete.toml"), "--step-deg", "5", "--progress"],
+        capture_output=True,
+        text=True,
+    )
     assert r.returncode == 0 and "[" in r.stderr and "#" in r.stderr and "[" not in r.stdout.splitlines()[0]

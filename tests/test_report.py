@@ -4,8 +4,8 @@ from math import cos, pi, sin, tan
 
 import numpy as np
 import pytest
-
 from conftest import TEMPLATES
+
 from wgcad.design import load_design
 from wgcad.drive import build_drive
 from wgcad.report import drive_report, format_summary, mesh_figures
@@ -124,8 +124,14 @@ def test_summary_shows_no_negative_thickness_and_leads_with_workshop_figures(nam
     for line in text.splitlines():
         if "thickness" in line or "space width" in line or "span" in line or "pins" in line:
             assert not re.search(r"\s-\d", line), line
-    for label in ("mid-depth diameter", "chordal thickness", "span W_k over k teeth", "pin (ball) diameter",
-                  "dimension over / between pins", "smallest concave radius"):
+    for label in (
+        "mid-depth diameter",
+        "chordal thickness",
+        "span W_k over k teeth",
+        "pin (ball) diameter",
+        "dimension over / between pins",
+        "smallest concave radius",
+    ):
         assert label in text
     for g in ("flexspline", "rigid"):
         w = rep[g]["workshop"]
@@ -135,7 +141,11 @@ def test_summary_shows_no_negative_thickness_and_leads_with_workshop_figures(nam
         assert ("between_pins_mm" in pins) == rep[g]["internal_teeth"]
         if not rep[g]["pitch_circle_within_teeth"]:
             # the virtual pitch figures stay in the data, not in the summary
-            assert "@pitch" not in text or rep["flexspline"]["pitch_circle_within_teeth"] or rep["rigid"]["pitch_circle_within_teeth"]
+            assert (
+                "@pitch" not in text
+                or rep["flexspline"]["pitch_circle_within_teeth"]
+                or rep["rigid"]["pitch_circle_within_teeth"]
+            )
 
 
 def test_d1_pitch_circles_outside_the_teeth_are_not_shown_as_negative_widths():
@@ -157,11 +167,14 @@ def test_chosen_diameter_and_pin_come_from_the_design():
     assert "chosen diameter" in format_summary(rep)
 
 
-@pytest.mark.parametrize("change,field,words", [
-    ({"measure_diameter": 34.2}, "flexspline.measure_diameter", "off the flanks"),
-    ({"pin_diameter": 0.3}, "flexspline.pin_diameter", "does not stand out of the teeth"),
-    ({"pin_diameter": 2.5}, "flexspline.pin_diameter", "must be in [0.1 m = 0.04, 5 m = 2] mm"),
-])
+@pytest.mark.parametrize(
+    "change,field,words",
+    [
+        ({"measure_diameter": 34.2}, "flexspline.measure_diameter", "off the flanks"),
+        ({"pin_diameter": 0.3}, "flexspline.pin_diameter", "does not stand out of the teeth"),
+        ({"pin_diameter": 2.5}, "flexspline.pin_diameter", "must be in [0.1 m = 0.04, 5 m = 2] mm"),
+    ],
+)
 def test_measurement_choices_that_cannot_be_measured_are_refused(change, field, words):
     d = drive("d4_discrete").design
     with pytest.raises(DesignError) as e:

@@ -7,8 +7,8 @@ import ezdxf
 import numpy as np
 import pytest
 import trimesh
-
 from conftest import TEMPLATES
+
 from wgcad.cli import main
 from wgcad.export.dxf import audit_dxf, read_dxf
 
@@ -26,8 +26,19 @@ def test_outputs_written(run_sim):
     code, out = run_sim
     assert code == 0  # no tip-to-tip left with the simulated heights
     names = sorted(p.name for p in out.iterdir())
-    assert names == sorted(f"d4_sectored_{s}" for s in ("heights.csv", "heights.png", "motion.csv", "motion.png",
-                                                       "sector_audit.png", "sector_rigid.dxf", "sector_rigid.stl", "sector.json"))
+    assert names == sorted(
+        f"d4_sectored_{s}"
+        for s in (
+            "heights.csv",
+            "heights.png",
+            "motion.csv",
+            "motion.png",
+            "sector_audit.png",
+            "sector_rigid.dxf",
+            "sector_rigid.stl",
+            "sector.json",
+        )
+    )
     for p in out.glob("*.png"):
         assert p.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
 
@@ -77,11 +88,15 @@ def test_exported_outline_lies_in_a_symmetric_band(run_sim):
     lay = sector_layout(design.sectors, design.drive.z_flex, design.drive.z_rigid)
     sp = tooth_spec(design, "rigid")
     with open(out / "d4_sectored_heights.csv") as fh:
-        heights = np.array([float(r["built_mm"]) for r in csv.DictReader(fh)])  # 1e-7 mm rounding: far below the tolerance
+        heights = np.array(
+            [float(r["built_mm"]) for r in csv.DictReader(fh)]
+        )  # 1e-7 mm rounding: far below the tolerance
     fine = sectored_outline(lay, TeethByHeight(sp, make_gear(sp, 1e-6), 1e-6), heights)
     one_sided = sectored_outline(lay, TeethByHeight(sp, drive.rigid, drive.tol), heights)
     F = shapely.Polygon(fine)
-    assert shapely.Polygon(o).exterior.hausdorff_distance(F.exterior) <= drive.tol + 2e-6  # + the fine outline's and the heights' rounding
+    assert (
+        shapely.Polygon(o).exterior.hausdorff_distance(F.exterior) <= drive.tol + 2e-6
+    )  # + the fine outline's and the heights' rounding
     err_band = abs(shapely.Polygon(o).area - F.area)
     err_one = abs(shapely.Polygon(one_sided).area - F.area)
     assert err_band < 0.25 * err_one

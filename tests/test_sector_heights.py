@@ -4,8 +4,8 @@ from math import pi
 
 import numpy as np
 import pytest
-
 from conftest import TEMPLATES
+
 from wgcad.design import load_design
 from wgcad.drive import build_drive, tooth_spec
 from wgcad.placement import tooth_pose, transform
@@ -23,7 +23,10 @@ def d4():
     lay = sector_layout(design.sectors, design.drive.z_flex, design.drive.z_rigid)
     teeth = TeethByHeight(tooth_spec(design, "rigid"), drive.rigid)
     res = {
-        "design": design, "drive": drive, "layout": lay, "teeth": teeth,
+        "design": design,
+        "drive": drive,
+        "layout": lay,
+        "teeth": teeth,
         "boundary": closed_form_heights(drive, lay, teeth, assign="boundary"),
         "register": closed_form_heights(drive, lay, teeth, assign="register", step_deg=STEP_DEG),
         "sim": simulated_heights(drive, lay, teeth, C_REQ, step_deg=STEP_DEG),
@@ -101,7 +104,6 @@ def test_closed_form_is_the_deformed_tip_radius(d4):
     """r_ari = r_cr + w + h_s against the radius of the placed flexspline tooth's tip centre (tooth_pose, exact placement):
     they differ only by the tangential terms, (v + h_s theta)^2 / (2 r) to first order."""
     cf, drive = d4["register"], d4["drive"]
-    lay = d4["layout"]
     i = np.nonzero(np.isfinite(cf.phi))[0]
     phi = cf.phi[i]
     rot, shift = tooth_pose(drive.law, phi, drive.r_m)
@@ -119,7 +121,6 @@ def test_simulated_against_closed_form(d4):
     closed form puts the tip at the tooth's centre-line tip radius. The tip corners of the tooth, turned by theta, reach
     at most (s_tip / 2) |theta| further, and both are sampled on the same sweep."""
     sim0, cf, drive = d4["sim0"], d4["register"], d4["drive"]
-    lay = d4["layout"]
     at_risk = np.isfinite(cf.phi)
     phi = np.linspace(0, pi / 2, 2001)
     corner = 0.5 * drive.flex.tip_thickness * np.abs(drive.law.state(phi).theta).max()

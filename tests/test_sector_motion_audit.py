@@ -4,8 +4,8 @@ from math import pi
 
 import numpy as np
 import pytest
-
 from conftest import TEMPLATES
+
 from wgcad.design import load_design
 from wgcad.design.sectors import SectorsSpec
 from wgcad.drive import build_drive, tooth_spec
@@ -58,8 +58,17 @@ def test_motion_law_of_a_plain_gear_is_the_gear_ratio():
     """A layout of one kind at the pitch of a plain 88-tooth gear: the law must be phi_h / u_hg (wgcad.kinematics)."""
     z_b, z_g = 88, 84
     c = (np.arange(z_b) + 0.5) * 2 * pi / z_b
-    lay = SectorLayout(c, np.zeros(z_b, int), np.arange(z_b), np.zeros(z_b, bool), np.full(z_b, 2 * pi / z_b),
-                       np.zeros(z_b), np.array([0.0, 2 * pi]), ("transmission",), c + pi / z_b)
+    lay = SectorLayout(
+        c,
+        np.zeros(z_b, int),
+        np.arange(z_b),
+        np.zeros(z_b, bool),
+        np.full(z_b, 2 * pi / z_b),
+        np.zeros(z_b),
+        np.array([0.0, 2 * pi]),
+        ("transmission",),
+        c + pi / z_b,
+    )
     law = motion_law(lay, z_g)
     phi_h = np.linspace(-3.0, 9.0, 1001)
     expect = flex_rotation(phi_h, z_g, z_b)

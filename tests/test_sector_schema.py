@@ -1,8 +1,8 @@
 """The [sectors] table: layout rules of a sectored rigid gear, each broken rule a one-line error with exit code 2 and nothing written."""
 
 import pytest
-
 from conftest import TEMPLATES, edit_toml
+
 from wgcad.cli import main
 from wgcad.design import load_design, parse_design
 from wgcad.design.sectors import SectorsSpec, validate_sectors
@@ -20,12 +20,18 @@ BAD = [
     ("sectors", "teeth", "[20, 22, 20, 22]", "sectors.teeth", "sectors must fill the circle"),
     ("sectors", "kinds", '["coupling", "coupling", "transmission", "transmission"]', "sectors.kinds", "must alternate"),
     ("sectors", "kinds", '["coupling", "transmission"]', "sectors.kinds", "2 x drive.waves = 4 sectors"),
-    ("sectors", "kinds", '["coupling", "transmision", "coupling", "transmission"]', "sectors.kinds[1]", "must be one of transmission, coupling"),
+    (
+        "sectors",
+        "kinds",
+        '["coupling", "transmision", "coupling", "transmission"]',
+        "sectors.kinds[1]",
+        "must be one of transmission, coupling",
+    ),
     ("sectors", "pitch_z", "[85, 88, 85, 88]", "sectors.pitch_z[0]", "coupling sector has the flexspline's pitch"),
     ("sectors", "pitch_z", "[84, 84, 84, 84]", "sectors.pitch_z[1]", "pitch other than the flexspline's"),
     ("sectors", "heights", '"patent"', "sectors.heights", "must be one of closed_form, simulated, full, list"),
     ("sectors", "heights", '"list"', "sectors.heights_mm", "one height per coupling tooth (21)"),
-    ("sectors", "heights_mm", "[0.3, 0.3]", "sectors.heights_mm", "used only with heights = \"list\""),
+    ("sectors", "heights_mm", "[0.3, 0.3]", "sectors.heights_mm", 'used only with heights = "list"'),
     ("sectors", "assign", '"middle"', "sectors.assign", "must be one of register, boundary"),
     ("sectors", "tip_clearance_um", "-5.0", "sectors.tip_clearance_um", "must be in [0, 1000)"),
     ("sectors", "teeth", '"21"', "sectors.teeth", "must be a non-empty list"),
@@ -83,7 +89,9 @@ def test_rules_directly():
     alt = SectorsSpec(kinds=spec.kinds, teeth=(21, 23, 21, 23), pitch_z=(86.0, 86 * 23 / 22, 86.0, 86 * 23 / 22))
     assert validate_sectors(alt, 86, 88, 2) is alt
     with pytest.raises(DesignError, match="drive.z_flex: must be a multiple of drive.waves"):
-        validate_sectors(SectorsSpec(kinds=spec.kinds, teeth=(21, 22, 21, 22), pitch_z=(85.0, 88.0, 85.0, 88.0)), 85, 89, 2)
+        validate_sectors(
+            SectorsSpec(kinds=spec.kinds, teeth=(21, 22, 21, 22), pitch_z=(85.0, 88.0, 85.0, 88.0)), 85, 89, 2
+        )
 
 
 def test_parse_design_keeps_lists_as_tuples():

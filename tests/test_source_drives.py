@@ -10,10 +10,10 @@ import shapely
 
 from wgcad.clearance.engine import AuditSettings, audit
 from wgcad.clearance.scene import Scene
-from wgcad.elastic import build_model
-from wgcad.elastic.sweep import torque_sweep
 from wgcad.design import load_design
 from wgcad.drive import build_drive
+from wgcad.elastic import build_model
+from wgcad.elastic.sweep import torque_sweep
 from wgcad.placement import tooth_pose, transform
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -60,7 +60,9 @@ def _s1_gap(d, drive, law, k: int, j: int, sgn: int, r_k: float, p_flex: np.ndar
     a_b = acos(rb * cos(alpha) / r_k)
     delta_0 = (r_k * psi - 0.5 * (s_b(r_k) + s_g(r_k - w))) * cos(a_b) + w * sin_(a_b)
     A = np.array([(drive.r_m + w) * np.cos(phi) - v * np.sin(phi), (drive.r_m + w) * np.sin(phi) + v * np.cos(phi)])
-    e_theta = -th * float(n @ np.array([-(p_flex - A)[1], (p_flex - A)[0]]))  # the point's move R90 (P - A) theta, along n
+    e_theta = -th * float(
+        n @ np.array([-(p_flex - A)[1], (p_flex - A)[0]])
+    )  # the point's move R90 (P - A) theta, along n
     return delta_0 - w * sin_(a_b) - sgn * v * cos(a_b) + e_theta
 
 

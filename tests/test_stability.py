@@ -21,19 +21,19 @@ from math import pi
 import numpy as np
 import pytest
 import shapely
+from conftest import TEMPLATES
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 from scipy.optimize import brentq
 
 import wgcad.report.drive as report_mod
-from conftest import TEMPLATES
 from wgcad import constants
 from wgcad.clearance.distance import Template, signed_clearance
 from wgcad.clearance.engine import AuditSettings, Scene, audit
-from wgcad.laws import _FF_BETA_HI, _FF_BETA_LO
 from wgcad.design import _TABLES, parse_design
 from wgcad.drive import build_drive, tooth_spec
 from wgcad.errors import DesignError
+from wgcad.laws import _FF_BETA_HI, _FF_BETA_LO
 from wgcad.placement import place_flex_teeth, tooth_angles, tooth_pose, transform
 from wgcad.profiles import cycloid as cy
 from wgcad.profiles.gear import _fillet_fits, largest_fillet_coef
@@ -122,18 +122,39 @@ def designs(draw):
         if draw(st.integers(0, 2)) == 0:
             g["thinning"] = draw(_f(-0.05, 0.1)) * m
         if draw(st.integers(0, 3)) == 0:  # truncated (or raised) tip, relative to the standard one
-            r_a, _ = closed_radii(form, m, z_of[which], internal, g.get("shift", 0.0),
-                                  tooth.get("addendum_coef", 1.0), tooth["clearance_coef"])
+            r_a, _ = closed_radii(
+                form,
+                m,
+                z_of[which],
+                internal,
+                g.get("shift", 0.0),
+                tooth.get("addendum_coef", 1.0),
+                tooth["clearance_coef"],
+            )
             g["tip_radius"] = r_a + (1 if internal else -1) * draw(_f(-0.2, 0.6)) * m
         if draw(st.integers(0, 5)) == 0:
-            _, r_f = closed_radii(form, m, z_of[which], internal, g.get("shift", 0.0),
-                                  tooth.get("addendum_coef", 1.0), tooth["clearance_coef"])
+            _, r_f = closed_radii(
+                form,
+                m,
+                z_of[which],
+                internal,
+                g.get("shift", 0.0),
+                tooth.get("addendum_coef", 1.0),
+                tooth["clearance_coef"],
+            )
             g["root_radius"] = r_f + draw(_f(-0.3, 0.3)) * m
         return g
 
     return {
-        "drive": {"name": "random", "module": m, "z_flex": z, "z_rigid": z_of["rigid"], "waves": waves,
-                  "deformation": "external" if external else "internal", "face_width": face},
+        "drive": {
+            "name": "random",
+            "module": m,
+            "z_flex": z,
+            "z_rigid": z_of["rigid"],
+            "waves": waves,
+            "deformation": "external" if external else "internal",
+            "face_width": face,
+        },
         "tooth": tooth,
         "flexspline": gear("flexspline"),
         "rigid": gear("rigid"),
@@ -200,8 +221,17 @@ def check_drive(data, drive, rep) -> None:
         z = d["z_flex"] if which == "flexspline" else d["z_rigid"]
         check_outline(gear)
         assert fig["outline_area_mm2"] > 0
-        r_a, r_f = closed_radii(form, m, z, internal, gs.get("shift", 0.0), t.get("addendum_coef", 1.0), c_star,
-                                gs.get("tip_radius"), gs.get("root_radius"))
+        r_a, r_f = closed_radii(
+            form,
+            m,
+            z,
+            internal,
+            gs.get("shift", 0.0),
+            t.get("addendum_coef", 1.0),
+            c_star,
+            gs.get("tip_radius"),
+            gs.get("root_radius"),
+        )
         # the teeth lie between their tip and root circles (the clearance engine's radial bounds rely on it)
         R = np.hypot(gear.outline[:, 0], gear.outline[:, 1])
         assert min(r_a, r_f) - 1e-9 <= R.min() and R.max() <= max(r_a, r_f) + 1e-9
@@ -234,8 +264,12 @@ def check_drive(data, drive, rep) -> None:
         # depth = w_major + r_a(flex) - r_a(rigid), sign-adjusted; the clearances close the tooth heights
         depth = sgn * (rep["flexspline"]["tip_radius_mm"] + mesh["w_major_mm"] - rep["rigid"]["tip_radius_mm"])
         assert mesh["depth_of_engagement_mm"] == pytest.approx(depth, abs=3e-6), where
-        assert mesh["depth_of_engagement_mm"] * 1e3 + mesh["clearance_flex_tip_major_um"] == pytest.approx(1e3 * heights["rigid"], abs=3e-3)
-        assert mesh["depth_of_engagement_mm"] * 1e3 + mesh["clearance_rigid_tip_major_um"] == pytest.approx(1e3 * heights["flexspline"], abs=3e-3)
+        assert mesh["depth_of_engagement_mm"] * 1e3 + mesh["clearance_flex_tip_major_um"] == pytest.approx(
+            1e3 * heights["rigid"], abs=3e-3
+        )
+        assert mesh["depth_of_engagement_mm"] * 1e3 + mesh["clearance_rigid_tip_major_um"] == pytest.approx(
+            1e3 * heights["flexspline"], abs=3e-3
+        )
     for v in rep["placement"].values():
         assert v >= 0
 
@@ -294,7 +328,15 @@ def check_audit(drive, n_sections: int, picks: list) -> None:
     assert c[w["tooth"]] == pytest.approx(res.min_clearance, abs=1e-9)
 
 
-STATS = {"built": 0, "raised": 0, "audited": 0, "messages": Counter(), "fields": Counter(), "kinds": Counter(), "audited_laws": Counter()}
+STATS = {
+    "built": 0,
+    "raised": 0,
+    "audited": 0,
+    "messages": Counter(),
+    "fields": Counter(),
+    "kinds": Counter(),
+    "audited_laws": Counter(),
+}
 
 
 def _one(data, audit_spec):
@@ -325,8 +367,13 @@ audit_specs = st.one_of(
     st.tuples(st.integers(1, 2), st.lists(st.integers(0, len(AUDIT_ANGLES) - 1), min_size=1, max_size=2, unique=True)),
 )
 
-_sweep = settings(derandomize=True, max_examples=N_EXAMPLES, deadline=None, database=None,
-                  suppress_health_check=[HealthCheck.too_slow, HealthCheck.data_too_large])(given(designs(), audit_specs)(_one))
+_sweep = settings(
+    derandomize=True,
+    max_examples=N_EXAMPLES,
+    deadline=None,
+    database=None,
+    suppress_health_check=[HealthCheck.too_slow, HealthCheck.data_too_large],
+)(given(designs(), audit_specs)(_one))
 
 
 def _pin_hypothesis_constants(monkeypatch):
@@ -357,8 +404,13 @@ def test_random_designs_build_with_invariants_or_raise_design_error(monkeypatch)
         STATS[key].clear()
     _sweep()
     n = STATS["built"] + STATS["raised"]
-    print(f"\nrandom designs: {n} examples, {STATS['built']} built ({STATS['audited']} audited), {STATS['raised']} DesignError")
-    print("  built, by law and tooth form: " + ", ".join(f"{law}/{form} {c}" for (law, form), c in sorted(STATS["kinds"].items())))
+    print(
+        f"\nrandom designs: {n} examples, {STATS['built']} built ({STATS['audited']} audited), {STATS['raised']} DesignError"
+    )
+    print(
+        "  built, by law and tooth form: "
+        + ", ".join(f"{law}/{form} {c}" for (law, form), c in sorted(STATS["kinds"].items()))
+    )
     print("  audited, by law: " + ", ".join(f"{law} {c}" for law, c in sorted(STATS["audited_laws"].items())))
     for field, c in STATS["fields"].most_common():
         print(f"  {c:4d}  {field}")
@@ -370,9 +422,18 @@ def test_random_designs_build_with_invariants_or_raise_design_error(monkeypatch)
 
 
 # ----------------------------------------------------------------------------- four-force band: rejected, never skipped
-@pytest.mark.parametrize("beta_deg,builds", [
-    (40.70, True), (40.71, False), (42.0, False), (43.89, False), (45.0, False), (49.29, False), (49.30, True),
-])
+@pytest.mark.parametrize(
+    "beta_deg,builds",
+    [
+        (40.70, True),
+        (40.71, False),
+        (42.0, False),
+        (43.89, False),
+        (45.0, False),
+        (49.29, False),
+        (49.30, True),
+    ],
+)
 def test_four_force_band_raises_design_error(beta_deg, builds):
     data = template("d1_involute")
     data["generator"]["beta_deg"] = beta_deg
@@ -435,15 +496,25 @@ def _raw_figures(data, monkeypatch) -> tuple[dict, dict]:
     flat["audit.min_clearance_mm"] = res.min_clearance
     flat["audit.entry_gap_mm"] = res.entry_gap
     flat["audit.backlash_at_pitch_mm"] = res.backlash * drive.rigid.r if math.isfinite(res.backlash) else None
-    per = {w: float(np.sum(np.hypot(*np.diff(g.outline, axis=0, append=g.outline[:1]).T)))
-           for w, g in (("flexspline", drive.flex), ("rigid", drive.rigid))}
+    per = {
+        w: float(np.sum(np.hypot(*np.diff(g.outline, axis=0, append=g.outline[:1]).T)))
+        for w, g in (("flexspline", drive.flex), ("rigid", drive.rigid))
+    }
     return flat, per
 
 
-CONDITIONING = [(name, table, key) for name in ("d1_involute", "d4_discrete", "d1_cycloidal", "d3_external")
-                for table, key in (("drive", "module"), ("flexspline", "shift"), ("rigid", "shift"),
-                                   ("generator", "w0_coef"), ("generator", "beta_deg"))
-                if key in template(name)[table]]  # cycloidal teeth have no shift
+CONDITIONING = [
+    (name, table, key)
+    for name in ("d1_involute", "d4_discrete", "d1_cycloidal", "d3_external")
+    for table, key in (
+        ("drive", "module"),
+        ("flexspline", "shift"),
+        ("rigid", "shift"),
+        ("generator", "w0_coef"),
+        ("generator", "beta_deg"),
+    )
+    if key in template(name)[table]
+]  # cycloidal teeth have no shift
 
 
 @pytest.mark.parametrize("name,table,key", CONDITIONING)
@@ -487,7 +558,11 @@ def _tip_thickness(form, m, z, internal, x, alpha, thinning, R):
 TIP_CASES = [
     ("d1_involute", "flexspline", "tip_radius"),
     ("d1_involute", "flexspline", "shift"),
-    ("d1_involute", "rigid", "tip_radius"),  # (no shift points D1's internal teeth: the tip moves out, where they are thicker)
+    (
+        "d1_involute",
+        "rigid",
+        "tip_radius",
+    ),  # (no shift points D1's internal teeth: the tip moves out, where they are thicker)
     ("d3_external", "flexspline", "tip_radius"),  # internal teeth of the external-deformation flexspline
     ("d3_external", "rigid", "shift"),
     ("d4_discrete", "flexspline", "tip_radius"),  # with thinning
@@ -531,7 +606,10 @@ def test_tip_thickness_at_the_minimum_builds_just_above_raises_just_below(name, 
     # eps in the parameter moves the tip thickness by ~eps (slope O(1) per mm, or per unit shift x m),
     # far above the ~1e-14 mm rounding of the closed form
     eps = 1e-9
-    for p, ok in ((p_star - eps * np.sign(grid[1] - grid[0]), True), (p_star + eps * np.sign(grid[1] - grid[0]), False)):
+    for p, ok in (
+        (p_star - eps * np.sign(grid[1] - grid[0]), True),
+        (p_star + eps * np.sign(grid[1] - grid[0]), False),
+    ):
         dd = copy.deepcopy(data)
         dd[which][via] = float(p)
         assert (excess(p) > 0) == ok
@@ -547,13 +625,16 @@ def test_tip_thickness_at_the_minimum_builds_just_above_raises_just_below(name, 
             assert "pointed teeth" in e.value.rule and e.value.field == f"{which}.{via}"
 
 
-@pytest.mark.parametrize("which,key,value,builds", [
-    ("rigid", "tip_radius", 81.0, False),  # internal teeth: tip beyond the pitch circle 80.8 (the sweep's find)
-    ("rigid", "tip_radius", 80.8, True),  # exactly on the pitch circle: no addendum left
-    ("flexspline", "tip_radius", 79.9, False),  # external teeth: tip inside the pitch circle 80
-    ("flexspline", "root_radius", 80.1, False),
-    ("rigid", "root_radius", 80.7, False),
-])
+@pytest.mark.parametrize(
+    "which,key,value,builds",
+    [
+        ("rigid", "tip_radius", 81.0, False),  # internal teeth: tip beyond the pitch circle 80.8 (the sweep's find)
+        ("rigid", "tip_radius", 80.8, True),  # exactly on the pitch circle: no addendum left
+        ("flexspline", "tip_radius", 79.9, False),  # external teeth: tip inside the pitch circle 80
+        ("flexspline", "root_radius", 80.1, False),
+        ("rigid", "root_radius", 80.7, False),
+    ],
+)
 def test_cycloidal_tip_or_root_across_the_pitch_circle_is_rejected(which, key, value, builds):
     # the addendum flank ends at the pitch circle: a tip beyond it used to build an outline that
     # dipped inside its own tip circle, and the audit, trusting the tip radius, missed overlaps
@@ -581,8 +662,13 @@ def test_pointed_cycloidal_tip_names_a_field_that_can_fix_it():
 
 
 # ----------------------------------------------------------------------------- near-degenerate: fillet at its largest radius
-FILLET_CASES = [("d1_involute", "rigid"), ("d1_involute", "flexspline"), ("d3_external", "flexspline"),
-                ("d3_external", "rigid"), ("d4_discrete", "rigid")]
+FILLET_CASES = [
+    ("d1_involute", "rigid"),
+    ("d1_involute", "flexspline"),
+    ("d3_external", "flexspline"),
+    ("d3_external", "rigid"),
+    ("d4_discrete", "rigid"),
+]
 
 
 @pytest.mark.parametrize("name,which", FILLET_CASES)
@@ -626,8 +712,16 @@ DIAMOND = np.array([[1.0, 0.0], [0.0, 1.0], [-1.0, 0.0], [0.0, -1.0]])
 
 
 def clearance(a, b, shift_b, rot_b=0.0, shift_a=(0.0, 0.0), rot_a=0.0):
-    return float(signed_clearance(Template(a), np.array([rot_a]), np.array([shift_a], dtype=float),
-                                  Template(b), np.array([rot_b]), np.array([shift_b], dtype=float))[0])
+    return float(
+        signed_clearance(
+            Template(a),
+            np.array([rot_a]),
+            np.array([shift_a], dtype=float),
+            Template(b),
+            np.array([rot_b]),
+            np.array([shift_b], dtype=float),
+        )[0]
+    )
 
 
 R2 = math.sqrt(0.5)
@@ -661,13 +755,17 @@ def test_exact_contact_is_zero_and_continuous(b, shift, direction, apart, into):
                 assert val == pytest.approx(coef * e, rel=1e-6, abs=1e-15)
 
 
-@pytest.mark.xfail(strict=True, reason="known limit: the overlap depth is that of the deepest vertex inside; "
-                   "bars crossing like '+' have none inside the other and read 0 (contact)")
+@pytest.mark.xfail(
+    strict=True,
+    reason="known limit: the overlap depth is that of the deepest vertex inside; "
+    "bars crossing like '+' have none inside the other and read 0 (contact)",
+)
 def test_plus_sign_overlap_reports_its_depth():
     # the overlap (0.2 x 0.2, area 0.04) has its deepest point 0.1 inside both bars' boundaries
     bar = np.array([[-2.0, -0.1], [2.0, -0.1], [2.0, 0.1], [-2.0, 0.1]])
-    c, a = signed_clearance(Template(bar), np.array([0.0]), np.zeros((1, 2)), Template(bar),
-                            np.array([pi / 2]), np.zeros((1, 2)), area=True)
+    c, a = signed_clearance(
+        Template(bar), np.array([0.0]), np.zeros((1, 2)), Template(bar), np.array([pi / 2]), np.zeros((1, 2)), area=True
+    )
     assert a[0] == pytest.approx(0.04)
     assert c[0] == pytest.approx(-0.1)
 
@@ -722,9 +820,23 @@ def test_audit_json_is_identical_except_elapsed_time(tmp_path):
     for seed in ("1", "2"):
         out = tmp_path / f"audit_{seed}.json"
         r = subprocess.run(
-            [sys.executable, "-m", "wgcad", "audit", str(TEMPLATES / "d1_involute.toml"), "--angles", "72", "--sections", "2",
-             "--json", str(out), "--quiet"],
-            env={**os.environ, "PYTHONHASHSEED": seed}, capture_output=True, text=True,
+            [
+                sys.executable,
+                "-m",
+                "wgcad",
+                "audit",
+                str(TEMPLATES / "d1_involute.toml"),
+                "--angles",
+                "72",
+                "--sections",
+                "2",
+                "--json",
+                str(out),
+                "--quiet",
+            ],
+            env={**os.environ, "PYTHONHASHSEED": seed},
+            capture_output=True,
+            text=True,
         )
         assert r.returncode in (0, 1), r.stderr  # 1: D1 interferes
         texts.append(out.read_text())
@@ -744,8 +856,11 @@ def test_audit_json_without_entry_crossing_is_strict_json(tmp_path):
     design = tmp_path / "d4_no_crossing.toml"
     design.write_text(edit_toml((TEMPLATES / "d4_discrete.toml").read_text(), "rigid", "shift", "0.0"))
     out = tmp_path / "audit.json"
-    r = subprocess.run([sys.executable, "-m", "wgcad", "audit", str(design), "--angles", "24", "--json", str(out), "--quiet"],
-                       capture_output=True, text=True)
+    r = subprocess.run(
+        [sys.executable, "-m", "wgcad", "audit", str(design), "--angles", "24", "--json", str(out), "--quiet"],
+        capture_output=True,
+        text=True,
+    )
     assert r.returncode == 1, r.stderr  # interference
     doc = json.loads(out.read_text(), parse_constant=lambda c: pytest.fail(f"{c} in the JSON"))
     assert doc["entry_gap_um"] is None

@@ -8,8 +8,8 @@ import time
 
 import numpy as np
 import pytest
-
 from conftest import ROOT, TEMPLATES
+
 from wgcad.errors import OutputError
 from wgcad.sweep.runner import plan_batch, run_sweep
 from wgcad.sweep.spec import parse_spec
@@ -23,25 +23,33 @@ D4 = str(TEMPLATES / "d4_discrete.toml")
 def _spec(seed=5, samples=6):
     # a grid of two generator deformations x random errors; the rigid run-out is normal about 5 um
     # with sd 10 um, so about a third of the draws are negative amplitudes the design rules refuse
-    return parse_spec({
-        "sweep": {"name": "dask test", "design": D4, "samples": samples, "seed": seed},
-        "figures": {"record": ["ke_pp_arcsec", "lost_motion_min_arcsec", "min_clearance_um"], "audit_step_deg": 1.0},
-        "parameters": {
-            "generator": {"w0_coef": {"grid": [1.05, 1.1]}},
-            "imperfections": {"rigid_runout_um": {"distribution": "normal", "mean": 5.0, "sd": 10.0},
-                              "flex_runout_um": {"distribution": "uniform", "lo": 0.0, "hi": 20.0},
-                              "flex_runout_phase_deg": {"distribution": "uniform", "lo": 0.0, "hi": 360.0}},
-        },
-        "limits": {"ke_pp_arcsec": {"max": 30.0}},
-    })
+    return parse_spec(
+        {
+            "sweep": {"name": "dask test", "design": D4, "samples": samples, "seed": seed},
+            "figures": {
+                "record": ["ke_pp_arcsec", "lost_motion_min_arcsec", "min_clearance_um"],
+                "audit_step_deg": 1.0,
+            },
+            "parameters": {
+                "generator": {"w0_coef": {"grid": [1.05, 1.1]}},
+                "imperfections": {
+                    "rigid_runout_um": {"distribution": "normal", "mean": 5.0, "sd": 10.0},
+                    "flex_runout_um": {"distribution": "uniform", "lo": 0.0, "hi": 20.0},
+                    "flex_runout_phase_deg": {"distribution": "uniform", "lo": 0.0, "hi": 360.0},
+                },
+            },
+            "limits": {"ke_pp_arcsec": {"max": 30.0}},
+        }
+    )
 
 
 @pytest.fixture(scope="module")
 def client():
     from distributed import Client, LocalCluster
 
-    cluster = LocalCluster(n_workers=2, threads_per_worker=1, processes=True, host="127.0.0.1",
-                           dashboard_address=None, silence_logs=40)
+    cluster = LocalCluster(
+        n_workers=2, threads_per_worker=1, processes=True, host="127.0.0.1", dashboard_address=None, silence_logs=40
+    )
     c = Client(cluster)
     yield c
     c.close()
@@ -123,14 +131,28 @@ def test_resume_after_kill_9(reference, tmp_path):
     spec_file.write_text(
         f'[sweep]\nname = "dask test"\ndesign = "{D4}"\nsamples = 6\nseed = 5\n'
         '[figures]\nrecord = ["ke_pp_arcsec", "lost_motion_min_arcsec", "min_clearance_um"]\naudit_step_deg = 1.0\n'
-        '[parameters.generator.w0_coef]\ngrid = [1.05, 1.1]\n'
+        "[parameters.generator.w0_coef]\ngrid = [1.05, 1.1]\n"
         '[parameters.imperfections.rigid_runout_um]\ndistribution = "normal"\nmean = 5.0\nsd = 10.0\n'
         '[parameters.imperfections.flex_runout_um]\ndistribution = "uniform"\nlo = 0.0\nhi = 20.0\n'
         '[parameters.imperfections.flex_runout_phase_deg]\ndistribution = "uniform"\nlo = 0.0\nhi = 360.0\n'
-        '[limits]\nke_pp_arcsec = { max = 30.0 }\n')
+        "[limits]\nke_pp_arcsec = { max = 30.0 }\n"
+    )
     out = tmp_path / "o"
     env = {**os.environ, "PYTHONPATH": str(ROOT)}
-    cmd = [sys.executable, "-m", "wgcad", "sweep", str(spec_file), "--workers", "0", "--batch", "1", "--out", str(out), "--no-plots"]
+    cmd = [
+        sys.executable,
+        "-m",
+        "wgcad",
+        "sweep",
+        str(spec_file),
+        "--workers",
+        "0",
+        "--batch",
+        "1",
+        "--out",
+        str(out),
+        "--no-plots",
+    ]
     p = subprocess.Popen(cmd, env=env, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
     chunks = out / "chunks"
     t0 = time.monotonic()

@@ -5,8 +5,8 @@ import math
 
 import numpy as np
 import pytest
-
 from conftest import TEMPLATES
+
 from wgcad.cli import main
 from wgcad.errors import DesignError
 from wgcad.sweep.sampling import sample_values, split_index
@@ -19,8 +19,12 @@ def _spec(**over):
     data = {
         "sweep": {"name": "t", "design": D4, "samples": 4, "seed": 7},
         "figures": {"record": ["ke_pp_arcsec"]},
-        "parameters": {"imperfections": {"rigid_runout_um": {"distribution": "uniform", "lo": 0.0, "hi": 30.0},
-                                         "rigid_runout_phase_deg": {"distribution": "normal", "mean": 0.0, "sd": 90.0}}},
+        "parameters": {
+            "imperfections": {
+                "rigid_runout_um": {"distribution": "uniform", "lo": 0.0, "hi": 30.0},
+                "rigid_runout_phase_deg": {"distribution": "normal", "mean": 0.0, "sd": 90.0},
+            }
+        },
         "limits": {"ke_pp_arcsec": {"max": 40.0}},
     }
     for k, v in over.items():
@@ -39,23 +43,48 @@ def test_template_spec_is_valid():
     assert d.total == 6 and d.grid_points == 6 and not d.random
 
 
-@pytest.mark.parametrize("change, field, words", [
-    ({"sweep": {"design": D4, "seed": 1, "sampels": 3}}, "sweep.sampels", "did you mean 'samples'"),
-    ({"sweep": {"design": D4}}, "sweep.seed", "required"),
-    ({"figures": {"record": ["ke_pp_arcsecs"]}}, "figures.record", "did you mean 'ke_pp_arcsec'"),
-    ({"figures": {"record": ["entry_gap_um@500Nm"]}}, "figures.record", "[bearing]"),
-    ({"figures": {"record": ["ke_pp_arcsec"], "ke_table": "each"}}, "figures.ke_table", "shared, per_sample"),
-    ({"parameters": {"generator": {"w0_cof": {"grid": [1.0]}}}}, "parameters.generator.w0_cof", "did you mean 'generator.w0_coef'"),
-    ({"parameters": {"imperfections": {"rigid_runout_um": {"distribution": "normal", "mean": 1.0, "sd": 0.0}}}},
-     "parameters.imperfections.rigid_runout_um.sd", "> 0"),
-    ({"parameters": {"imperfections": {"rigid_runout_um": {"distribution": "lognormal"}}}},
-     "parameters.imperfections.rigid_runout_um.distribution", "normal, uniform, grid"),
-    ({"parameters": {"drive": {"z_flex": {"distribution": "uniform", "lo": 80, "hi": 90}}}}, "parameters.drive.z_flex", "grid"),
-    ({"parameters": {"generator": {"law": {"grid": ["disc", "oval"]}}}}, "parameters.generator.law.grid[1]", "harmonic"),
-    ({"parameters": {"load": {"cam_offset_um": {"distribution": "uniform", "lo": 0.0, "hi": 10.0}}}}, "parameters.load.cam_offset_um", "no recorded figure depends on [load]"),
-    ({"limits": {"entry_gap_um": {"min": 0.0}}}, "limits.entry_gap_um", "not a recorded figure"),
-    ({"limits": {"ke_pp_arcsec": {"min": 5.0, "max": 1.0}}}, "limits.ke_pp_arcsec.max", "> min"),
-])
+@pytest.mark.parametrize(
+    "change, field, words",
+    [
+        ({"sweep": {"design": D4, "seed": 1, "sampels": 3}}, "sweep.sampels", "did you mean 'samples'"),
+        ({"sweep": {"design": D4}}, "sweep.seed", "required"),
+        ({"figures": {"record": ["ke_pp_arcsecs"]}}, "figures.record", "did you mean 'ke_pp_arcsec'"),
+        ({"figures": {"record": ["entry_gap_um@500Nm"]}}, "figures.record", "[bearing]"),
+        ({"figures": {"record": ["ke_pp_arcsec"], "ke_table": "each"}}, "figures.ke_table", "shared, per_sample"),
+        (
+            {"parameters": {"generator": {"w0_cof": {"grid": [1.0]}}}},
+            "parameters.generator.w0_cof",
+            "did you mean 'generator.w0_coef'",
+        ),
+        (
+            {"parameters": {"imperfections": {"rigid_runout_um": {"distribution": "normal", "mean": 1.0, "sd": 0.0}}}},
+            "parameters.imperfections.rigid_runout_um.sd",
+            "> 0",
+        ),
+        (
+            {"parameters": {"imperfections": {"rigid_runout_um": {"distribution": "lognormal"}}}},
+            "parameters.imperfections.rigid_runout_um.distribution",
+            "normal, uniform, grid",
+        ),
+        (
+            {"parameters": {"drive": {"z_flex": {"distribution": "uniform", "lo": 80, "hi": 90}}}},
+            "parameters.drive.z_flex",
+            "grid",
+        ),
+        (
+            {"parameters": {"generator": {"law": {"grid": ["disc", "oval"]}}}},
+            "parameters.generator.law.grid[1]",
+            "harmonic",
+        ),
+        (
+            {"parameters": {"load": {"cam_offset_um": {"distribution": "uniform", "lo": 0.0, "hi": 10.0}}}},
+            "parameters.load.cam_offset_um",
+            "no recorded figure depends on [load]",
+        ),
+        ({"limits": {"entry_gap_um": {"min": 0.0}}}, "limits.entry_gap_um", "not a recorded figure"),
+        ({"limits": {"ke_pp_arcsec": {"min": 5.0, "max": 1.0}}}, "limits.ke_pp_arcsec.max", "> min"),
+    ],
+)
 def test_bad_specs_name_the_field_and_rule(change, field, words):
     with pytest.raises(DesignError) as e:
         parse_spec(_spec(**change))
@@ -64,7 +93,9 @@ def test_bad_specs_name_the_field_and_rule(change, field, words):
 
 def test_cli_bad_spec_one_line_exit_2(tmp_path, capsys):
     p = tmp_path / "s.toml"
-    p.write_text(f'[sweep]\ndesign = "{D4}"\nseed = 1\n[figures]\nrecord = ["ke_pp_arcsec"]\n[parameters.generator.w0_coef]\ngrid = [1.1, 1.1]\n')
+    p.write_text(
+        f'[sweep]\ndesign = "{D4}"\nseed = 1\n[figures]\nrecord = ["ke_pp_arcsec"]\n[parameters.generator.w0_coef]\ngrid = [1.1, 1.1]\n'
+    )
     assert main(["sweep", str(p), "--workers", "0", "--out", str(tmp_path / "o")]) == 2
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and "parameters.generator.w0_coef.grid" in err[0] and "repeat" in err[0]
@@ -74,9 +105,15 @@ def test_cli_bad_spec_one_line_exit_2(tmp_path, capsys):
 
 
 def test_samples_depend_on_seed_and_index_only():
-    spec = parse_spec(_spec(parameters={"generator": {"w0_coef": {"grid": [1.05, 1.1, 1.15]}},
-                                        "imperfections": {"rigid_runout_um": {"distribution": "uniform", "lo": 0.0, "hi": 30.0}}},
-                            sweep={"design": D4, "samples": 5, "seed": 3}))
+    spec = parse_spec(
+        _spec(
+            parameters={
+                "generator": {"w0_coef": {"grid": [1.05, 1.1, 1.15]}},
+                "imperfections": {"rigid_runout_um": {"distribution": "uniform", "lo": 0.0, "hi": 30.0}},
+            },
+            sweep={"design": D4, "samples": 5, "seed": 3},
+        )
+    )
     pl = spec.payload()
     assert spec.total == 15
     fwd = [sample_values(pl, i) for i in range(15)]
@@ -84,23 +121,35 @@ def test_samples_depend_on_seed_and_index_only():
     assert fwd == back
     # grid point slowest, draw fastest; every grid point sees the same draws (common random numbers)
     assert [v["generator.w0_coef"] for v in fwd] == [1.05] * 5 + [1.1] * 5 + [1.15] * 5
-    assert [v["imperfections.rigid_runout_um"] for v in fwd[:5]] == [v["imperfections.rigid_runout_um"] for v in fwd[10:]]
+    assert [v["imperfections.rigid_runout_um"] for v in fwd[:5]] == [
+        v["imperfections.rigid_runout_um"] for v in fwd[10:]
+    ]
     assert split_index(13, 5, (3,)) == ((2,), 3)
     other = parse_spec(_spec(sweep={"design": D4, "samples": 5, "seed": 4}, parameters=spec_params(spec)))
     assert sample_values(other.payload(), 0) != fwd[0]
 
 
 def spec_params(spec):
-    return {"generator": {"w0_coef": {"grid": [1.05, 1.1, 1.15]}},
-            "imperfections": {"rigid_runout_um": {"distribution": "uniform", "lo": 0.0, "hi": 30.0}}}
+    return {
+        "generator": {"w0_coef": {"grid": [1.05, 1.1, 1.15]}},
+        "imperfections": {"rigid_runout_um": {"distribution": "uniform", "lo": 0.0, "hi": 30.0}},
+    }
 
 
 def test_distributions_have_their_moments():
     # 4000 draws: the sample mean is within 4 standard errors of the true mean (fails with p ~ 6e-5),
     # the uniform stays in its range, the normal's sd within 5 % (its standard error is ~1.1 %)
-    spec = parse_spec(_spec(sweep={"design": D4, "samples": 4000, "seed": 11}, parameters={"imperfections": {
-        "rigid_runout_um": {"distribution": "uniform", "lo": 10.0, "hi": 30.0},
-        "flex_runout_um": {"distribution": "normal", "mean": 50.0, "sd": 8.0}}}))
+    spec = parse_spec(
+        _spec(
+            sweep={"design": D4, "samples": 4000, "seed": 11},
+            parameters={
+                "imperfections": {
+                    "rigid_runout_um": {"distribution": "uniform", "lo": 10.0, "hi": 30.0},
+                    "flex_runout_um": {"distribution": "normal", "mean": 50.0, "sd": 8.0},
+                }
+            },
+        )
+    )
     pl = spec.payload()
     v = [sample_values(pl, i) for i in range(4000)]
     u = np.array([x["imperfections.rigid_runout_um"] for x in v])
@@ -115,10 +164,12 @@ def test_distributions_have_their_moments():
 
 def test_cli_run_in_process_writes_results_summary_and_pictures(tmp_path, capsys):
     p = tmp_path / "s.toml"
-    p.write_text(f'[sweep]\nname = "grid"\ndesign = "{D4}"\nseed = 1\nsamples = 2\n[figures]\nrecord = ["ke_pp_arcsec"]\n'
-                 '[parameters.generator.w0_coef]\ngrid = [1.05, 1.1]\n'
-                 '[parameters.imperfections.rigid_runout_um]\ndistribution = "uniform"\nlo = 0.0\nhi = 40.0\n'
-                 '[limits]\nke_pp_arcsec = { max = 40.0 }\n')
+    p.write_text(
+        f'[sweep]\nname = "grid"\ndesign = "{D4}"\nseed = 1\nsamples = 2\n[figures]\nrecord = ["ke_pp_arcsec"]\n'
+        "[parameters.generator.w0_coef]\ngrid = [1.05, 1.1]\n"
+        '[parameters.imperfections.rigid_runout_um]\ndistribution = "uniform"\nlo = 0.0\nhi = 40.0\n'
+        "[limits]\nke_pp_arcsec = { max = 40.0 }\n"
+    )
     out = tmp_path / "o"
     assert main(["sweep", str(p), "--workers", "0", "--out", str(out)]) == 0
     text = capsys.readouterr().out
@@ -168,24 +219,33 @@ def test_a_sample_that_fails_or_errors_is_counted_not_fatal(tmp_path, monkeypatc
 def test_loaded_figures_are_the_elastic_models():
     # figures under load against the elastic model called directly (wgcad audit --torque-nm's path);
     # the torque may be written 500.0 or 500
-    from wgcad.elastic.model import build_model
-    from wgcad.elastic.sweep import torque_sweep
     from wgcad.design import load_design
     from wgcad.drive import build_drive
+    from wgcad.elastic.model import build_model
+    from wgcad.elastic.sweep import torque_sweep
     from wgcad.sweep.tasks import run_sample
 
     d1 = str(TEMPLATES / "d1_involute.toml")
-    spec = parse_spec({"sweep": {"design": d1, "seed": 1},
-                       "figures": {"record": ["entry_gap_um@500.0Nm", "teeth_in_contact@500Nm"]},
-                       "parameters": {"load": {"cam_offset_um": {"grid": [30.0]}}}})
+    spec = parse_spec(
+        {
+            "sweep": {"design": d1, "seed": 1},
+            "figures": {"record": ["entry_gap_um@500.0Nm", "teeth_in_contact@500Nm"]},
+            "parameters": {"load": {"cam_offset_um": {"grid": [30.0]}}},
+        }
+    )
     row = run_sample(spec.payload(), 0)
     assert row["status"] == "ok", row["reason"]
     drive = build_drive(load_design(d1))
     lv = torque_sweep(build_model(drive, 3), [500.0], 30.0, drive.design.load.cam_offset_deg)["levels"][0]
     assert row["entry_gap_um@500.0Nm"] == lv["entry_gap_um"] and row["teeth_in_contact@500Nm"] == lv["teeth_in_contact"]
     with pytest.raises(DesignError, match="named twice"):
-        parse_spec({"sweep": {"design": d1, "seed": 1}, "figures": {"record": ["entry_gap_um@500.0Nm", "entry_gap_um@500Nm"]},
-                    "parameters": {"load": {"cam_offset_um": {"grid": [30.0]}}}})
+        parse_spec(
+            {
+                "sweep": {"design": d1, "seed": 1},
+                "figures": {"record": ["entry_gap_um@500.0Nm", "entry_gap_um@500Nm"]},
+                "parameters": {"load": {"cam_offset_um": {"grid": [30.0]}}},
+            }
+        )
 
 
 def test_spec_and_cli_do_not_import_dask_or_pyarrow():
@@ -193,8 +253,15 @@ def test_spec_and_cli_do_not_import_dask_or_pyarrow():
     import subprocess
     import sys
 
-    code = ("import sys, wgcad.cli, wgcad.sweep, wgcad.sweep.tasks, wgcad.sweep.store, wgcad.sweep.runner; "
-            "print(sorted(m for m in ('distributed', 'dask', 'pyarrow', 'matplotlib') if m in sys.modules))")
-    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True,
-                         env={**__import__("os").environ, "PYTHONPATH": str(TEMPLATES.parent)})
+    code = (
+        "import sys, wgcad.cli, wgcad.sweep, wgcad.sweep.tasks, wgcad.sweep.store, wgcad.sweep.runner; "
+        "print(sorted(m for m in ('distributed', 'dask', 'pyarrow', 'matplotlib') if m in sys.modules))"
+    )
+    out = subprocess.run(
+        [sys.executable, "-c", code],
+        capture_output=True,
+        text=True,
+        check=True,
+        env={**__import__("os").environ, "PYTHONPATH": str(TEMPLATES.parent)},
+    )
     assert out.stdout.strip() == "[]"

@@ -8,17 +8,31 @@ import pytest
 from wgcad.errors import OutputError
 from wgcad.sweep.store import Store, have_pyarrow
 
-COLS = ["sample", "grid_point", "draw", "generator.law", "imperfections.flex_runout_um", "ke_pp_arcsec", "status", "reason"]
+COLS = [
+    "sample",
+    "grid_point",
+    "draw",
+    "generator.law",
+    "imperfections.flex_runout_um",
+    "ke_pp_arcsec",
+    "status",
+    "reason",
+]
 
 
 def _chunk(a, b):
     n = b - a
     rng = np.random.default_rng(a)
-    return {"sample": list(range(a, b)), "grid_point": [0] * n, "draw": list(range(a, b)), "generator.law": ["disc"] * n,
-            "imperfections.flex_runout_um": list(rng.normal(size=n) * 1e-3 + 1 / 3),
-            "ke_pp_arcsec": [math.nan if i % 3 == 0 else float(x) for i, x in enumerate(rng.random(n) * 600)],
-            "status": ["refused" if i % 3 == 0 else "ok" for i in range(n)],
-            "reason": ["x.y: must be >= 0, got -1" if i % 3 == 0 else "" for i in range(n)]}
+    return {
+        "sample": list(range(a, b)),
+        "grid_point": [0] * n,
+        "draw": list(range(a, b)),
+        "generator.law": ["disc"] * n,
+        "imperfections.flex_runout_um": list(rng.normal(size=n) * 1e-3 + 1 / 3),
+        "ke_pp_arcsec": [math.nan if i % 3 == 0 else float(x) for i, x in enumerate(rng.random(n) * 600)],
+        "status": ["refused" if i % 3 == 0 else "ok" for i in range(n)],
+        "reason": ["x.y: must be >= 0, got -1" if i % 3 == 0 else "" for i in range(n)],
+    }
 
 
 @pytest.mark.parametrize("fmt", ["csv"] + (["parquet"] if have_pyarrow() else []))

@@ -4,14 +4,14 @@ import math
 
 import numpy as np
 import pytest
+from conftest import TEMPLATES
 from scipy.stats import binom
 
-from conftest import TEMPLATES
 from wgcad.accuracy import ke as K
-from wgcad.placement.imperfect import Imperfections
 from wgcad.design import load_design
 from wgcad.design.schema import parse_design
 from wgcad.drive import build_drive
+from wgcad.placement.imperfect import Imperfections
 from wgcad.sweep.runner import run_sweep
 from wgcad.sweep.sampling import sample_design_data, sample_values
 from wgcad.sweep.spec import parse_spec
@@ -74,12 +74,14 @@ def threshold_um(d4):
 
 def test_yield_against_the_known_fraction(threshold_um, tmp_path):
     # one parameter, uniform on [0, 60] um, and a limit it crosses once at F*: the exact yield is F* / 60
-    spec = parse_spec({
-        "sweep": {"name": "known", "design": D4, "samples": 48, "seed": 2026},
-        "figures": {"record": ["ke_pp_arcsec"]},
-        "parameters": {"imperfections": {"rigid_runout_um": {"distribution": "uniform", "lo": 0.0, "hi": F_HI}}},
-        "limits": {"ke_pp_arcsec": {"max": LIMIT}},
-    })
+    spec = parse_spec(
+        {
+            "sweep": {"name": "known", "design": D4, "samples": 48, "seed": 2026},
+            "figures": {"record": ["ke_pp_arcsec"]},
+            "parameters": {"imperfections": {"rigid_runout_um": {"distribution": "uniform", "lo": 0.0, "hi": F_HI}}},
+            "limits": {"ke_pp_arcsec": {"max": LIMIT}},
+        }
+    )
     run_sweep(spec, tmp_path, workers=0, batch=16)
     pl = spec.payload()
     cols = Store(tmp_path, pl["fingerprint"], columns_of(pl), spec.total).read()
@@ -120,13 +122,19 @@ def test_shared_table_gives_the_per_sample_table_result():
 
 def test_per_sample_table_is_wgcad_ke_exactly():
     # figures.ke_table = "per_sample": the table wgcad ke would build for each drive, so the same number
-    spec = parse_spec({
-        "sweep": {"name": "own", "design": D4, "samples": 2, "seed": 9},
-        "figures": {"record": ["ke_pp_arcsec"], "ke_table": "per_sample"},
-        "parameters": {"imperfections": {"rigid_runout_um": {"distribution": "uniform", "lo": 0.0, "hi": 40.0},
-                                         "flex_eccentricity_um": {"distribution": "uniform", "lo": 0.0, "hi": 15.0},
-                                         "cam_offset_fixed_um": {"distribution": "uniform", "lo": 0.0, "hi": 20.0}}},
-    })
+    spec = parse_spec(
+        {
+            "sweep": {"name": "own", "design": D4, "samples": 2, "seed": 9},
+            "figures": {"record": ["ke_pp_arcsec"], "ke_table": "per_sample"},
+            "parameters": {
+                "imperfections": {
+                    "rigid_runout_um": {"distribution": "uniform", "lo": 0.0, "hi": 40.0},
+                    "flex_eccentricity_um": {"distribution": "uniform", "lo": 0.0, "hi": 15.0},
+                    "cam_offset_fixed_um": {"distribution": "uniform", "lo": 0.0, "hi": 20.0},
+                }
+            },
+        }
+    )
     pl = spec.payload()
     for i in (0, 1):
         assert run_sample(pl, i)["ke_pp_arcsec"] == _own_table_ke(pl, i)

@@ -6,7 +6,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .clearance.engine import AuditResult, AuditSettings, audit
+from .clearance.engine import AuditSettings, audit
 from .design import load_design
 from .design.budget import DEFAULT_MAX_MEMORY_MB
 from .drive import build_drive
@@ -37,7 +37,7 @@ class RunSettings:
     def as_dict(self) -> dict:
         return dict(self.__dict__)
 
-    def check(self) -> "RunSettings":
+    def check(self) -> RunSettings:
         if not 1e-4 <= self.step_deg <= 90.0:
             raise DesignError("--step-deg", f"must be in [1e-4, 90] degrees, got {self.step_deg:g}")
         if not 1 <= self.sections <= 200:
@@ -70,8 +70,15 @@ def run_audit(design_path, rs: RunSettings, progress=None):
     design = load_design(design_path)
     n = int(round(360.0 / rs.step_deg))
     # judged before any large allocation: outlines, sample arrays and evaluation batches
-    run = {"angles": n, "sections": rs.sections, "use_period": rs.use_period, "use_waves": rs.use_waves,
-           "use_mirror": rs.use_mirror, "bound": rs.bound, "exports": False}
+    run = {
+        "angles": n,
+        "sections": rs.sections,
+        "use_period": rs.use_period,
+        "use_waves": rs.use_waves,
+        "use_mirror": rs.use_mirror,
+        "bound": rs.bound,
+        "exports": False,
+    }
     # the imperfect poses (docs/models.md 6.2) take the rigid gear as the fixed member (the housing's
     # frame); with a fixed flexspline the audit stays on perfect parts and says so (cli.common.not_modelled)
     imperfect = design.imperfections.any and design.drive.fixed == "rigid"
@@ -87,8 +94,11 @@ def run_audit(design_path, rs: RunSettings, progress=None):
 
         turns = full_cycle_turns(design.drive.z_flex, design.drive.z_rigid) if rs.turns is None else rs.turns
     elif rs.turns != 1:
-        raise DesignError("--turns", "sweeps more generator turns only for an imperfect drive (an [imperfections] table, "
-                          "rigid gear fixed): a perfect drive repeats every mesh period")
+        raise DesignError(
+            "--turns",
+            "sweeps more generator turns only for an imperfect drive (an [imperfections] table, "
+            "rigid gear fixed): a perfect drive repeats every mesh period",
+        )
     drive = build_drive(design, tol=rs.chord_tol_um * 1e-3, max_memory_mb=rs.max_memory_mb, run=run)
     angles = np.deg2rad(np.arange(n * turns) * (360.0 / n))
     settings = AuditSettings(
@@ -103,8 +113,8 @@ def run_audit(design_path, rs: RunSettings, progress=None):
         refine=rs.refine,
     )
     if imperfect:
-        from .placement.imperfect import Imperfections
         from .clearance.imperfect import audit_imperfect
+        from .placement.imperfect import Imperfections
 
         return drive, audit_imperfect(drive, settings, Imperfections.from_spec(design.imperfections), progress=progress)
     return drive, audit(drive, settings, progress=progress)

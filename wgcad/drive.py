@@ -8,10 +8,10 @@ from math import pi
 import numpy as np
 
 from . import constants
-from .laws import Law, coned_w0, make_law
 from .design import Design
 from .design.budget import DEFAULT_MAX_MEMORY_MB, check_budget, estimate_run
 from .errors import DesignError
+from .laws import Law, coned_w0, make_law
 from .profiles.gear import Gear, ToothSpec, _radii, make_gear
 
 __all__ = ["Drive", "build_drive", "tooth_spec"]
@@ -110,15 +110,26 @@ def _check_teeth_meet(design: Design) -> None:
         return
     need = w0 - depth  # the W0 at which the tips would just touch
     if need / design.module > 5.0:  # beyond the w0_coef bound: the tooth counts are the cause
-        raise DesignError("drive.z_rigid", f"the teeth never meet: the flexspline tips stay {-depth:.4f} mm short of the rigid "
-                                           f"tips on the major axis, and no W0 within the bound (5 m) closes the gap; "
-                                           "bring z_rigid near z_flex")
-    raise DesignError("generator.w0_coef", f"the teeth never meet: the flexspline tips stay {-depth:.4f} mm short of the rigid "
-                                           f"tips on the major axis; W0 must exceed {need:.4f} mm (w0_coef > {need / design.module:.4f})")
+        raise DesignError(
+            "drive.z_rigid",
+            f"the teeth never meet: the flexspline tips stay {-depth:.4f} mm short of the rigid "
+            f"tips on the major axis, and no W0 within the bound (5 m) closes the gap; "
+            "bring z_rigid near z_flex",
+        )
+    raise DesignError(
+        "generator.w0_coef",
+        f"the teeth never meet: the flexspline tips stay {-depth:.4f} mm short of the rigid "
+        f"tips on the major axis; W0 must exceed {need:.4f} mm (w0_coef > {need / design.module:.4f})",
+    )
 
 
-def build_drive(design: Design, tol: float = constants.CHORD_TOL, *, max_memory_mb: float | None = DEFAULT_MAX_MEMORY_MB,
-                run: dict | None = None) -> Drive:
+def build_drive(
+    design: Design,
+    tol: float = constants.CHORD_TOL,
+    *,
+    max_memory_mb: float | None = DEFAULT_MAX_MEMORY_MB,
+    run: dict | None = None,
+) -> Drive:
     """Build both gears and the deformation law, checking the derived geometry.
 
     Before any outline is sampled the run is estimated
@@ -152,13 +163,18 @@ def build_drive(design: Design, tol: float = constants.CHORD_TOL, *, max_memory_
         flex_rim = flex.r_f + h1
         rigid_rim = rigid.r_f - design.rigid.rim_thickness
         if rigid_rim <= 0:
-            raise DesignError("rigid.rim_thickness", f"{design.rigid.rim_thickness:g} mm leaves no bore inside the root circle {rigid.r_f:.4f} mm")
+            raise DesignError(
+                "rigid.rim_thickness",
+                f"{design.rigid.rim_thickness:g} mm leaves no bore inside the root circle {rigid.r_f:.4f} mm",
+            )
     else:
         r_m = flex.r_f - 0.5 * h1
         flex_rim = flex.r_f - h1
         rigid_rim = rigid.r_f + design.rigid.rim_thickness
         if flex_rim <= 0:
-            raise DesignError("flexspline.rim_thickness", f"{h1:g} mm leaves no bore inside the root circle {flex.r_f:.4f} mm")
+            raise DesignError(
+                "flexspline.rim_thickness", f"{h1:g} mm leaves no bore inside the root circle {flex.r_f:.4f} mm"
+            )
     g = design.generator
     law = make_law(
         g.law,

@@ -8,8 +8,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from wgcad.laws import Law
 from wgcad.errors import DesignError
+from wgcad.laws import Law
 
 __all__ = ["gear_ratios", "flex_rotation", "RingVelocities", "ring_generator_velocities"]
 
@@ -129,9 +129,7 @@ class RingVelocities:
             object.__setattr__(self, name, arr)
 
 
-def ring_generator_velocities(
-    law: Law, phi, omega_h: float, h_c: float, a_w: float
-) -> RingVelocities:
+def ring_generator_velocities(law: Law, phi, omega_h: float, h_c: float, a_w: float) -> RingVelocities:
     """Velocity fields of an external-deformation ring generator (docs/models.md 3.5).
 
     Follows [S3] as docs/models.md 3.5 writes it: phi = omega_h t, i.e. the angle

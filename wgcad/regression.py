@@ -39,8 +39,10 @@ class Drift:
     def __str__(self) -> str:
         if self.expected is None or self.actual is None:
             return f"  {self.key}: expected {self.expected}, got {self.actual}"
-        return (f"  {self.key}: expected {self.expected:.9g}, got {self.actual:.9g} "
-                f"(diff {self.actual - self.expected:+.3g}, tolerance {self.tol:.3g})")
+        return (
+            f"  {self.key}: expected {self.expected:.9g}, got {self.actual:.9g} "
+            f"(diff {self.actual - self.expected:+.3g}, tolerance {self.tol:.3g})"
+        )
 
 
 def baseline_figures(drive, audit_json: dict) -> dict:
@@ -52,7 +54,10 @@ def baseline_figures(drive, audit_json: dict) -> dict:
         lo, hi = sorted((gear.r_a, gear.r_f))
         # thickness at the pitch circle (virtual if outside the teeth) and mid-depth
         for label, R in (("pitch", gear.r), ("mid_depth", 0.5 * (lo + hi))):
-            fig[f"{name}.tooth_thickness_{label}_mm"] = {"value": float(gear.tooth_thickness(R)), "tol": THICKNESS_TOL_MM}
+            fig[f"{name}.tooth_thickness_{label}_mm"] = {
+                "value": float(gear.tooth_thickness(R)),
+                "tol": THICKNESS_TOL_MM,
+            }
         fig[f"{name}.tip_thickness_mm"] = {"value": gear.tip_thickness, "tol": THICKNESS_TOL_MM}
     for key in ("min_clearance_um", "entry_gap_um"):
         fig[key] = {"value": audit_json[key], "tol": CLEARANCE_TOL_UM}
@@ -63,7 +68,12 @@ def baseline_figures(drive, audit_json: dict) -> dict:
 
 def make_baseline(design_source: str, settings: dict, drive, audit_json: dict) -> dict:
     """A baseline document: design, settings to recompute with, figures with tolerances."""
-    return {"wgcad_baseline": FORMAT, "design": design_source, "settings": settings, "figures": baseline_figures(drive, audit_json)}
+    return {
+        "wgcad_baseline": FORMAT,
+        "design": design_source,
+        "settings": settings,
+        "figures": baseline_figures(drive, audit_json),
+    }
 
 
 def load_baseline(path) -> dict:

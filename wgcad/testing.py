@@ -17,8 +17,12 @@ __all__ = ["baseline_drifts", "assert_matches_baseline", "record_baseline"]
 
 def _settings(doc: dict) -> RunSettings:
     s = doc["settings"]
-    return RunSettings(step_deg=float(s["step_deg"]), sections=int(s["sections"]),
-                       chord_tol_um=float(s["chord_tol_um"]), interference_tol_um=float(s["interference_tol_um"]))
+    return RunSettings(
+        step_deg=float(s["step_deg"]),
+        sections=int(s["sections"]),
+        chord_tol_um=float(s["chord_tol_um"]),
+        interference_tol_um=float(s["interference_tol_um"]),
+    )
 
 
 def baseline_drifts(design_path, baseline_path) -> list:
@@ -39,5 +43,7 @@ def record_baseline(design_path, settings: RunSettings | None = None) -> dict:
     """A baseline document for a design (write it with ``json.dump``)."""
     rs = settings or RunSettings()
     drive, result = run_audit(design_path, rs)
-    keep = {k: v for k, v in rs.as_dict().items() if k in ("step_deg", "sections", "chord_tol_um", "interference_tol_um")}
+    keep = {
+        k: v for k, v in rs.as_dict().items() if k in ("step_deg", "sections", "chord_tol_um", "interference_tol_um")
+    }
     return make_baseline(str(design_path), keep, drive, audit_json(result))

@@ -89,7 +89,9 @@ class Eccentricities:
         for f in fields(self):
             val = _real(getattr(self, f.name), f"eccentricity.{f.name}")
             if not f.name.endswith("_phase") and val < 0.0:
-                raise DesignError(f"eccentricity.{f.name}", f"must be >= 0 mm (the phase carries the direction), got {val:g}")
+                raise DesignError(
+                    f"eccentricity.{f.name}", f"must be >= 0 mm (the phase carries the direction), got {val:g}"
+                )
             object.__setattr__(self, f.name, val)
 
 
@@ -120,7 +122,9 @@ class FlankErrors:
 def _angle(value, name: str, lo: float = 0.0, hi: float = 0.5 * math.pi) -> float:
     val = _real(value, name)
     if not lo < val < hi:
-        raise DesignError(name, f"must lie in ({math.degrees(lo):g}, {math.degrees(hi):g}) degrees, got {math.degrees(val):.10g}")
+        raise DesignError(
+            name, f"must lie in ({math.degrees(lo):g}, {math.degrees(hi):g}) degrees, got {math.degrees(val):.10g}"
+        )
     return val
 
 
@@ -166,8 +170,15 @@ def gear_angles(phi_h, z_flex: int, z_rigid: int, flex_start: float = 0.0, rigid
     return theta_flex, theta_rigid
 
 
-def flank_errors(theta_flex, theta_rigid, ecc: Eccentricities, alpha: float, alpha_w: float,
-                 engagement: str = "double", zone: float = 0.0) -> FlankErrors:
+def flank_errors(
+    theta_flex,
+    theta_rigid,
+    ecc: Eccentricities,
+    alpha: float,
+    alpha_w: float,
+    engagement: str = "double",
+    zone: float = 0.0,
+) -> FlankErrors:
     """Radial and tangential displacements dR, dT of [S2] (docs/models.md 6.1), vectorised.
 
     Parameters
@@ -256,7 +267,9 @@ def drive_displacements(drive, imp, phi_h, zone: float = 0.0):
     Z = zone + phi_h  # the zone's direction in the rigid gear's frame
     a_f = Z - phi_g  # the flexspline tooth there, in the flexspline's own frame
     g = imp.flex_install
-    T_f = imp.flex_ecc * np.stack([np.cos(imp.flex_ecc_phase + g + phi_g), np.sin(imp.flex_ecc_phase + g + phi_g)], axis=-1)
+    T_f = imp.flex_ecc * np.stack(
+        [np.cos(imp.flex_ecc_phase + g + phi_g), np.sin(imp.flex_ecc_phase + g + phi_g)], axis=-1
+    )
     D = T_f + cam_offset(imp, phi_h, phi_g) - rigid_translation(imp)
     er = np.stack([np.cos(Z), np.sin(Z)], axis=-1)
     et = np.stack([-np.sin(Z), np.cos(Z)], axis=-1)
@@ -268,8 +281,9 @@ def drive_displacements(drive, imp, phi_h, zone: float = 0.0):
     return dr, dt, (tan_f - tan_b) * math.cos(alpha)
 
 
-def drive_flank_errors(drive, imp, phi_h, engagement: str = "double", zone: float = 0.0,
-                       alpha_w: float | None = None) -> FlankErrors:
+def drive_flank_errors(
+    drive, imp, phi_h, engagement: str = "double", zone: float = 0.0, alpha_w: float | None = None
+) -> FlankErrors:
     """[S2]'s ``dR``, ``dT`` of an imperfect drive in a mesh zone (:func:`drive_displacements`), docs/models.md 6.1.
 
     ``alpha_w`` defaults to the profile angle (the teeth of both gears are cut to one rack)."""
@@ -280,9 +294,17 @@ def drive_flank_errors(drive, imp, phi_h, engagement: str = "double", zone: floa
     return _take_up(dr, dt, kin, alpha, alpha if alpha_w is None else alpha_w, engagement)
 
 
-def flank_errors_over_rotation(phi_h, z_flex: int, z_rigid: int, ecc: Eccentricities, alpha: float,
-                               alpha_w: float, flex_start: float = 0.0, rigid_start: float = 0.0,
-                               zone: float = 0.0) -> dict[str, FlankErrors]:
+def flank_errors_over_rotation(
+    phi_h,
+    z_flex: int,
+    z_rigid: int,
+    ecc: Eccentricities,
+    alpha: float,
+    alpha_w: float,
+    flex_start: float = 0.0,
+    rigid_start: float = 0.0,
+    zone: float = 0.0,
+) -> dict[str, FlankErrors]:
     """:func:`flank_errors` of every engagement type over generator angles ``phi_h`` (rad, relative to the rigid gear).
 
     Returns
@@ -294,12 +316,23 @@ def flank_errors_over_rotation(phi_h, z_flex: int, z_rigid: int, ecc: Eccentrici
     return {e: flank_errors(ty, tb, ecc, alpha, alpha_w, e, zone) for e in ENGAGEMENTS}
 
 
-def flank_error_table(generator_angle_deg, *, z_flex: int, z_rigid: int, pressure_angle_deg: float,
-                      working_pressure_angle_deg: float, flex_geometric_um: float = 0.0,
-                      flex_kinematic_um: float = 0.0, rigid_geometric_um: float = 0.0,
-                      rigid_kinematic_um: float = 0.0, flex_phase_deg: float = 0.0,
-                      rigid_phase_deg: float = 0.0, flex_start_deg: float = 0.0,
-                      rigid_start_deg: float = 0.0, zone_deg: float = 0.0):
+def flank_error_table(
+    generator_angle_deg,
+    *,
+    z_flex: int,
+    z_rigid: int,
+    pressure_angle_deg: float,
+    working_pressure_angle_deg: float,
+    flex_geometric_um: float = 0.0,
+    flex_kinematic_um: float = 0.0,
+    rigid_geometric_um: float = 0.0,
+    rigid_kinematic_um: float = 0.0,
+    flex_phase_deg: float = 0.0,
+    rigid_phase_deg: float = 0.0,
+    flex_start_deg: float = 0.0,
+    rigid_start_deg: float = 0.0,
+    zone_deg: float = 0.0,
+):
     """Both engagement types side by side, at the edge: degrees and micrometres in, a header and rows out.
 
     Returns
@@ -319,7 +352,10 @@ def flank_error_table(generator_angle_deg, *, z_flex: int, z_rigid: int, pressur
     )
     deg = np.atleast_1d(np.asarray(generator_angle_deg, dtype=np.float64)).ravel()
     res = flank_errors_over_rotation(
-        np.radians(deg), z_flex, z_rigid, ecc,
+        np.radians(deg),
+        z_flex,
+        z_rigid,
+        ecc,
         math.radians(_real(pressure_angle_deg, "pressure_angle_deg")),
         math.radians(_real(working_pressure_angle_deg, "working_pressure_angle_deg")),
         math.radians(_real(flex_start_deg, "flex_start_deg")),

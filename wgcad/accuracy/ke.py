@@ -58,9 +58,19 @@ from .ke_table import DEFAULT_N, ContactTable, LanePlan, _harmonics, _lanes, con
 #: generator angles per pass (a few MB of temporaries per lattice class)
 _SPAN = 1 << 16
 
-__all__ = ["ContactTable", "contact_table", "KEResult", "kinematic_error", "install_angle_scan",
-           "optimize_install_angle", "closing_direct", "spectrum", "expected_orders", "DEFAULT_N", "DEEP_OVERLAP"]
-
+__all__ = [
+    "ContactTable",
+    "contact_table",
+    "KEResult",
+    "kinematic_error",
+    "install_angle_scan",
+    "optimize_install_angle",
+    "closing_direct",
+    "spectrum",
+    "expected_orders",
+    "DEFAULT_N",
+    "DEEP_OVERLAP",
+]
 
 
 def _side_coeffs(tab, side, imp, lever):
@@ -71,8 +81,11 @@ def _side_coeffs(tab, side, imp, lever):
     if lever is None:
         return A, None, None
     key = "rigid_install" if lever == "rigid" else "flex_install"
-    return (A, _harmonics(tab, side, imp.replace(**{key: 0.0}), (lever,)),
-            _harmonics(tab, side, imp.replace(**{key: 0.5 * pi}), (lever,)))
+    return (
+        A,
+        _harmonics(tab, side, imp.replace(**{key: 0.0}), (lever,)),
+        _harmonics(tab, side, imp.replace(**{key: 0.5 * pi}), (lever,)),
+    )
 
 
 #: closing rotation (rad, negative: turning back) of the first contact's perfect pair beyond which the linear
@@ -123,8 +136,9 @@ def _record(tab: ContactTable) -> int:
     return int(np.ceil(tab.N * tab.z_b * u - 1e-9))
 
 
-def kinematic_error(drive, imp: Imperfections, n_per_mesh: int = DEFAULT_N, sections=None, table=None,
-                    samples: int | None = None) -> KEResult:
+def kinematic_error(
+    drive, imp: Imperfections, n_per_mesh: int = DEFAULT_N, sections=None, table=None, samples: int | None = None
+) -> KEResult:
     """No-load KE of an imperfect drive over one flexspline revolution (``|u_hg|`` generator turns).
 
     Parameters
@@ -151,8 +165,18 @@ def kinematic_error(drive, imp: Imperfections, n_per_mesh: int = DEFAULT_N, sect
     theta, lm = _theta(tab, dw, dn)
     phi_h = tab.sigma * np.arange(I) * 2 * pi / (tab.z_b * tab.N)
     eng = "single-flank (backlash)" if lm.min() >= 0 else "double-flank (interference)" if lm.max() < 0 else "mixed"
-    return KEResult(phi_h, dw, dn, lm, -(theta - theta[0]), tab.N, I / (tab.N * tab.z_b), eng,
-                    abs(gear_ratios(tab.z_g, tab.z_b)["u_hg"]), float(deep.mean()) if I else 0.0)
+    return KEResult(
+        phi_h,
+        dw,
+        dn,
+        lm,
+        -(theta - theta[0]),
+        tab.N,
+        I / (tab.N * tab.z_b),
+        eng,
+        abs(gear_ratios(tab.z_g, tab.z_b)["u_hg"]),
+        float(deep.mean()) if I else 0.0,
+    )
 
 
 def install_angle_scan(tab: ContactTable, imp: Imperfections, angles, lever: str = "rigid") -> np.ndarray:
@@ -178,7 +202,6 @@ def install_angle_scan(tab: ContactTable, imp: Imperfections, angles, lever: str
             hi[k] = max(hi[k], th.max())
             lo[k] = min(lo[k], th.min())
     return hi - lo
-
 
 
 def optimize_install_angle(tab: ContactTable, imp: Imperfections, lever: str = "rigid", n_grid: int = 36):
@@ -213,7 +236,7 @@ def spectrum(res: KEResult):
     """Amplitude spectrum of the KE over the record: orders (cycles per record) and amplitudes (rad)."""
     f = res.ke - res.ke.mean()
     amp = 2.0 * np.abs(np.fft.rfft(f)) / len(f)
-    return np.arange(len(amp)) * (res.flex_turns_per_record ** -1), amp
+    return np.arange(len(amp)) * (res.flex_turns_per_record**-1), amp
 
 
 def expected_orders(z_g: int, z_b: int) -> dict:

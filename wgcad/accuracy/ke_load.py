@@ -37,7 +37,6 @@ from ..placement.imperfect import Imperfections, cam_offset, flex_deviations, ri
 __all__ = ["LoadedKE", "sample_periods", "tooth_errors", "loaded_ke", "LoadedLever", "install_lever", "SCAN_ANGLES"]
 
 
-
 @dataclass
 class LoadedKE:
     """Loaded KE at whole mesh periods (radians; arrays over the samples)."""
@@ -105,11 +104,22 @@ def tooth_errors(model, imp: Imperfections, n: int):
     S = len(model.zs)
     E = cam_offset(imp, phi_h, phi_g)
     Eg = np.array([c * E[0] - s * E[1], s * E[0] + c * E[1]])
-    return (np.tile(turn, S), np.tile(move, (S, 1))), 1e3 * float(np.hypot(*Eg)), float(np.degrees(np.arctan2(Eg[1], Eg[0])))
+    return (
+        (np.tile(turn, S), np.tile(move, (S, 1))),
+        1e3 * float(np.hypot(*Eg)),
+        float(np.degrees(np.arctan2(Eg[1], Eg[0]))),
+    )
 
 
-def loaded_ke(drive, imp: Imperfections, torque_nm: float, samples: int | None = None, model=None, progress=None,
-              tol: float | None = None) -> LoadedKE:
+def loaded_ke(
+    drive,
+    imp: Imperfections,
+    torque_nm: float,
+    samples: int | None = None,
+    model=None,
+    progress=None,
+    tol: float | None = None,
+) -> LoadedKE:
     """The KE of an imperfect drive under ``torque_nm`` from the elastic model at whole mesh periods (module docstring).
 
     Parameters
@@ -151,8 +161,16 @@ def loaded_ke(drive, imp: Imperfections, torque_nm: float, samples: int | None =
             progress(i + 1, len(periods))
     sigma = 1 if d.rotation == "ccw" else -1
     phi_h = sigma * periods * 2.0 * pi / d.z_rigid
-    return LoadedKE(float(torque_nm), periods, phi_h, theta, -(theta - theta[0]), float(model.torque_sign * theta.mean()),
-                    teeth, time.perf_counter() - t0)
+    return LoadedKE(
+        float(torque_nm),
+        periods,
+        phi_h,
+        theta,
+        -(theta - theta[0]),
+        float(model.torque_sign * theta.mean()),
+        teeth,
+        time.perf_counter() - t0,
+    )
 
 
 #: installation angles of the loaded scan's coarse grid (20 deg): the largest KE under load against the angle
@@ -197,9 +215,17 @@ class LoadedLever:
         return self.design.ke_pp / self.best.ke_pp if self.best.ke_pp > 0 else float("inf")
 
 
-def install_lever(drive, imp: Imperfections, torque_nm: float, model=None, samples: int | None = None,
-                  scan_samples: int | None = None, n_grid: int = SCAN_ANGLES, progress=None,
-                  design: LoadedKE | None = None) -> LoadedLever:
+def install_lever(
+    drive,
+    imp: Imperfections,
+    torque_nm: float,
+    model=None,
+    samples: int | None = None,
+    scan_samples: int | None = None,
+    n_grid: int = SCAN_ANGLES,
+    progress=None,
+    design: LoadedKE | None = None,
+) -> LoadedLever:
     """The rigid gear's installation angle that lowers the largest KE under ``torque_nm`` most ([S4], docs/models.md 6.3).
 
     Each angle turns the rigid gear's error pattern (its run-out) against the

@@ -14,12 +14,19 @@ from math import pi
 
 import numpy as np
 
+from ..clearance.closing import closing_rotation
 from ..clearance.distance import Template
 from ..errors import DesignError
 from ..kinematics import gear_ratios
 from ..placement import tooth_pose
-from ..clearance.closing import closing_rotation
-from ..placement.imperfect import Imperfections, cam_offset, coning_factor, flex_deviations, rigid_deviations, rigid_translation
+from ..placement.imperfect import (
+    Imperfections,
+    cam_offset,
+    coning_factor,
+    flex_deviations,
+    rigid_deviations,
+    rigid_translation,
+)
 
 __all__ = ["ContactTable", "contact_table", "DEFAULT_N", "NT_MAX"]
 
@@ -63,11 +70,20 @@ class ContactTable:
 def _check(drive):
     d = drive.design.drive
     if d.fixed != "rigid":
-        raise DesignError("drive.fixed", f"wgcad ke models a fixed rigid gear, flexspline output (docs/models.md 6.2); got '{d.fixed}'")
+        raise DesignError(
+            "drive.fixed",
+            f"wgcad ke models a fixed rigid gear, flexspline output (docs/models.md 6.2); got '{d.fixed}'",
+        )
 
 
-def contact_table(drive, imp: Imperfections, n_per_mesh: int = DEFAULT_N, sections=None, reach_pitches: float = 0.5,
-                  exhaustive: bool = False) -> ContactTable:
+def contact_table(
+    drive,
+    imp: Imperfections,
+    n_per_mesh: int = DEFAULT_N,
+    sections=None,
+    reach_pitches: float = 0.5,
+    exhaustive: bool = False,
+) -> ContactTable:
     """Tabulate every tooth's contact on both sides at the ``N z_g`` lattice angles (module docstring).
 
     Parameters
@@ -106,8 +122,17 @@ def contact_table(drive, imp: Imperfections, n_per_mesh: int = DEFAULT_N, sectio
     fa = -phi * z_g / z_b  # generator angle that puts a tooth at phi with its material angle at phi (z_b - z_g)/z_b
     # radial reach of the linear errors (the cam-borne offset is in the table exactly), plus 2 um
     margin = 2e-3 + imp.flex_ecc + imp.rigid_ecc + imp.cam_flex + imp.cam_fixed
-    tab = ContactTable(z_g, z_b, n_per_mesh, list(sections), side_w, sigma, drive.flex.r, drive.rigid.r,
-                       (imp.cam_cam, imp.cam_cam_phase))
+    tab = ContactTable(
+        z_g,
+        z_b,
+        n_per_mesh,
+        list(sections),
+        side_w,
+        sigma,
+        drive.flex.r,
+        drive.rigid.r,
+        (imp.cam_cam, imp.cam_cam_phase),
+    )
     parts = {s: [] for s in (1, -1)}
     pending = {s: [] for s in (1, -1)}  # each section's solved pairs, for the second features
     h = 1e-6
@@ -138,8 +163,9 @@ def contact_table(drive, imp: Imperfections, n_per_mesh: int = DEFAULT_N, sectio
         for side in (1, -1):
             j = (lo + (1 if side > 0 else 0)) % z_b
             rb = (j + 0.5) * gamma_b
-            con = closing_rotation(flex, rot[idx], shift[idx], rigid, rb, np.zeros((len(idx), 2)), side,
-                                   reach_pitches * 2 * pi / z_g)
+            con = closing_rotation(
+                flex, rot[idx], shift[idx], rigid, rb, np.zeros((len(idx), 2)), side, reach_pitches * 2 * pi / z_g
+            )
             good = con.ok & (np.hypot(con.nt[:, 0], con.nt[:, 1]) * drive.rigid.r <= NT_MAX)
             k = np.nonzero(good)[0]
             rows = _rows(con, k, idx, rot, shift, drot, dshift, m_all, j, cz, side, np.zeros(len(k)))
@@ -151,17 +177,39 @@ def contact_table(drive, imp: Imperfections, n_per_mesh: int = DEFAULT_N, sectio
     # its own sensitivity, added as a further candidate (_second_features)
     if imp.cam_flex + imp.cam_fixed + imp.flex_ecc + imp.rigid_ecc > 0.0:
         for side in (1, -1):
-            keep = (np.ones(sum(len(x[1]) for x in pending[side]), dtype=bool) if exhaustive else
-                    _can_be_first(tab, side, imp, pending[side], flex, rigid))
+            keep = (
+                np.ones(sum(len(x[1]) for x in pending[side]), dtype=bool)
+                if exhaustive
+                else _can_be_first(tab, side, imp, pending[side], flex, rigid)
+            )
             at = 0
             for rows, k, idx, rot, shift, drot, dshift, j, cz, rb in pending[side]:
                 sub = np.nonzero(keep[at : at + len(k)])[0]
                 at += len(k)
                 rho = cz * (imp.cam_flex + imp.cam_fixed) + imp.flex_ecc + imp.rigid_ecc
                 if rho > 0.0 and sub.size:
-                    parts[side].extend(_second_features(flex, rigid, {key: v[sub] for key, v in rows.items()}, k[sub],
-                                                        idx, rot, shift, drot, dshift, m_all, j, cz, side, rb, rho,
-                                                        reach_pitches * 2 * pi / z_g, drive.rigid.r, warm=not exhaustive))
+                    parts[side].extend(
+                        _second_features(
+                            flex,
+                            rigid,
+                            {key: v[sub] for key, v in rows.items()},
+                            k[sub],
+                            idx,
+                            rot,
+                            shift,
+                            drot,
+                            dshift,
+                            m_all,
+                            j,
+                            cz,
+                            side,
+                            rb,
+                            rho,
+                            reach_pitches * 2 * pi / z_g,
+                            drive.rigid.r,
+                            warm=not exhaustive,
+                        )
+                    )
     for side in (1, -1):
         tab.sides[side] = {key: np.concatenate([p[key] for p in parts[side]]) for key in parts[side][0]}
         _refine(tab, side, imp, flex, rigid, reach_pitches * 2 * pi / z_g)
@@ -178,12 +226,20 @@ def _rows(con, k, idx, rot, shift, drot, dshift, m_all, j, cz, side, extra):
     dP = drot[k, None] * np.stack([-(p[:, 1] - sh[:, 1]), p[:, 0] - sh[:, 0]], -1) + ds
     rr = rot[idx[k]] + t
     return {
-        "m": m_all[idx[k]], "g": con.delta[k], "nt": nt,
+        "m": m_all[idx[k]],
+        "g": con.delta[k],
+        "nt": nt,
         "a_phi": np.einsum("ij,ij->i", dP, nt),
         "a_rho": np.cos(rr) * nt[:, 0] + np.sin(rr) * nt[:, 1],
         "a_beta": -q[:, 1] * nt[:, 0] + q[:, 0] * nt[:, 1],
-        "j": j[k], "c": np.full(len(k), cz),
-        "dP": dP, "rr": rr, "q": q, "rot": rot[idx[k]], "shift": shift[idx[k]], "extra": extra,
+        "j": j[k],
+        "c": np.full(len(k), cz),
+        "dP": dP,
+        "rr": rr,
+        "q": q,
+        "rot": rot[idx[k]],
+        "shift": shift[idx[k]],
+        "extra": extra,
     }
 
 
@@ -221,7 +277,9 @@ def _can_be_first(tab: ContactTable, side: int, imp: Imperfections, pending, fle
     ntn = np.concatenate([np.hypot(*r["nt"].T) for r, *_ in pending])
     # a second feature's contact point is on the tooth moved radially by up to the reach
     arm = float(np.hypot(*flex.local.T).max()) + imp.flex_ecc + imp.rigid_ecc + imp.cam_flex + imp.cam_fixed
-    speed = np.concatenate([np.hypot(*dshift[k].T) + np.abs(drot[k]) * arm for _, k, _, _, _, drot, dshift, *_ in pending])
+    speed = np.concatenate(
+        [np.hypot(*dshift[k].T) + np.abs(drot[k]) * arm for _, k, _, _, _, drot, dshift, *_ in pending]
+    )
     q_max = float(np.hypot(*rigid.local.T).max())
     A_b = 0.5 * imp.rigid_runout / tab.r_b
     A_a = (0.5 * imp.flex_runout + imp.flex_ecc) / tab.r_g
@@ -242,7 +300,9 @@ _RADIAL_STEPS = (-0.25, 0.25, -0.5, 0.5, -1.0, 1.0)
 _LINE_TOL = 0.01 / 206264.80624709636
 
 
-def _second_features(flex, rigid, rows, k, idx, rot, shift, drot, dshift, m_all, j, cz, side, rb, rho, reach, r_b, warm=True):
+def _second_features(
+    flex, rigid, rows, k, idx, rot, shift, drot, dshift, m_all, j, cz, side, rb, rho, reach, r_b, warm=True
+):
     """Contacts on the features a pair touches once the errors move its flexspline tooth radially by up to ``rho``.
 
     Where the tooth space is locally convex (a tip running from the other's
@@ -265,8 +325,20 @@ def _second_features(flex, rigid, rows, k, idx, rot, shift, drot, dshift, m_all,
         with np.errstate(invalid="ignore"):
             c2 = closing_rotation(flex, rot[ii], sh, rigid, rb[k[kk]], np.zeros((len(kk), 2)), side, reach, start=start)
             c2.delta = np.where(c2.ok, c2.delta, 0.0)
-            r2 = _rows(c2, np.arange(len(kk)), ii, rot, shift, drot[k[kk]], dshift[k[kk]], m_all, j[k[kk]], cz,
-                       side, np.ones(len(kk)))
+            r2 = _rows(
+                c2,
+                np.arange(len(kk)),
+                ii,
+                rot,
+                shift,
+                drot[k[kk]],
+                dshift[k[kk]],
+                m_all,
+                j[k[kk]],
+                cz,
+                side,
+                np.ones(len(kk)),
+            )
         return c2, r2
 
     # the full reach first, every pair: those whose closing rotation there is off the perfect contact's
@@ -297,8 +369,12 @@ def _second_features(flex, rigid, rows, k, idx, rot, shift, drot, dshift, m_all,
         off = c2.ok.copy()
         for g_l, a_l in lines:
             off &= ~(c2.delta >= g_l - dr * a_l - _LINE_TOL)  # a NaN line (none) does not hold it back
-        new = (off & np.all(np.isfinite(c2.nt), axis=1) & (np.hypot(*c2.nt.T) * r_b <= NT_MAX)
-               & (g0 >= rows["g"][kk] - 1e-12))
+        new = (
+            off
+            & np.all(np.isfinite(c2.nt), axis=1)
+            & (np.hypot(*c2.nt.T) * r_b <= NT_MAX)
+            & (g0 >= rows["g"][kk] - 1e-12)
+        )
         sel = np.nonzero(new)[0]
         lines.append((np.where(new, g0, np.nan), np.where(new, r2["a_rho"], np.nan)))
         if sel.size:
@@ -367,7 +443,9 @@ def _geometry(tab: ContactTable, side: int, i: np.ndarray, e: np.ndarray) -> dic
     return {"k": k, "sb": sb, "nx": cr * ntx - sr * nty, "ny": sr * ntx + cr * nty}
 
 
-def _terms(tab: ContactTable, side: int, imp: Imperfections, i: np.ndarray, e: np.ndarray, which: str, geo=None) -> np.ndarray:
+def _terms(
+    tab: ContactTable, side: int, imp: Imperfections, i: np.ndarray, e: np.ndarray, which: str, geo=None
+) -> np.ndarray:
     """One group of linear error terms of the closing rotation, for samples ``i`` (I, 1) and contacts ``e`` (I, C)."""
     S = tab.sides[side]
     z_g, z_b = tab.z_g, tab.z_b
@@ -433,14 +511,20 @@ def _harmonics(tab: ContactTable, side: int, imp: Imperfections, groups=("cam", 
         A_b = 0.5 * imp.rigid_runout / tab.r_b
         # T . n + dev_b[j] a_beta, j = j_e + q + s, dev_b = A_b sin((j + 1/2) 2 pi / z_b - gamma + xi)
         A[:, 0] += np.conj(T) * nt
-        A[:, 0] += S["a_beta"] * (-1j) * A_b * np.exp(1j * (imp.rigid_runout_phase - imp.rigid_install)
-                                                      + 2j * pi * (S["j"] + q + 0.5) / z_b)
+        A[:, 0] += (
+            S["a_beta"]
+            * (-1j)
+            * A_b
+            * np.exp(1j * (imp.rigid_runout_phase - imp.rigid_install) + 2j * pi * (S["j"] + q + 0.5) / z_b)
+        )
     if "flex" in groups:
         g = imp.flex_install
         A1 = 0.5 * imp.flex_runout / tab.r_g
         Ec = imp.flex_ecc * np.exp(-1j * (imp.flex_ecc_phase + g))
         # -dalpha[k] a_phi - drho[k] a_rho at a = 2 pi k / z_g: dalpha = Im(c_a e^{ia}), drho = Re(Ec e^{ia})
-        c_a = A1 * np.exp(1j * (imp.flex_runout_phase - g)) - (imp.flex_ecc / tab.r_g) * np.exp(-1j * (imp.flex_ecc_phase + g))
+        c_a = A1 * np.exp(1j * (imp.flex_runout_phase - g)) - (imp.flex_ecc / tab.r_g) * np.exp(
+            -1j * (imp.flex_ecc_phase + g)
+        )
         A[:, 1] += np.exp(2j * pi * p / z_g) * (-S["a_phi"] * (-1j) * c_a - S["a_rho"] * Ec)
     if "cam" in groups:
         # -c (E . n): the stationary part with the normal's wave, the flexspline-borne one turning with phi_g
@@ -528,8 +612,15 @@ class LanePlan:
             self.r.append(r)
 
 
-def lane_minimum(tab: ContactTable, lanes: np.ndarray, g: np.ndarray, A: np.ndarray, i: np.ndarray, block: int = _BLOCK,
-                 plan: LanePlan | None = None):
+def lane_minimum(
+    tab: ContactTable,
+    lanes: np.ndarray,
+    g: np.ndarray,
+    A: np.ndarray,
+    i: np.ndarray,
+    block: int = _BLOCK,
+    plan: LanePlan | None = None,
+):
     """The first contact of each sample: ``min_e g[e] + Re(A[e] . w(i))`` over its lanes, and which ``e`` it is.
 
     Exact, and cheaper than every lane at every sample: the samples of one
@@ -602,7 +693,9 @@ def _lanes(tab: ContactTable, side: int, imp: Imperfections, slack: float = 1.05
     cls = (-tab.sigma * np.arange(N)) % N  # lattice class of sample residue r
     mf = (S["m"] + M // 2) % M - M // 2  # folded lattice index
     cq = np.round(S["c"] * 1e6).astype(int)
-    group = np.unique(np.stack([zone, cq], 1), axis=0, return_inverse=True)[1].ravel()  # (zone, section) of each contact
+    group = np.unique(np.stack([zone, cq], 1), axis=0, return_inverse=True)[
+        1
+    ].ravel()  # (zone, section) of each contact
     out = []
     for r in range(N):
         e = np.nonzero(S["m"] % N == cls[r])[0]
@@ -617,10 +710,12 @@ def _lanes(tab: ContactTable, side: int, imp: Imperfections, slack: float = 1.05
             dk = np.abs(mf[grp] - mf[es]) // N  # teeth apart (same class: a whole number)
             dj = np.abs(((S["j"][grp] - S["j"][es] + (mf[grp] - mf[es]) // N) + z_b // 2) % z_b - z_b // 2)
             dnt = np.hypot(*(S["nt"][grp] - S["nt"][es]).T)
-            D = (Vmax[grp] * (dnt + ntn[es] * 2 * pi * dk / z_b)
-                 + A_b * (np.abs(S["a_beta"][grp] - S["a_beta"][es]) + np.abs(S["a_beta"][es]) * 2 * pi * dj / z_b)
-                 + A_a * (np.abs(S["a_phi"][grp] - S["a_phi"][es]) + np.abs(S["a_phi"][es]) * 2 * pi * dk / z_g)
-                 + imp.flex_ecc * (np.abs(S["a_rho"][grp] - S["a_rho"][es]) + np.abs(S["a_rho"][es]) * 2 * pi * dk / z_g))
+            D = (
+                Vmax[grp] * (dnt + ntn[es] * 2 * pi * dk / z_b)
+                + A_b * (np.abs(S["a_beta"][grp] - S["a_beta"][es]) + np.abs(S["a_beta"][es]) * 2 * pi * dj / z_b)
+                + A_a * (np.abs(S["a_phi"][grp] - S["a_phi"][es]) + np.abs(S["a_phi"][es]) * 2 * pi * dk / z_g)
+                + imp.flex_ecc * (np.abs(S["a_rho"][grp] - S["a_rho"][es]) + np.abs(S["a_rho"][es]) * 2 * pi * dk / z_g)
+            )
             far = S["g"][grp] - S["g"][es] > slack * D + 1e-12
             keep[np.nonzero(sel)[0][far]] = False
         out.append(e[keep])

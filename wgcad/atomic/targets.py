@@ -35,6 +35,7 @@ _PSEUDO_FS = {
     "binfmt_misc": "binary-format rules",
 }
 
+
 def _reason(exc: OSError) -> str:
     """Short reason of an OS error, without the path (the caller names it)."""
     return exc.strerror or type(exc).__name__
@@ -167,7 +168,9 @@ def check_writable_dir(path: str | os.PathLike) -> Path:
         raise OutputError(f"{folder}: output folder is not writable ({which} is {_kind(st.st_mode)}, not a folder)")
     fs = _mount_type(probe_dir)
     if fs in _PSEUDO_FS:
-        raise OutputError(f"{folder}: output folder is not writable (it is on a {fs} file system, which holds {_PSEUDO_FS[fs]}, not files)")
+        raise OutputError(
+            f"{folder}: output folder is not writable (it is on a {fs} file system, which holds {_PSEUDO_FS[fs]}, not files)"
+        )
     try:
         probe = _new_temp(probe_dir / ".wgcad-write-probe")
     except OSError as exc:

@@ -25,6 +25,7 @@ _TEMP_RE = re.compile(r"^\..+\.(\d+)-[0-9a-f]{12}\.tmp$")
 _LEGACY_TEMP_RE = re.compile(r"^\..+\.[0-9a-f]{12}\.tmp$")
 _LEGACY_TEMP_AGE_S = 3600.0
 
+
 def _pid_alive(pid: int) -> bool:
     if pid == os.getpid():
         return True

@@ -185,8 +185,9 @@ def discard_all(temps: Iterable[str | os.PathLike]) -> None:
         _remove_quietly(temp)
 
 
-def commit_all(pairs: Iterable[tuple[str | os.PathLike, str | os.PathLike]],
-               remove: Iterable[str | os.PathLike] = ()) -> None:
+def commit_all(
+    pairs: Iterable[tuple[str | os.PathLike, str | os.PathLike]], remove: Iterable[str | os.PathLike] = ()
+) -> None:
     """Rename several prepared temporary files onto their final names (and remove obsolete files).
 
     Every temporary file is checked (exists, regular file), every final name
@@ -237,8 +238,7 @@ def commit_all(pairs: Iterable[tuple[str | os.PathLike, str | os.PathLike]],
             except OSError as exc:
                 discard_all(t for _, t in pairs[k:])
                 raise OutputError(
-                    f"{final}: cannot write file ({_reason(exc)}); "
-                    f"{k} of {len(pairs)} files were already written"
+                    f"{final}: cannot write file ({_reason(exc)}); {k} of {len(pairs)} files were already written"
                 ) from exc
 
 

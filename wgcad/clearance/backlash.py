@@ -98,8 +98,11 @@ def backlash(scene: Scene, phi_h: float, z=None, exact: bool = False) -> float:
             if (d[i] - gap) / r_max >= best:
                 break
             # (a pair the polygons overlap but the curves do not starts from no turn)
-            angle[int(i)] = max(contact_angle(int(i), int(idx[i]), direction), 0.0) if exact else \
-                contact_angle(int(i), int(idx[i]), direction)
+            angle[int(i)] = (
+                max(contact_angle(int(i), int(idx[i]), direction), 0.0)
+                if exact
+                else contact_angle(int(i), int(idx[i]), direction)
+            )
             best = min(best, angle[int(i)])
         if exact and np.isfinite(best):
             best = _exact_side(scene, turned, idx, direction, d, angle, best, gap)

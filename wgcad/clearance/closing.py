@@ -70,8 +70,9 @@ def _turn(rot, shift, t):
     return rot + t, np.stack([c * shift[:, 0] - s * shift[:, 1], s * shift[:, 0] + c * shift[:, 1]], axis=-1)
 
 
-def closing_rotation(flex: Template, rot, shift, rigid: Template, rot_b, shift_b, side: float,
-                     reach: float, start=None) -> Contact:
+def closing_rotation(
+    flex: Template, rot, shift, rigid: Template, rot_b, shift_b, side: float, reach: float, start=None
+) -> Contact:
     """Rotation of the flexspline (about the axis, direction ``side``) that brings each tooth into contact with its rigid tooth.
 
     Newton's method on the gap (it falls at ``s (z x p) . n`` per radian),
@@ -117,8 +118,16 @@ def closing_rotation(flex: Template, rot, shift, rigid: Template, rot_b, shift_b
         d = np.hypot(*(line[:, 1] - line[:, 0]).T)
         over = np.nonzero(d == 0.0)[0]
         if over.size:
-            d[over] = signed_clearance(flex, r[over], sh[over], rigid, rot_b[idx][over], shift_b[idx][over],
-                                       b_geoms=rigid_g[idx][over], a_geoms=geo[over])
+            d[over] = signed_clearance(
+                flex,
+                r[over],
+                sh[over],
+                rigid,
+                rot_b[idx][over],
+                shift_b[idx][over],
+                b_geoms=rigid_g[idx][over],
+                a_geoms=geo[over],
+            )
             d[over] = np.minimum(d[over], -1e-15)
         return d, line
 
@@ -215,7 +224,9 @@ def closing_direct(drive, imp: Imperfections, phi_h: float, side: int, sections=
     """
     d = drive.design.drive
     if d.fixed != "rigid":
-        raise DesignError("drive.fixed", f"the imperfect poses take the rigid gear as fixed (docs/models.md 6.2); got '{d.fixed}'")
+        raise DesignError(
+            "drive.fixed", f"the imperfect poses take the rigid gear as fixed (docs/models.md 6.2); got '{d.fixed}'"
+        )
     z_b = d.z_rigid
     if sections is None:
         sections = [float(z) for z in drive.sections(3)] if drive.coned else [None]

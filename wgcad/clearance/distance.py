@@ -48,7 +48,7 @@ class Template:
             a = self.local
             self._seg_a = a
             self._seg_d = np.roll(a, -1, axis=0) - a
-            self._seg_l2 = np.maximum((self._seg_d ** 2).sum(-1), 1e-300)
+            self._seg_l2 = np.maximum((self._seg_d**2).sum(-1), 1e-300)
         a, d, l2 = self._seg_a, self._seg_d, self._seg_l2
         out = np.empty(len(pts))
         step = max(1, 400_000 // len(a))
@@ -71,7 +71,9 @@ def _relative(rot_a, shift_a, rot_b, shift_b):
     return rel, np.stack([c * d[:, 0] - s * d[:, 1], s * d[:, 0] + c * d[:, 1]], axis=-1)
 
 
-def signed_clearance(a: Template, rot_a, shift_a, b: Template, rot_b, shift_b, b_geoms=None, area: bool = False, a_geoms=None):
+def signed_clearance(
+    a: Template, rot_a, shift_a, b: Template, rot_b, shift_b, b_geoms=None, area: bool = False, a_geoms=None
+):
     """Signed clearance of pairs of rigid copies ``(A_k, B_k)``: > 0 apart, < 0 overlapping (minus the depth).
 
     The depth of an overlap is the largest distance by which a vertex of one

@@ -40,14 +40,40 @@ import numpy as np
 from .. import constants
 from ..placement import tooth_pose
 from .backlash import backlash
+from .entry import (
+    EDGES,
+    entry_crossings,
+    entry_gap,
+    entry_passages,
+    entry_pinch,
+    lipschitz_min,
+    location,
+    section_poses,
+    smallest,
+)
 from .findings import Finding
-from .entry import EDGES, entry_crossings, entry_gap, entry_passages, entry_pinch, lipschitz_min, location, section_poses, smallest
 from .scene import Scene, _classify, clearance_at_poses, refine_min, tooth_clearance, tooth_clearance_sections
 from .search import AuditSettings, _evaluate, _fold, _sample_phi, _SectionSearch
 
-__all__ = ["AuditSettings", "AuditResult", "Finding", "Scene", "tooth_clearance", "clearance_at_poses", "clearance_profile",
-           "clearance_vs_angle", "audit", "brute_force_min", "backlash", "entry_crossings", "entry_gap", "entry_pinch",
-           "lipschitz_min", "refine_min", "tooth_clearance_sections"]
+__all__ = [
+    "AuditSettings",
+    "AuditResult",
+    "Finding",
+    "Scene",
+    "tooth_clearance",
+    "clearance_at_poses",
+    "clearance_profile",
+    "clearance_vs_angle",
+    "audit",
+    "brute_force_min",
+    "backlash",
+    "entry_crossings",
+    "entry_gap",
+    "entry_pinch",
+    "lipschitz_min",
+    "refine_min",
+    "tooth_clearance_sections",
+]
 
 
 @dataclass
@@ -87,9 +113,13 @@ class AuditResult:
     def raw(self) -> dict:
         """Unrounded tooth angles (rad) of the tightest spot, the entry crossing and the pinch."""
         f = self.findings
-        return {"worst_phi": f["min_clearance"].tooth_angle, "entry_phi": f["entry_gap"].tooth_angle,
-                "crossing_phi": f["entry_crossing"].tooth_angle if "entry_crossing" in f else None,
-                "pinch_phi": f["entry_pinch"].tooth_angle, "min_clearance_polygon": f["min_clearance"].polygon_value}
+        return {
+            "worst_phi": f["min_clearance"].tooth_angle,
+            "entry_phi": f["entry_gap"].tooth_angle,
+            "crossing_phi": f["entry_crossing"].tooth_angle if "entry_crossing" in f else None,
+            "pinch_phi": f["entry_pinch"].tooth_angle,
+            "min_clearance_polygon": f["min_clearance"].polygon_value,
+        }
 
 
 #: refinement: above this many candidate samples they are first sorted out on polygons _FINE
@@ -119,7 +149,13 @@ def _ticker(progress):
 
 #: share of an audit's run time spent in each stage (measured on D1, full revolution, 3 sections):
 #: the progress fractions follow the work, not the stage count
-_STAGES = {"clearance": (0.0, 0.70), "refine": (0.70, 0.80), "entry gap": (0.80, 0.86), "pinch": (0.86, 0.95), "backlash": (0.95, 1.0)}
+_STAGES = {
+    "clearance": (0.0, 0.70),
+    "refine": (0.70, 0.80),
+    "entry gap": (0.80, 0.86),
+    "pinch": (0.86, 0.95),
+    "backlash": (0.95, 1.0),
+}
 
 
 def _stage(tick, name):
@@ -191,8 +227,13 @@ def audit(drive, settings: AuditSettings, progress=None) -> AuditResult:
     # coarse pass over every section first: the best of any prunes all; then finer strides
     best = _evaluate(scene, results, [r.coarse() for r in results], sections, lambda f: st(0.3 * f))
     for step, stride in enumerate((64, 16, 4, 1)):
-        best = _evaluate(scene, results, [r.candidates(stride, best) for r in results], sections,
-                         lambda f, s=step: st(0.3 + 0.15 * (s + f)))
+        best = _evaluate(
+            scene,
+            results,
+            [r.candidates(stride, best) for r in results],
+            sections,
+            lambda f, s=step: st(0.3 + 0.15 * (s + f)),
+        )
     best = _evaluate(scene, results, [r.culled_needed(best) for r in results], sections, lambda f: st(0.9 + 0.1 * f))
     best_poly = best
     # refinement on the exact curves of every sample that can hold the minimum
@@ -218,7 +259,9 @@ def audit(drive, settings: AuditSettings, progress=None) -> AuditResult:
         from ..drive import build_drive
 
         ref_scene = Scene(build_drive(drive.design, tol=drive.tol / _FINE))
-        cand_v = _chunked(lambda sl: tooth_clearance_sections(ref_scene, phi_sorted[cand_i[sl]], cand_s[sl], sections), len(cand_i))
+        cand_v = _chunked(
+            lambda sl: tooth_clearance_sections(ref_scene, phi_sorted[cand_i[sl]], cand_s[sl], sections), len(cand_i)
+        )
         n_fine = len(cand_v)
         o = np.argsort(cand_v, kind="stable")
         cand_s, cand_i, cand_v = cand_s[o], cand_i[o], cand_v[o]
@@ -234,12 +277,20 @@ def audit(drive, settings: AuditSettings, progress=None) -> AuditResult:
                 break
             # the 16 lowest first (they set the bar), then every remaining candidate in one batch:
             # the refinement's cost is per call, not per sample
-            live = np.nonzero(cand_v[at:] - ref_scene.chord_gap < exact_best)[0] + at if at else np.arange(min(16, len(cand_v)))
+            live = (
+                np.nonzero(cand_v[at:] - ref_scene.chord_gap < exact_best)[0] + at
+                if at
+                else np.arange(min(16, len(cand_v)))
+            )
             if live.size == 0:
                 break
             sl = live
-            vals = _chunked(lambda c: tooth_clearance_sections(scene, phi_sorted[cand_i[sl][c]], cand_s[sl][c], sections, exact=True),
-                            len(sl))
+            vals = _chunked(
+                lambda c: tooth_clearance_sections(
+                    scene, phi_sorted[cand_i[sl][c]], cand_s[sl][c], sections, exact=True
+                ),
+                len(sl),
+            )
             n_refined += len(vals)
             j = int(np.argmin(vals))
             if vals[j] < exact_best:
@@ -258,14 +309,24 @@ def audit(drive, settings: AuditSettings, progress=None) -> AuditResult:
     if np.isfinite(pinch_f.value) and pinch_f.value < best:
         # a pinch is a sample of the same clearance, found by its own finer search: the minimum holds it too
         best = float(pinch_f.value)
-        worst = _worst_finding(scene, phi_all, period, float(pinch_f.tooth_angle), pinch_f.section_z, settings.refine, angles,
-                               best, best_poly)
+        worst = _worst_finding(
+            scene,
+            phi_all,
+            period,
+            float(pinch_f.tooth_angle),
+            pinch_f.section_z,
+            settings.refine,
+            angles,
+            best,
+            best_poly,
+        )
     _stage(tick, "backlash")(0.0)
     # backlash at the first requested generator angle, middle section
     z_mid = sections[len(sections) // 2]
     bl = float(backlash(scene, float(angles[0]), z_mid, exact=settings.refine))
-    backlash_f = Finding("backlash", bl, "exact" if settings.refine else "brent",
-                         generator_angle=float(angles[0]), section_z=z_mid)
+    backlash_f = Finding(
+        "backlash", bl, "exact" if settings.refine else "brent", generator_angle=float(angles[0]), section_z=z_mid
+    )
     tick(1.0, "done")
     evaluated = int(sum(r.evaluated.sum() for r in results))
     counts = {
@@ -284,8 +345,11 @@ def audit(drive, settings: AuditSettings, progress=None) -> AuditResult:
         "angles": int(len(angles)),
         "angle_step_deg": round(float(np.rad2deg(np.median(np.diff(angles)))), 6) if len(angles) > 1 else None,
         "sections_z_mm": [None if z is None else round(z, 6) for z in sections],
-        "sections_note": ("identical sections (no coning): one computed" if not drive.coned else
-                          "coned: every section computed" + ("" if ends else "; the face ends were NOT checked")),
+        "sections_note": (
+            "identical sections (no coning): one computed"
+            if not drive.coned
+            else "coned: every section computed" + ("" if ends else "; the face ends were NOT checked")
+        ),
         "face_ends_checked": bool(ends),
         "mesh_period": bool(settings.use_period),
         "identical_waves": bool(settings.use_waves),
@@ -299,8 +363,13 @@ def audit(drive, settings: AuditSettings, progress=None) -> AuditResult:
     }
     res = AuditResult(
         settings=rs,
-        findings={"min_clearance": worst, "entry_gap": entry, "entry_crossing": crossing_f, "entry_pinch": pinch_f,
-                  "backlash": backlash_f},
+        findings={
+            "min_clearance": worst,
+            "entry_gap": entry,
+            "entry_crossing": crossing_f,
+            "entry_pinch": pinch_f,
+            "backlash": backlash_f,
+        },
         interference=best < -settings.interference_tol,
         interference_tol=settings.interference_tol,
         counts=counts,
@@ -318,28 +387,64 @@ def entry_findings(scene: Scene, sections: list, refine: bool, interference_tol:
     nan = float("nan")
     best = smallest(passages)
     if best is None:  # the tips never cross the rigid tip circle
-        return (Finding("entry_gap", nan, method), Finding("entry_crossing", nan, method),
-                Finding("entry_pinch", nan, method, details={"tip_to_tip_risk": False}))
+        return (
+            Finding("entry_gap", nan, method),
+            Finding("entry_crossing", nan, method),
+            Finding("entry_pinch", nan, method, details={"tip_to_tip_risk": False}),
+        )
     z = sections[best.index]
     e = EDGES.index(best.delta_edge)
     loc = location(scene, best.delta_phi, z, e)
-    per = [{"section_z": sections[p.index], "crossing": p.crossing, "crossing_gaps": p.crossing_gaps,
-            "pinch": p.pinch, "delta": p.delta, "delta_phi": p.delta_phi, "edge": p.delta_edge, "kind": p.delta_kind}
-           for p in passages]
-    gap = Finding("entry_gap", best.delta, method, tooth_angle=best.delta_phi, section_z=z, location=loc,
-                  details={"edge": best.delta_edge, "kind": best.delta_kind, "passages": per,
-                           "tip_to_tip_risk": bool(best.delta < interference_tol and loc == "tip")})
+    per = [
+        {
+            "section_z": sections[p.index],
+            "crossing": p.crossing,
+            "crossing_gaps": p.crossing_gaps,
+            "pinch": p.pinch,
+            "delta": p.delta,
+            "delta_phi": p.delta_phi,
+            "edge": p.delta_edge,
+            "kind": p.delta_kind,
+        }
+        for p in passages
+    ]
+    gap = Finding(
+        "entry_gap",
+        best.delta,
+        method,
+        tooth_angle=best.delta_phi,
+        section_z=z,
+        location=loc,
+        details={
+            "edge": best.delta_edge,
+            "kind": best.delta_kind,
+            "passages": per,
+            "tip_to_tip_risk": bool(best.delta < interference_tol and loc == "tip"),
+        },
+    )
     cr = min((p for p in passages if np.isfinite(p.crossing)), key=lambda p: min(p.crossing_gaps))
     ce = int(np.argmin(cr.crossing_gaps))
-    crossing = Finding("entry_crossing", float(cr.crossing_gaps[ce]), method, tooth_angle=cr.crossing,
-                       section_z=sections[cr.index], details={"edge": EDGES[ce],
-                                                              "crossing": "flexspline tip arc crossing the rigid tip circle"})
+    crossing = Finding(
+        "entry_crossing",
+        float(cr.crossing_gaps[ce]),
+        method,
+        tooth_angle=cr.crossing,
+        section_z=sections[cr.index],
+        details={"edge": EDGES[ce], "crossing": "flexspline tip arc crossing the rigid tip circle"},
+    )
     pins = [(pin[0], pin[1], p.index, e2) for p in passages for e2, pin in enumerate(p.pinch) if pin is not None]
     if pins:
         pv, pp, pk, pe = min(pins)
         ploc = location(scene, pp, sections[pk], pe)
-        pinch = Finding("entry_pinch", float(pv), method, tooth_angle=float(pp), section_z=sections[pk], location=ploc,
-                        details={"edge": EDGES[pe], "tip_to_tip_risk": bool(pv < interference_tol and ploc == "tip")})
+        pinch = Finding(
+            "entry_pinch",
+            float(pv),
+            method,
+            tooth_angle=float(pp),
+            section_z=sections[pk],
+            location=ploc,
+            details={"edge": EDGES[pe], "tip_to_tip_risk": bool(pv < interference_tol and ploc == "tip")},
+        )
     else:
         pinch = Finding("entry_pinch", nan, method, details={"tip_to_tip_risk": False})
     return gap, crossing, pinch
@@ -351,13 +456,18 @@ def accuracy_settings(drive, refine: bool) -> dict:
         "chord_tol_um": round(1e3 * drive.tol, 6),
         "refined": bool(refine),
         "refine_tol_um": round(1e3 * constants.REFINE_TOL, 6) if refine else None,
-        "error_side": ("figures on the exact curves, within refine_tol_um either side" if refine else
-                       "polygon figures: chords lie inside convex and outside concave curve parts, "
-                       "so each figure is within 2 x chord_tol_um of the exact one, either side"),
+        "error_side": (
+            "figures on the exact curves, within refine_tol_um either side"
+            if refine
+            else "polygon figures: chords lie inside convex and outside concave curve parts, "
+            "so each figure is within 2 x chord_tol_um of the exact one, either side"
+        ),
     }
 
 
-def _worst_finding(scene: Scene, phi_all, period, phi_w: float, z_w, exact: bool, angles, best: float, best_poly: float) -> Finding:
+def _worst_finding(
+    scene: Scene, phi_all, period, phi_w: float, z_w, exact: bool, angles, best: float, best_poly: float
+) -> Finding:
     """The smallest clearance as a :class:`Finding`: its canonical spot, the mirror image, the overlap area."""
     phi_c, loc, mirror_loc, flat, sgn_c = _canonical(scene, phi_all, period, phi_w, z_w, exact)
     ai, k = divmod(flat, scene.z_g)
@@ -366,10 +476,22 @@ def _worst_finding(scene: Scene, phi_all, period, phi_w: float, z_w, exact: bool
     side_val = {"lower": detail["lower"][0], "upper": detail["upper"][0], "third": detail["third"][0]}
     side = min(side_val, key=side_val.get)
     area = detail.get(f"{side}_area", np.zeros(1))[0] if side != "third" else 0.0
-    return Finding("min_clearance", float(best), "exact" if exact else "polygon", tooth_angle=float(phi_c), section_z=z_w,
-                   location=loc, generator_angle=float(angles[ai]), tooth=int(k), polygon_value=float(best_poly),
-                   details={"mirror": (float(-phi_c), mirror_loc), "sample_tooth_angle": float(phi_rep),
-                            "overlap_area": float(area)})
+    return Finding(
+        "min_clearance",
+        float(best),
+        "exact" if exact else "polygon",
+        tooth_angle=float(phi_c),
+        section_z=z_w,
+        location=loc,
+        generator_angle=float(angles[ai]),
+        tooth=int(k),
+        polygon_value=float(best_poly),
+        details={
+            "mirror": (float(-phi_c), mirror_loc),
+            "sample_tooth_angle": float(phi_rep),
+            "overlap_area": float(area),
+        },
+    )
 
 
 def brute_force_min(drive, angles: np.ndarray, sections) -> float:

@@ -30,8 +30,20 @@ import numpy as np
 from ..placement import transform
 from .scene import Scene, _classify
 
-__all__ = ["EntryPassage", "EDGES", "section_poses", "crossings", "edge_gaps", "entry_passages", "smallest",
-           "entry_crossings", "entry_gap", "entry_pinch", "lipschitz_min", "PINCH_STEP"]
+__all__ = [
+    "EntryPassage",
+    "EDGES",
+    "section_poses",
+    "crossings",
+    "edge_gaps",
+    "entry_passages",
+    "smallest",
+    "entry_crossings",
+    "entry_gap",
+    "entry_pinch",
+    "lipschitz_min",
+    "PINCH_STEP",
+]
 
 #: the two edges of a tooth pair, in the order of every ``(K, 2)`` array here
 EDGES = ("working", "non-working")
@@ -152,7 +164,7 @@ def edge_gaps(scene: Scene, rot: np.ndarray, shift: np.ndarray, exact: bool = Tr
     out = np.empty((len(rot), 2))
     if exact:
         val = scene.exact_to(np.concatenate([rot, rot]), np.concatenate([shift, shift]), np.concatenate([jw, jn]))[0]
-        out[:, 0], out[:, 1] = val[: len(rot)], val[len(rot):]
+        out[:, 0], out[:, 1] = val[: len(rot)], val[len(rot) :]
     else:
         out[:, 0] = scene.clearance_to(rot, shift, jw)
         out[:, 1] = scene.clearance_to(rot, shift, jn)
@@ -182,7 +194,7 @@ def _bands(scene: Scene, poses, starts: np.ndarray, module: float):
         b = c
         while b < len(grid) - 1 and inside[b + 1]:
             b += 1
-        bands[k] = grid[a:b + 1]
+        bands[k] = grid[a : b + 1]
     return bands
 
 
@@ -211,7 +223,7 @@ def _walk(scene: Scene, poses, starts: np.ndarray, noise: float):
     at = 0
     for k in live:
         n = len(bands[k])
-        gk = g[at:at + n]
+        gk = g[at : at + n]
         at += n
         for e in (0, 1):
             v = gk[:, e]
@@ -256,7 +268,9 @@ def _refine(scene: Scene, poses, jobs, exact: bool):
     for _ in range(_NEST):
         t = np.clip(c[:, None] + w[:, None] * u[None, :], lo[:, None], hi[:, None])
         rot, shift = poses(sgn * t.ravel(), np.repeat(k, _NEST_PTS))
-        g = edge_gaps(scene, rot, shift, exact=exact)[np.arange(J * _NEST_PTS), np.repeat(e, _NEST_PTS)].reshape(J, _NEST_PTS)
+        g = edge_gaps(scene, rot, shift, exact=exact)[np.arange(J * _NEST_PTS), np.repeat(e, _NEST_PTS)].reshape(
+            J, _NEST_PTS
+        )
         j = np.argmin(g, axis=1)
         gv = g[np.arange(J), j]
         better = gv < best
@@ -287,7 +301,9 @@ def entry_passages(scene: Scene, poses, K: int, exact: bool = True) -> list[Entr
     out = []
     for k in range(K):
         if not np.isfinite(phi_c[k]):
-            out.append(EntryPassage(k, float("nan"), (float("nan"),) * 2, (None, None), float("nan"), float("nan"), "", ""))
+            out.append(
+                EntryPassage(k, float("nan"), (float("nan"),) * 2, (None, None), float("nan"), float("nan"), "", "")
+            )
             continue
         pinch = tuple((found[(k, e)][0], sgn * found[(k, e)][1]) if (k, e) in found else None for e in (0, 1))
         cands = [(float(cg[k, e]), float(phi_c[k]), EDGES[e], "crossing") for e in (0, 1)]

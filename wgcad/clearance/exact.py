@@ -68,15 +68,17 @@ class ExactTooth:
             g = self.grid_p.reshape(-1, 2)
             self._g_c = g.mean(axis=0)
             self._g_rel = g - self._g_c
-            self._g_n2 = (self._g_rel ** 2).sum(-1)
+            self._g_n2 = (self._g_rel**2).sum(-1)
         p = pts - self._g_c
-        d2 = (p ** 2).sum(-1)[:, None] + self._g_n2[None, :] - 2.0 * (p @ self._g_rel.T)
+        d2 = (p**2).sum(-1)[:, None] + self._g_n2[None, :] - 2.0 * (p @ self._g_rel.T)
         return np.maximum(d2, 0.0).reshape(len(pts), self.n, -1)
 
     def _tables(self):
         """Per-piece parameters as arrays, so one call evaluates many pieces of one kind (by kind, not by piece)."""
         n = self.n
-        self.kind = np.array([{"arc": 0, "line": 1, "involute": 2, "epicycloid": 3, "hypocycloid": 3}[p.kind] for p in self.pieces])
+        self.kind = np.array(
+            [{"arc": 0, "line": 1, "involute": 2, "epicycloid": 3, "hypocycloid": 3}[p.kind] for p in self.pieces]
+        )
         par = np.zeros((n, 4))
         for i, p in enumerate(self.pieces):
             if p.kind == "arc":

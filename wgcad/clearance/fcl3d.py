@@ -122,7 +122,9 @@ def _flex_poses(scene: Scene, phi: float, zs: np.ndarray, track=None):
     return np.array([r[0] for r, _ in poses]), np.array([s[0] for _, s in poses])
 
 
-def flex_tooth_solid(scene: Scene, phi: float, n_sections: int = 9, sections=None, track=None) -> tuple[np.ndarray, np.ndarray]:
+def flex_tooth_solid(
+    scene: Scene, phi: float, n_sections: int = 9, sections=None, track=None
+) -> tuple[np.ndarray, np.ndarray]:
     """The flexspline tooth at tooth angle ``phi`` as a closed mesh lofted through its deformed cross-sections.
 
     Parameters
@@ -243,7 +245,11 @@ def fcl_distance(mesh_a, mesh_b, nearest: bool = False):
         overlapping = bool(fcl.collide(oa, ob, fcl.CollisionRequest(), cres) > 0 or cres.is_collision)
         d = 0.0
     if nearest:
-        return d, overlapping, (np.array(res.nearest_points[0], dtype=float), np.array(res.nearest_points[1], dtype=float))
+        return (
+            d,
+            overlapping,
+            (np.array(res.nearest_points[0], dtype=float), np.array(res.nearest_points[1], dtype=float)),
+        )
     return d, overlapping
 
 
@@ -319,10 +325,16 @@ def check_tooth(scene: Scene, phi: float, n_sections: int = 9, sections=None, tr
             if int(idx[0]) not in teeth:
                 teeth.append(int(idx[0]))
     # 2D: per section, per rigid tooth; and the engine's own figure
-    c = np.array([[float(scene.clearance_to(rot[k : k + 1], shift[k : k + 1], np.array([j]))[0]) for j in teeth]
-                  for k in range(len(zl))])  # (K, T)
+    c = np.array(
+        [
+            [float(scene.clearance_to(rot[k : k + 1], shift[k : k + 1], np.array([j]))[0]) for j in teeth]
+            for k in range(len(zl))
+        ]
+    )  # (K, T)
     # the engine's own figure of each section (its neighbour search and third-tooth bound)
-    c_engine = np.array([float(clearance_at_poses(scene, rot[k : k + 1], shift[k : k + 1])["min"][0]) for k in range(len(zl))])
+    c_engine = np.array(
+        [float(clearance_at_poses(scene, rot[k : k + 1], shift[k : k + 1])["min"][0]) for k in range(len(zl))]
+    )
     t_2d = time.perf_counter() - t0
     # bounds (coning only)
     if coned:
@@ -378,15 +390,21 @@ def check_tooth(scene: Scene, phi: float, n_sections: int = 9, sections=None, tr
         "sections_z_mm": [round(float(z), 6) for z in zs] if coned else None,
         "bound_um": (round(1e3 * max(c2d - lower, 0.0), 6) if coned else 0.0) if c2d >= 0 else None,
         "loft_error_um": round(1e3 * geom, 9),
-        "agree": bool(_agrees(c2d, d_min, ov_any, lower, not coned) and all(r["agree"] for _, r in per)
-                      and abs(c2d - c_pairs) <= FCL_TOL),
+        "agree": bool(
+            _agrees(c2d, d_min, ov_any, lower, not coned)
+            and all(r["agree"] for _, r in per)
+            and abs(c2d - c_pairs) <= FCL_TOL
+        ),
         "per_tooth": [r for _, r in per],
     }
     if "fcl_witness_z_mm" in best and not ov_any:
         out["fcl_witness_z_mm"] = best["fcl_witness_z_mm"]
         out["clearance_2d_at_witness_um"] = best["clearance_2d_at_witness_um"]
-    out["timing_ms"] = {"2d": round(1e3 * t_2d, 3), "fcl_total": round(1e3 * t_fcl, 3),
-                        "fcl_per_query": [round(q, 3) for q in query_ms]}
+    out["timing_ms"] = {
+        "2d": round(1e3 * t_2d, 3),
+        "fcl_total": round(1e3 * t_fcl, 3),
+        "fcl_per_query": [round(q, 3) for q in query_ms],
+    }
     return out
 
 
@@ -444,8 +462,11 @@ def verify_worst(drive, result, n_sections: int = 9, imp=None) -> dict:
         extra = [z for z in result.settings.get("sections_z_mm", []) if z is not None]
         zs = np.unique(np.round(np.concatenate([zs, np.asarray(extra, dtype=float)]), 12))
     if imp is not None:
-        return _summarise(drive, zs, [{"what": what, **_check_sample(scene, drive, imp, f, zs)}
-                                      for what, f in _imperfect_targets(result)])
+        return _summarise(
+            drive,
+            zs,
+            [{"what": what, **_check_sample(scene, drive, imp, f, zs)} for what, f in _imperfect_targets(result)],
+        )
     # the records' unrounded tooth angles (rad)
     f = result.findings
     targets = [("tightest", f["min_clearance"].tooth_angle)]
@@ -480,8 +501,14 @@ def _summarise(drive, zs, pairs) -> dict:
     for p in pairs:
         f = "overlap" if p["fcl_overlap"] else f"{p['fcl_distance_um']:.4f} um"
         b = f" (bound {p['bound_um']:.3g} um)" if drive.coned and not p["fcl_overlap"] else ""
-        who = f" (tooth {p['tooth']} at generator angle {p['generator_angle_deg']:.3f} deg, parts with their errors)" if "tooth" in p else ""
-        parts.append(f"{p['what']} at {p['tooth_angle_deg']:.3f} deg{who}: FCL {f} vs 2D {p['clearance_2d_um']:.4f} um{b}")
+        who = (
+            f" (tooth {p['tooth']} at generator angle {p['generator_angle_deg']:.3f} deg, parts with their errors)"
+            if "tooth" in p
+            else ""
+        )
+        parts.append(
+            f"{p['what']} at {p['tooth_angle_deg']:.3f} deg{who}: FCL {f} vs 2D {p['clearance_2d_um']:.4f} um{b}"
+        )
     ok = all(p["agree"] for p in pairs)
     secs = f"{len(zs)} sections" if drive.coned else "prisms (no coning)"
     summary = ("agree" if ok else "DISAGREE") + f", {secs}: " + "; ".join(parts)

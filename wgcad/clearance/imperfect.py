@@ -35,7 +35,15 @@ from .imperfect_bounds import ErrorBound, PerfectBound, PerfectBounds, chunk_bou
 from .imperfect_scene import ImperfectScene
 from .scene import Scene, clearance_at_poses, refine_min
 
-__all__ = ["ImperfectScene", "flex_poses_batch", "PerfectBound", "ErrorBound", "audit_imperfect", "chunk_angles", "CHUNK_SAMPLES"]
+__all__ = [
+    "ImperfectScene",
+    "flex_poses_batch",
+    "PerfectBound",
+    "ErrorBound",
+    "audit_imperfect",
+    "chunk_angles",
+    "CHUNK_SAMPLES",
+]
 
 #: samples (generator angles x teeth x sections) per chunk: a chunk's bounds and their temporaries
 #: (~10 arrays of 8 bytes a sample) hold ~5 MB at 2**16, and the per-chunk overhead (a few array
@@ -170,8 +178,9 @@ def audit_imperfect(drive, settings, imp: Imperfections, progress=None, chunk_sa
             keep_v.append(v[ok]), keep_a.append(a_[ok]), keep_k.append(k_[ok]), keep_s.append(s_[ok])
         v = np.concatenate(keep_v)
         ok = v <= best + margin
-        keep_v, keep_a, keep_k, keep_s = ([x[ok]] for x in (v, np.concatenate(keep_a), np.concatenate(keep_k),
-                                                              np.concatenate(keep_s)))
+        keep_v, keep_a, keep_k, keep_s = (
+            [x[ok]] for x in (v, np.concatenate(keep_a), np.concatenate(keep_k), np.concatenate(keep_s))
+        )
 
     if not settings.bound:
         # the reference: every sample in every chunk
@@ -210,7 +219,9 @@ def audit_imperfect(drive, settings, imp: Imperfections, progress=None, chunk_sa
             idx = idx[np.argsort(L[idx], kind="stable")]
             s_, k_, b_ = np.unravel_index(idx, (S, z_g, a1 - a0))
             b_ = b_ + a0
-            fresh = np.array([(x, y, w) not in done for x, y, w in zip(s_.tolist(), k_.tolist(), b_.tolist())], dtype=bool)
+            fresh = np.array(
+                [(x, y, w) not in done for x, y, w in zip(s_.tolist(), k_.tolist(), b_.tolist())], dtype=bool
+            )
             # re-checked against the bar as it falls: a batch is dropped once its bounds are above it
             s_, k_, b_, Lc = s_[fresh], k_[fresh], b_[fresh], L[idx][fresh]
             for a in range(0, len(s_), _BATCH):
@@ -238,8 +249,12 @@ def audit_imperfect(drive, settings, imp: Imperfections, progress=None, chunk_sa
             rot, shift = _poses_of(drive, imp, angles, cand_a, cand_k, cand_s, sections)
             # in batches: a candidate on the finer polygons holds ~18 kB while measured, and their number
             # grows with the sampling density (2900 at 0.05 deg on D1 [S4])
-            cand_v = np.concatenate([clearance_at_poses(ref, rot[a : a + _FINE_BATCH], shift[a : a + _FINE_BATCH])["min"]
-                                     for a in range(0, len(rot), _FINE_BATCH)])
+            cand_v = np.concatenate(
+                [
+                    clearance_at_poses(ref, rot[a : a + _FINE_BATCH], shift[a : a + _FINE_BATCH])["min"]
+                    for a in range(0, len(rot), _FINE_BATCH)
+                ]
+            )
             n_fine = len(cand_v)
             o = np.argsort(cand_v, kind="stable")
             cand_v, cand_a, cand_k, cand_s = cand_v[o], cand_a[o], cand_k[o], cand_s[o]
@@ -275,11 +290,23 @@ def audit_imperfect(drive, settings, imp: Imperfections, progress=None, chunk_sa
     area = det.get(f"{side}_area", np.zeros(1))[0] if side != "third" else 0.0
     phi_tooth = float((2 * pi * k / z_g + angles[ai] / scene.ratios["u_hg"] - angles[ai] + pi) % (2 * pi) - pi)
     phi_major = float((phi_tooth + pi / scene.n_w) % (2 * pi / scene.n_w) - pi / scene.n_w)
-    worst = Finding("min_clearance", float(best), "exact" if settings.refine else "polygon", tooth_angle=phi_major,
-                    section_z=z_w, location=_classify(isc, float(rot[0]), shift[0], j),
-                    generator_angle=float(angles[ai]), tooth=k, polygon_value=float(best_poly),
-                    details={"mirror": None,  # the errors break the mirror symmetry
-                             "sample_tooth_angle": phi_tooth, "rigid_tooth": j, "overlap_area": float(area)})
+    worst = Finding(
+        "min_clearance",
+        float(best),
+        "exact" if settings.refine else "polygon",
+        tooth_angle=phi_major,
+        section_z=z_w,
+        location=_classify(isc, float(rot[0]), shift[0], j),
+        generator_angle=float(angles[ai]),
+        tooth=k,
+        polygon_value=float(best_poly),
+        details={
+            "mirror": None,  # the errors break the mirror symmetry
+            "sample_tooth_angle": phi_tooth,
+            "rigid_tooth": j,
+            "overlap_area": float(area),
+        },
+    )
     # entry gap and pinch: every passage of a tooth through the entry in the swept angles, each with its
     # own crossing (wgcad.clearance.imperfect_entry), found from the perfect drive's (polygons suffice there:
     # they only say where to look)
@@ -309,8 +336,11 @@ def audit_imperfect(drive, settings, imp: Imperfections, progress=None, chunk_sa
         "angles": int(A),
         "angle_step_deg": round(float(np.rad2deg(np.median(np.diff(angles)))), 6) if A > 1 else None,
         "sections_z_mm": [None if z is None else round(z, 6) for z in sections],
-        "sections_note": ("identical sections (no coning): one computed" if not drive.coned else
-                          "coned: every section computed" + ("" if ends else "; the face ends were NOT checked")),
+        "sections_note": (
+            "identical sections (no coning): one computed"
+            if not drive.coned
+            else "coned: every section computed" + ("" if ends else "; the face ends were NOT checked")
+        ),
         "face_ends_checked": bool(ends),
         "mesh_period": False,
         "identical_waves": False,
@@ -318,46 +348,106 @@ def audit_imperfect(drive, settings, imp: Imperfections, progress=None, chunk_sa
         "culling": bool(settings.cull),
         "branch_and_bound": bool(settings.bound),
         "imperfections": True,
-        "generator_turns": round(float((angles[-1] - angles[0]) / (2 * pi) + (np.median(np.diff(angles)) / (2 * pi) if A > 1 else 0.0)), 6),
+        "generator_turns": round(
+            float((angles[-1] - angles[0]) / (2 * pi) + (np.median(np.diff(angles)) / (2 * pi) if A > 1 else 0.0)), 6
+        ),
         "full_cycle_turns": int(full_cycle_turns(drive.design.drive.z_flex, drive.design.drive.z_rigid)),
-        "shortcuts_that_hold": {k2: sc[k2] for k2 in ("mesh_period", "identical_waves", "mirror_symmetry", "one_generator_turn")},
-        "shortcuts_note": ("imperfect parts: every (generator angle, tooth, section) sample posed with its errors, "
-                           f"in chunks of {B} generator angles; bounds only along a tooth's track ({sc['why']})"),
+        "shortcuts_that_hold": {
+            k2: sc[k2] for k2 in ("mesh_period", "identical_waves", "mirror_symmetry", "one_generator_turn")
+        },
+        "shortcuts_note": (
+            "imperfect parts: every (generator angle, tooth, section) sample posed with its errors, "
+            f"in chunks of {B} generator angles; bounds only along a tooth's track ({sc['why']})"
+        ),
         **accuracy_settings(drive, settings.refine),
         "working_flank": scene.working,
         "rigid_pitch_radius_mm": drive.rigid.r,
     }
-    counts = {"samples": int(A * z_g * S), "unique_tooth_angles": int(A * z_g), "sections": S, "evaluated": int(n_ev),
-              "culled": int(n_pruned), "perfect_evaluated": perfect.evaluated, "refined": int(n_refined), "fine_polygon": int(n_fine), "chunks": -(-A // B)}
+    counts = {
+        "samples": int(A * z_g * S),
+        "unique_tooth_angles": int(A * z_g),
+        "sections": S,
+        "evaluated": int(n_ev),
+        "culled": int(n_pruned),
+        "perfect_evaluated": perfect.evaluated,
+        "refined": int(n_refined),
+        "fine_polygon": int(n_fine),
+        "chunks": -(-A // B),
+    }
     exact = "exact" if settings.refine else "polygon"
     rs["entry_side"] = "entry (+phi)" if scene.entry_sign > 0 else "entry (-phi)"
     fold = lambda a: float((a + pi / scene.n_w) % (2 * pi / scene.n_w) - pi / scene.n_w)  # noqa: E731  (nearest major axis)
     if np.isfinite(ent.get("gap", np.nan)):
         edge, gloc = _entry_edge(drive, imp, isc, ent["gap_phi_h"], ent["gap_tooth"], ent["gap_z"], settings.refine)
-        gap_f = Finding("entry_crossing", ent["gap"], exact, tooth_angle=fold(ent["gap_tooth_angle"]), section_z=ent["gap_z"],
-                        location=gloc, generator_angle=ent["gap_phi_h"], tooth=ent["gap_tooth"],
-                        details={"crossing": "flexspline tip arc crossing the rigid tip circle", "edge": edge,
-                                 "passages": ent["passages"], "spread": ent["spread"], "all_passages": ent["all"],
-                                 "perfect_gaps": [float(g[0]) for g, _ in gaps], "perfect_phi": [float(g[1]) for g, _ in gaps]})
+        gap_f = Finding(
+            "entry_crossing",
+            ent["gap"],
+            exact,
+            tooth_angle=fold(ent["gap_tooth_angle"]),
+            section_z=ent["gap_z"],
+            location=gloc,
+            generator_angle=ent["gap_phi_h"],
+            tooth=ent["gap_tooth"],
+            details={
+                "crossing": "flexspline tip arc crossing the rigid tip circle",
+                "edge": edge,
+                "passages": ent["passages"],
+                "spread": ent["spread"],
+                "all_passages": ent["all"],
+                "perfect_gaps": [float(g[0]) for g, _ in gaps],
+                "perfect_phi": [float(g[1]) for g, _ in gaps],
+            },
+        )
     else:
         gap_f = Finding("entry_crossing", float("nan"), exact, details={"passages": ent.get("passages", 0)})
     if np.isfinite(ent.get("pinch", np.nan)):
         ploc = _classify(isc, ent["pinch_rot"], ent["pinch_shift"], ent["pinch_rigid"])
-        pedge = _entry_edge(drive, imp, isc, ent["pinch_phi_h"], ent["pinch_tooth"], ent["pinch_z"], settings.refine,
-                            rigid=ent["pinch_rigid"])[0]
-        pinch_f = Finding("entry_pinch", ent["pinch"], exact, tooth_angle=fold(ent["pinch_tooth_angle"]),
-                          section_z=ent["pinch_z"], location=ploc, generator_angle=ent["pinch_phi_h"], tooth=ent["pinch_tooth"],
-                          details={"edge": pedge, "tip_to_tip_risk": bool(ent["pinch"] < settings.interference_tol and ploc == "tip")})
+        pedge = _entry_edge(
+            drive,
+            imp,
+            isc,
+            ent["pinch_phi_h"],
+            ent["pinch_tooth"],
+            ent["pinch_z"],
+            settings.refine,
+            rigid=ent["pinch_rigid"],
+        )[0]
+        pinch_f = Finding(
+            "entry_pinch",
+            ent["pinch"],
+            exact,
+            tooth_angle=fold(ent["pinch_tooth_angle"]),
+            section_z=ent["pinch_z"],
+            location=ploc,
+            generator_angle=ent["pinch_phi_h"],
+            tooth=ent["pinch_tooth"],
+            details={
+                "edge": pedge,
+                "tip_to_tip_risk": bool(ent["pinch"] < settings.interference_tol and ploc == "tip"),
+            },
+        )
     else:
         pinch_f = Finding("entry_pinch", float("nan"), exact, details={"tip_to_tip_risk": False})
     # Delta of [S1] (docs/models.md 5): the smallest gap of the entry, the pinch where the tips pass or, without
     # one, the crossing; over every passage
-    delta_src, kind = ((pinch_f, "pinch") if np.isfinite(pinch_f.value) and not (pinch_f.value > gap_f.value)
-                       else (gap_f, "crossing"))
-    delta_f = Finding("entry_gap", float(delta_src.value), exact, tooth_angle=delta_src.tooth_angle, section_z=delta_src.section_z,
-                      location=delta_src.location, generator_angle=delta_src.generator_angle, tooth=delta_src.tooth,
-                      details={"kind": kind if np.isfinite(delta_src.value) else None, "edge": delta_src.details.get("edge"),
-                               "tip_to_tip_risk": bool(pinch_f.details.get("tip_to_tip_risk", False) and kind == "pinch")})
+    delta_src, kind = (
+        (pinch_f, "pinch") if np.isfinite(pinch_f.value) and not (pinch_f.value > gap_f.value) else (gap_f, "crossing")
+    )
+    delta_f = Finding(
+        "entry_gap",
+        float(delta_src.value),
+        exact,
+        tooth_angle=delta_src.tooth_angle,
+        section_z=delta_src.section_z,
+        location=delta_src.location,
+        generator_angle=delta_src.generator_angle,
+        tooth=delta_src.tooth,
+        details={
+            "kind": kind if np.isfinite(delta_src.value) else None,
+            "edge": delta_src.details.get("edge"),
+            "tip_to_tip_risk": bool(pinch_f.details.get("tip_to_tip_risk", False) and kind == "pinch"),
+        },
+    )
     findings = {
         "min_clearance": worst,
         "entry_gap": delta_f,
@@ -365,13 +455,19 @@ def audit_imperfect(drive, settings, imp: Imperfections, progress=None, chunk_sa
         "entry_pinch": pinch_f,
         "backlash": Finding("backlash", float(bl), "brent", generator_angle=float(angles[0]), section_z=z_mid),
     }
-    res = AuditResult(settings=rs, findings=findings, interference=best < -settings.interference_tol,
-                      interference_tol=settings.interference_tol, counts=counts, settings_angles=angles)
+    res = AuditResult(
+        settings=rs,
+        findings=findings,
+        interference=best < -settings.interference_tol,
+        interference_tol=settings.interference_tol,
+        counts=counts,
+        settings_angles=angles,
+    )
     res.elapsed_s = time.perf_counter() - t0
     return res
 
 
-def _entry_edge(drive, imp: Imperfections, isc: "ImperfectScene", phi_h: float, k: int, z, exact: bool, rigid=None):
+def _entry_edge(drive, imp: Imperfections, isc: ImperfectScene, phi_h: float, k: int, z, exact: bool, rigid=None):
     """The edge (working / non-working) of the entry gap of tooth ``k`` at ``phi_h``, section ``z``, and where on
     the tooth it lies: the edge facing rigid tooth ``rigid`` or, without one, the edge with the smaller gap."""
     from .entry import EDGES, _edge_idx, edge_gaps

@@ -131,8 +131,9 @@ class ErrorBound:
             w_max, v_max = float(np.abs(st.w).max()), float(np.abs(st.v).max())
             dth = float(np.abs(st.dtheta).max())
             # 1 % on every maximum over the grid of rim angles (they vary by far less between its points)
-            self.k_gain.append(1.01 * (float(np.hypot(st.dw - st.v, st.w + st.dv).max()) + r_m * da_max
-                                       + (1.0 + dth) * lever_f))
+            self.k_gain.append(
+                1.01 * (float(np.hypot(st.dw - st.v, st.w + st.dv).max()) + r_m * da_max + (1.0 + dth) * lever_f)
+            )
             self.rho_gain.append(1.01 * (float(np.abs(st.theta).max()) + da_max * (1.0 + dth)))
             # a flexspline tooth point p: | |p| - r_b | and its angle from mat (tooth half-width, v, theta)
             rad_spread = float(max(abs(R_loc.max() + w_max - self.r_b), abs(R_loc.min() - w_max - self.r_b)))
@@ -142,8 +143,15 @@ class ErrorBound:
             self.cz.append(coning_factor(drive, z))
         # second order: the rigid frame's own turn applied to the displacement (|dev| |Delta|), bounded
         # with the largest displacement the amplitudes allow
-        amp = (0.5 * imp.flex_runout + 2 * abs(imp.flex_ecc) + abs(imp.cam_cam) + abs(imp.cam_flex) + abs(imp.cam_fixed)
-               + abs(imp.rigid_ecc) + 0.5 * imp.rigid_runout)
+        amp = (
+            0.5 * imp.flex_runout
+            + 2 * abs(imp.flex_ecc)
+            + abs(imp.cam_cam)
+            + abs(imp.cam_flex)
+            + abs(imp.cam_fixed)
+            + abs(imp.rigid_ecc)
+            + 0.5 * imp.rigid_runout
+        )
         self.second = self.a_b * amp
 
     def bound(self, k, phi_h) -> np.ndarray:
@@ -166,7 +174,12 @@ class ErrorBound:
         ada, adr, adev = np.abs(da), np.abs(dr), np.abs(dev)
         out = np.empty((len(self.cz), len(k), len(phi_h)))
         for si, cz in enumerate(self.cz):
-            rem = ada * self.k_gain[si] + adr * self.rho_gain[si] + adev * self.dev_gain[si] + (self.fixed[si] + self.second)
+            rem = (
+                ada * self.k_gain[si]
+                + adr * self.rho_gain[si]
+                + adev * self.dev_gain[si]
+                + (self.fixed[si] + self.second)
+            )
             out[si] = np.hypot(bx + cz * E[None, :, 0], by + cz * E[None, :, 1]) + rem
         return out
 

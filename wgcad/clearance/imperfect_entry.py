@@ -151,12 +151,22 @@ def imperfect_entry(drive, imp, isc, scene, perfect_gaps, perfect_pinch, angles,
         if not np.isfinite(g0):
             continue
         ph0, k = passages(scene, p0, lo, hi)
-        ph = np.concatenate([_crossings(drive, imp, isc, ph0[a : a + _CHUNK], k[a : a + _CHUNK], z, sgn)
-                             for a in range(0, len(ph0), _CHUNK)] or [np.zeros(0)])
+        ph = np.concatenate(
+            [
+                _crossings(drive, imp, isc, ph0[a : a + _CHUNK], k[a : a + _CHUNK], z, sgn)
+                for a in range(0, len(ph0), _CHUNK)
+            ]
+            or [np.zeros(0)]
+        )
         ok = np.isfinite(ph)
         po, ko = ph[ok], k[ok]
-        v = np.concatenate([clearance_at_poses(isc, *_poses(drive, imp, isc, po[a : a + _CHUNK], ko[a : a + _CHUNK], z))["min"]
-                            for a in range(0, len(po), _CHUNK)] or [np.zeros(0)])
+        v = np.concatenate(
+            [
+                clearance_at_poses(isc, *_poses(drive, imp, isc, po[a : a + _CHUNK], ko[a : a + _CHUNK], z))["min"]
+                for a in range(0, len(po), _CHUNK)
+            ]
+            or [np.zeros(0)]
+        )
         rows.append((v, ph[ok], k[ok], np.full(int(ok.sum()), si)))
         shifts[si] = (ph0, k, ph - ph0)  # the crossing's shift in generator angle, NaN where none
         out["passages"] += int(len(ph0))
@@ -221,8 +231,15 @@ def _pinch(drive, imp, isc, scene, perfect_gaps, perfect_pinch, shifts, refine):
     # tooth angle a window can reach, times |c|, plus how fast the errors move it (each first-harmonic term turns
     # at most once per generator turn relative to the tooth, so by at most its amplitude per radian)
     reach = np.linspace(p_pin - CROSS_WINDOW - PINCH_HALF, p_pin + CROSS_WINDOW + PINCH_HALF, 321)
-    amp = (0.5 * imp.flex_runout + 2 * abs(imp.flex_ecc) + abs(imp.cam_cam) + abs(imp.cam_flex) + abs(imp.cam_fixed)
-           + abs(imp.rigid_ecc) + 0.5 * imp.rigid_runout) * (1.0 + abs(c))
+    amp = (
+        0.5 * imp.flex_runout
+        + 2 * abs(imp.flex_ecc)
+        + abs(imp.cam_cam)
+        + abs(imp.cam_flex)
+        + abs(imp.cam_fixed)
+        + abs(imp.rigid_ecc)
+        + 0.5 * imp.rigid_runout
+    ) * (1.0 + abs(c))
     speed = {si: isc.speed_bound(reach, perfect_gaps[si][1]) * abs(c) + amp for si in shifts}
     cand = []
     for si, (ph0, k, dph) in shifts.items():
@@ -290,6 +307,13 @@ def _pinch(drive, imp, isc, scene, perfect_gaps, perfect_pinch, shifts, refine):
     rot, shift = _poses(drive, imp, isc, np.array([x]), np.array([kk[i]]), z)
     det = clearance_at_poses(isc, rot, shift)
     side = "lower" if det["lower"][0] <= det["upper"][0] else "upper"
-    return {"pinch": float(val), "pinch_phi_h": float(x), "pinch_tooth": int(kk[i]), "pinch_z": z,
-            "pinch_tooth_angle": float(2 * pi * kk[i] / scene.z_g + c * x), "pinch_rot": float(rot[0]),
-            "pinch_shift": shift[0], "pinch_rigid": int(det["lo" if side == "lower" else "up"][0])}
+    return {
+        "pinch": float(val),
+        "pinch_phi_h": float(x),
+        "pinch_tooth": int(kk[i]),
+        "pinch_z": z,
+        "pinch_tooth_angle": float(2 * pi * kk[i] / scene.z_g + c * x),
+        "pinch_rot": float(rot[0]),
+        "pinch_shift": shift[0],
+        "pinch_rigid": int(det["lo" if side == "lower" else "up"][0]),
+    }

@@ -26,7 +26,7 @@ class ImperfectScene(Scene):
     """
 
     @classmethod
-    def from_scene(cls, scene: Scene, imp: Imperfections) -> "ImperfectScene":
+    def from_scene(cls, scene: Scene, imp: Imperfections) -> ImperfectScene:
         new = cls.__new__(cls)
         new.__dict__.update(scene.__dict__)
         new.imp = imp

@@ -109,6 +109,7 @@ def _one_side(A: ExactTooth, B: ExactTooth, polyA: np.ndarray, ringB, rot, shift
     t = B.grid_t[ib, d2[row, ib].argmin(axis=1)]
     kk, ia, s = kk[row], ia[row], s[row]
     r_k, sh_k = rot[kk], shift[kk]
+
     def project(ib, t, Pa):
         for _ in range(3):  # warm-started from the last iterate: Newton converges in a few steps
             Qb, b1, b2 = B.eval(ib, t)
@@ -260,7 +261,9 @@ def _rotmat(rot):
     return m
 
 
-def refine_pairs(A: ExactTooth, polyA, geomA, rot_a, shift_a, B: ExactTooth, polyB, geomB, rot_b, shift_b, margin: float):
+def refine_pairs(
+    A: ExactTooth, polyA, geomA, rot_a, shift_a, B: ExactTooth, polyB, geomB, rot_b, shift_b, margin: float
+):
     """Exact signed clearance ``(K,)`` of pairs of placed teeth (A_k at ``rot_a, shift_a``, B_k at ``rot_b, shift_b``).
 
     ``polyA``/``polyB`` are the teeth's polygons (own frames), ``geomA``/

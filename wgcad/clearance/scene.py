@@ -55,8 +55,13 @@ class Scene:
         self.flex_exact = ExactTooth(drive.flex, self.flex.local)
         self.rigid_exact = ExactTooth(drive.rigid, self.rigid.local)
         self.chord_gap = 2.0 * drive.tol
-        tip = [p for p in drive.flex.pieces if p.kind == "arc" and np.allclose(p.center, 0.0, atol=1e-12)
-               and abs(p.radius - drive.flex.r_a) <= 1e-9 * drive.flex.r_a]
+        tip = [
+            p
+            for p in drive.flex.pieces
+            if p.kind == "arc"
+            and np.allclose(p.center, 0.0, atol=1e-12)
+            and abs(p.radius - drive.flex.r_a) <= 1e-9 * drive.flex.r_a
+        ]
         self.tip_arc = tip[0] if tip else None
         self.entry_sign = rot  # teeth enter engagement on the side the generator turns toward
         self._laws = {}
@@ -158,7 +163,9 @@ class Scene:
         inside = rel <= hi_t - lo_t
         ends = []
         for t in (lo_t, hi_t):
-            ends.append(np.hypot(shift[:, 0] + arc.radius * np.cos(rot + t), shift[:, 1] + arc.radius * np.sin(rot + t)))
+            ends.append(
+                np.hypot(shift[:, 0] + arc.radius * np.cos(rot + t), shift[:, 1] + arc.radius * np.sin(rot + t))
+            )
         if self.external:
             R = np.where(inside, np.abs(arc.radius - c), np.minimum(*ends))
             return R - self.r_tip_b
@@ -167,8 +174,17 @@ class Scene:
 
     def clearance_to(self, rot, shift, j, area: bool = False, flex_geoms=None):
         """Signed clearance of flexspline teeth at poses ``(rot, shift)`` to rigid teeth ``j`` (polygons)."""
-        return signed_clearance(self.flex, rot, shift, self.rigid, self.rigid_rot[j], self.rigid_shift[j],
-                                b_geoms=self.rigid_geoms[j], area=area, a_geoms=flex_geoms)
+        return signed_clearance(
+            self.flex,
+            rot,
+            shift,
+            self.rigid,
+            self.rigid_rot[j],
+            self.rigid_shift[j],
+            b_geoms=self.rigid_geoms[j],
+            area=area,
+            a_geoms=flex_geoms,
+        )
 
     def exact_to(self, rot, shift, j):
         """Signed clearance of flexspline teeth at poses ``(rot, shift)`` to rigid teeth ``j`` on the exact curves.
@@ -176,9 +192,19 @@ class Scene:
         Returns ``(value (K,), side (K,), point (K, 2))`` of :func:`wgcad.clearance.refine.refine_pairs`.
         """
         j = np.atleast_1d(j)
-        return refine_pairs(self.flex_exact, self.flex.local, self.flex.polygon, rot, shift,
-                            self.rigid_exact, self.rigid.local, self.rigid.polygon, self.rigid_rot[j], self.rigid_shift[j],
-                            margin=2.0 * self.chord_gap)
+        return refine_pairs(
+            self.flex_exact,
+            self.flex.local,
+            self.flex.polygon,
+            rot,
+            shift,
+            self.rigid_exact,
+            self.rigid.local,
+            self.rigid.polygon,
+            self.rigid_rot[j],
+            self.rigid_shift[j],
+            margin=2.0 * self.chord_gap,
+        )
 
 
 def tooth_clearance(scene: Scene, phi, z=None, third: bool = True, area: bool = False, exact: bool = False) -> dict:
@@ -198,7 +224,9 @@ def tooth_clearance(scene: Scene, phi, z=None, third: bool = True, area: bool = 
     return refine_min(scene, rot, shift, out) if exact else out
 
 
-def tooth_clearance_sections(scene: Scene, phi: np.ndarray, zi: np.ndarray, zs: list, exact: bool = False) -> np.ndarray:
+def tooth_clearance_sections(
+    scene: Scene, phi: np.ndarray, zi: np.ndarray, zs: list, exact: bool = False
+) -> np.ndarray:
     """Smallest clearance of teeth at angles ``phi[k]`` in sections ``zs[zi[k]]``, in one batch, ``(K,)``."""
     rot, shift = scene.pose_sections(phi, zi, zs)
     out = clearance_at_poses(scene, rot, shift)
@@ -243,7 +271,9 @@ def refine_min(scene: Scene, rot: np.ndarray, shift: np.ndarray, det: dict) -> d
     return out
 
 
-def clearance_at_poses(scene: Scene, rot: np.ndarray, shift: np.ndarray, third: bool = True, area: bool = False) -> dict:
+def clearance_at_poses(
+    scene: Scene, rot: np.ndarray, shift: np.ndarray, third: bool = True, area: bool = False
+) -> dict:
     """:func:`tooth_clearance` for teeth given by their poses (rigid frame)."""
     lo, up, th = scene.neighbours(shift, rot)
     pts = transform(scene.flex_local, rot, shift)
@@ -297,7 +327,9 @@ def classify(scene: Scene, pts: np.ndarray, rigid_idx: int, phi: float, z) -> st
     g = scene.drive.flex
     m = g.spec.module
     tip_zone = abs(R - g.r_a) < 0.05 * m
-    root_zone = abs(R - g.r_f) < (g.spec.fillet_coef + 0.05) * m if g.spec.form == "involute" else abs(R - g.r_f) < 0.05 * m
+    root_zone = (
+        abs(R - g.r_f) < (g.spec.fillet_coef + 0.05) * m if g.spec.form == "involute" else abs(R - g.r_f) < 0.05 * m
+    )
     if tip_zone:
         return "tip"
     if root_zone:

@@ -142,5 +142,4 @@ def _evaluate(scene: Scene, searches: list, picks: list, zs: list, done=None) ->
     return min(r.best() for r in searches)
 
 
-
 SectionSearch, evaluate, sample_phi, fold = _SectionSearch, _evaluate, _sample_phi, _fold

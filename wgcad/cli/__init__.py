@@ -24,22 +24,34 @@ from .common import (  # noqa: F401
     TRACEBACK_ENV,
     Parser,
     Terminated,
-    circle as _circle,
     internal_error_line,
     signals_raise,
 )
+from .common import circle as _circle  # noqa: F401  (tests/test_cli.py reaches it here)
 
 __all__ = ["main", "build_parser", "EXIT_OK", "EXIT_INTERFERENCE", "EXIT_INPUT", "EXIT_INTERNAL"]
 
 
 def build_parser() -> argparse.ArgumentParser:
-    p = Parser(prog="wgcad", description="Geometry, deformation and clearance of harmonic (strain-wave) drives.",
-               epilog=EPILOG, formatter_class=argparse.RawDescriptionHelpFormatter)
+    p = Parser(
+        prog="wgcad",
+        description="Geometry, deformation and clearance of harmonic (strain-wave) drives.",
+        epilog=EPILOG,
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
     p.add_argument("--version", action="version", version=f"wgcad {__version__}", help="print the version and exit")
-    p.add_argument("--traceback", action="store_true",
-                   help=f"on an internal error (exit 3) also print the Python traceback (same as {TRACEBACK_ENV}=1)")
-    sub = p.add_subparsers(dest="command", required=True, parser_class=Parser, metavar="COMMAND",
-                           help="generate, audit, kinematics, ke, sector, parts or sweep; wgcad COMMAND --help for its flags")
+    p.add_argument(
+        "--traceback",
+        action="store_true",
+        help=f"on an internal error (exit 3) also print the Python traceback (same as {TRACEBACK_ENV}=1)",
+    )
+    sub = p.add_subparsers(
+        dest="command",
+        required=True,
+        parser_class=Parser,
+        metavar="COMMAND",
+        help="generate, audit, kinematics, ke, sector, parts or sweep; wgcad COMMAND --help for its flags",
+    )
     for mod in (generate, audit, kinematics, ke, sector, parts, sweep):
         mod.register(sub)
     return p

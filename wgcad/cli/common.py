@@ -12,9 +12,29 @@ from pathlib import Path
 from ..errors import WgcadError
 from .progress import Progress
 
-__all__ = ["EXIT_OK", "EXIT_INTERFERENCE", "EXIT_INPUT", "EXIT_INTERNAL", "EXIT_MODEL", "EPILOG", "TRACEBACK_ENV", "Parser",
-           "angles_deg", "positive_float", "angle_count", "out_dir", "angle_tag", "circle", "Progress",
-           "Terminated", "signals_raise", "internal_error_line", "want_progress", "add_memory_flag", "not_modelled"]
+__all__ = [
+    "EXIT_OK",
+    "EXIT_INTERFERENCE",
+    "EXIT_INPUT",
+    "EXIT_INTERNAL",
+    "EXIT_MODEL",
+    "EPILOG",
+    "TRACEBACK_ENV",
+    "Parser",
+    "angles_deg",
+    "positive_float",
+    "angle_count",
+    "out_dir",
+    "angle_tag",
+    "circle",
+    "Progress",
+    "Terminated",
+    "signals_raise",
+    "internal_error_line",
+    "want_progress",
+    "add_memory_flag",
+    "not_modelled",
+]
 
 EXIT_OK = 0
 EXIT_INTERFERENCE = 1  # reserved for `wgcad audit`: interference found or baseline drift
@@ -60,6 +80,7 @@ class Terminated(KeyboardInterrupt):
 @contextlib.contextmanager
 def signals_raise():
     """While active, SIGTERM and SIGHUP raise :class:`Terminated` in the main thread (SIGINT already raises)."""
+
     def handler(signum, frame):
         raise Terminated(signum)
 
@@ -90,13 +111,15 @@ def internal_error_line(exc: BaseException) -> str:
     frames = [f for f in traceback.extract_tb(exc.__traceback__) if f"{os.sep}wgcad{os.sep}" in f.filename]
     if frames:
         f = frames[-1]
-        rel = f.filename[f.filename.rfind(f"{os.sep}wgcad{os.sep}") + 1:]
+        rel = f.filename[f.filename.rfind(f"{os.sep}wgcad{os.sep}") + 1 :]
         where = f" at {rel}:{f.lineno}"
     kind = type(exc).__name__
     if isinstance(exc, MemoryError):
         what = "out of memory" + ("" if what == "(no message)" else f" ({what})")
-    return (f"wgcad: internal error: {kind}: {what}{where}; this is a bug in wgcad, please report it with the design "
-            f"file and the command (run with --traceback or {TRACEBACK_ENV}=1 for the traceback)")
+    return (
+        f"wgcad: internal error: {kind}: {what}{where}; this is a bug in wgcad, please report it with the design "
+        f"file and the command (run with --traceback or {TRACEBACK_ENV}=1 for the traceback)"
+    )
 
 
 def want_progress(flag: bool) -> bool:
@@ -141,6 +164,7 @@ def positive_float(lo: float, hi: float, unit: str):
 
 def whole_number(lo: int, hi: int, what: str, words: dict | None = None):
     """An argparse type: a whole number in ``lo..hi`` of ``what``, or one of ``words`` (word -> value)."""
+
     def conv(text: str):
         if words and text in words:
             return words[text]
@@ -148,7 +172,9 @@ def whole_number(lo: int, hi: int, what: str, words: dict | None = None):
             n = int(text)
         except ValueError:
             alt = "".join(f" nor '{w}'" for w in words) if words else ""
-            raise argparse.ArgumentTypeError(f"'{text}' is {'neither' if words else 'not'} a whole number{alt}") from None
+            raise argparse.ArgumentTypeError(
+                f"'{text}' is {'neither' if words else 'not'} a whole number{alt}"
+            ) from None
         if not lo <= n <= hi:
             alt = "".join(f" or '{w}'" for w in words) if words else ""
             raise argparse.ArgumentTypeError(f"must be {lo}..{hi} {what}{alt}, got {n}")
@@ -164,8 +190,12 @@ def add_memory_flag(parser) -> None:
     """``--max-memory-mb``: the memory budget a run is judged against before it starts (wgcad.design.budget)."""
     from ..design.budget import DEFAULT_MAX_MEMORY_MB
 
-    parser.add_argument("--max-memory-mb", type=positive_float(0.0, 1e7, "MB"), default=DEFAULT_MAX_MEMORY_MB,
-                        help=f"refuse a run whose estimated memory exceeds this, MB (default {DEFAULT_MAX_MEMORY_MB:g})")
+    parser.add_argument(
+        "--max-memory-mb",
+        type=positive_float(0.0, 1e7, "MB"),
+        default=DEFAULT_MAX_MEMORY_MB,
+        help=f"refuse a run whose estimated memory exceeds this, MB (default {DEFAULT_MAX_MEMORY_MB:g})",
+    )
 
 
 def out_dir(args, design_path: str) -> Path:
@@ -196,9 +226,13 @@ def not_modelled(design, command: str, imperfections: bool = False) -> list[str]
     """
     notes = []
     if design.sectors.active:
-        notes.append(f"[sectors]: {command} uses the plain rigid gear of drive.z_rigid = {design.drive.z_rigid} teeth; "
-                     "`wgcad sector` builds and audits the sectored gear")
+        notes.append(
+            f"[sectors]: {command} uses the plain rigid gear of drive.z_rigid = {design.drive.z_rigid} teeth; "
+            "`wgcad sector` builds and audits the sectored gear"
+        )
     if design.imperfections.any and not imperfections:
         why = " (imperfect parts are modelled with a fixed rigid gear only)" if design.drive.fixed != "rigid" else ""
-        notes.append(f"[imperfections]: {command} uses perfect parts{why}; `wgcad ke` computes the imperfect drive's kinematic error")
+        notes.append(
+            f"[imperfections]: {command} uses perfect parts{why}; `wgcad ke` computes the imperfect drive's kinematic error"
+        )
     return notes

@@ -8,7 +8,7 @@ import sys
 import time
 from pathlib import Path
 
-from .common import EPILOG, EXIT_OK, add_memory_flag, angles_deg, circle, out_dir, angle_tag, positive_float
+from .common import EPILOG, EXIT_OK, add_memory_flag, angle_tag, angles_deg, circle, out_dir, positive_float
 
 __all__ = ["register", "cmd_generate", "deformed_scene", "report_name"]
 
@@ -59,7 +59,9 @@ def deformed_scene(drive, phi_h_abs: float, imp=None) -> dict:
     if not shapely.LinearRing(outline).is_simple:
         from ..errors import GeometryError
 
-        raise GeometryError(f"deformed flexspline outline at generator angle {np.rad2deg(phi_h_abs):g} deg is not simple")
+        raise GeometryError(
+            f"deformed flexspline outline at generator angle {np.rad2deg(phi_h_abs):g} deg is not simple"
+        )
     # how far toward the minor axis the tips still overlap the rigid tip circle (close-up extent)
     R = np.hypot(teeth[..., 0], teeth[..., 1])
     over = (R.min(axis=1) < drive.rigid.r_a) if drive.external else (R.max(axis=1) > drive.rigid.r_a)
@@ -90,8 +92,22 @@ def deformed_scene(drive, phi_h_abs: float, imp=None) -> dict:
         "rigid_outward": not drive.external,
         # radial window of the close-up: both gears' teeth, the flexspline's moved by up to +-1.2 W0
         "y_range": (
-            min(drive.rigid.r_a, drive.rigid.r_f, drive.flex.r_a - 1.2 * drive.law.w0, drive.flex.r_f - 1.2 * drive.law.w0) - drive.rigid.r - 0.2 * d.module,
-            max(drive.rigid.r_a, drive.rigid.r_f, drive.flex.r_a + 1.2 * drive.law.w0, drive.flex.r_f + 1.2 * drive.law.w0) - drive.rigid.r + 0.2 * d.module,
+            min(
+                drive.rigid.r_a,
+                drive.rigid.r_f,
+                drive.flex.r_a - 1.2 * drive.law.w0,
+                drive.flex.r_f - 1.2 * drive.law.w0,
+            )
+            - drive.rigid.r
+            - 0.2 * d.module,
+            max(
+                drive.rigid.r_a,
+                drive.rigid.r_f,
+                drive.flex.r_a + 1.2 * drive.law.w0,
+                drive.flex.r_f + 1.2 * drive.law.w0,
+            )
+            - drive.rigid.r
+            + 0.2 * d.module,
         ),
     }
 
@@ -114,8 +130,13 @@ def cmd_generate(args) -> int:
     t0 = time.perf_counter()
     bar = Progress(want_progress(args.progress) and (args.progress or not args.quiet))
     angles = list(args.generator_angle or [])
-    total = (_COST["design"] + _COST["dxf"] + (0 if args.no_stl else 2 * _COST["stl"])
-             + len(angles) * (_COST["angle_dxf"] + _COST["angle_png"]) + _COST["report"])
+    total = (
+        _COST["design"]
+        + _COST["dxf"]
+        + (0 if args.no_stl else 2 * _COST["stl"])
+        + len(angles) * (_COST["angle_dxf"] + _COST["angle_png"])
+        + _COST["report"]
+    )
     done = 0.0
 
     def step(cost, next_stage):
@@ -125,9 +146,9 @@ def cmd_generate(args) -> int:
         bar.set(done / total, next_stage)
 
     bar.start("loading modules")
+    from ..atomic import check_target
     from ..design import load_design
     from ..drive import build_drive
-    from ..atomic import check_target
     from ..report import drive_report, format_summary
 
     bar.set(0.0, "reading the design")
@@ -180,8 +201,10 @@ def cmd_generate(args) -> int:
         imp = Imperfections.from_spec(design.imperfections)
     rep["not_modelled"] = not_modelled(design, "generate", imperfections=imp is not None)
     if imp is not None:
-        rep["imperfections"] = ("the deformed-assembly DXF/PNG (--generator-angle) place every tooth with its [imperfections]; "
-                                "the gears' DXF and STL are the nominal parts")
+        rep["imperfections"] = (
+            "the deformed-assembly DXF/PNG (--generator-angle) place every tooth with its [imperfections]; "
+            "the gears' DXF and STL are the nominal parts"
+        )
     files = []
     with atomic_batch() as batch:
         path = out / f"{stem}.dxf"
@@ -223,11 +246,14 @@ def cmd_generate(args) -> int:
             write_dxf(batch.temp_path(path), dl)
             files.append(path)
             step(_COST["angle_dxf"], f"{deg:g} deg: picture")
-            png = assembly_png(scene, f"{design.drive.name}: generator at {deg:g} deg counter-clockwise from +x "
-                                      f"({design.generator.law} law, W0 = {design.w0:.3f} mm"
-                                      + (", generator's centre section" if drive.coned else "")
-                                      + (", parts with their [imperfections])" if imp is not None else ")"),
-                               entry_deg=scene["entry_deg"])
+            png = assembly_png(
+                scene,
+                f"{design.drive.name}: generator at {deg:g} deg counter-clockwise from +x "
+                f"({design.generator.law} law, W0 = {design.w0:.3f} mm"
+                + (", generator's centre section" if drive.coned else "")
+                + (", parts with their [imperfections])" if imp is not None else ")"),
+                entry_deg=scene["entry_deg"],
+            )
             path = out / f"{stem}_phi{tag}.png"
             Path(batch.temp_path(path)).write_bytes(png)
             files.append(path)
@@ -252,9 +278,13 @@ def cmd_generate(args) -> int:
         write_stdout(json.dumps(rep, indent=2) + "\n")
     elif not args.quiet:
         removed = f", removed {len(stale)} of the previous run's files" if stale else ""
-        write_stdout(format_summary(rep) + "\n" + "".join(f"  NOT MODELLED: {n}\n" for n in rep["not_modelled"])
-                     + (f"  [imperfections]: {rep['imperfections']}\n" if "imperfections" in rep else "")
-                     + f"\n  wrote {len(files)} files to {out}/ ({report_path.name}){removed} in {time.perf_counter() - t0:.2f} s\n")
+        write_stdout(
+            format_summary(rep)
+            + "\n"
+            + "".join(f"  NOT MODELLED: {n}\n" for n in rep["not_modelled"])
+            + (f"  [imperfections]: {rep['imperfections']}\n" if "imperfections" in rep else "")
+            + f"\n  wrote {len(files)} files to {out}/ ({report_path.name}){removed} in {time.perf_counter() - t0:.2f} s\n"
+        )
     return EXIT_OK
 
 
@@ -264,26 +294,53 @@ def register(sub) -> None:
     import textwrap
 
     g = sub.add_parser(
-        "generate", help="write DXF, STL, <design>.report.json (and deformed-state DXF/PNG) for a design",
-        description=textwrap.fill("Write the manufacturing files of a design into one folder: <design>.dxf, "
-                    "<design>_flexspline.stl, <design>_rigid.stl, <design>.report.json and, per --generator-angle, "
-                    "<design>_phi<angle>.dxf/.png. Several designs can share a folder (each file starts with the design "
-                    "file's name). A re-run replaces this design's files and removes those of its previous run that it "
-                    "does not write again (listed in the hidden .<design>.wgcad-files.json), nothing else, "
-                    "and the temporary files a killed run left (.<file>.<pid>-<hex>.tmp).", width=79),
-        epilog=EPILOG, formatter_class=argparse.RawDescriptionHelpFormatter)
+        "generate",
+        help="write DXF, STL, <design>.report.json (and deformed-state DXF/PNG) for a design",
+        description=textwrap.fill(
+            "Write the manufacturing files of a design into one folder: <design>.dxf, "
+            "<design>_flexspline.stl, <design>_rigid.stl, <design>.report.json and, per --generator-angle, "
+            "<design>_phi<angle>.dxf/.png. Several designs can share a folder (each file starts with the design "
+            "file's name). A re-run replaces this design's files and removes those of its previous run that it "
+            "does not write again (listed in the hidden .<design>.wgcad-files.json), nothing else, "
+            "and the temporary files a killed run left (.<file>.<pid>-<hex>.tmp).",
+            width=79,
+        ),
+        epilog=EPILOG,
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
     g.add_argument("design", help="design file (TOML), e.g. templates/d1_involute.toml")
-    g.add_argument("--out", metavar="DIR", help="output folder (default: output/<design name>); created when the files are written")
-    g.add_argument("--chord-tol-um", type=positive_float(0.0, 100.0, "um"), default=1.0,
-                   help="largest distance between outline and exact curve, um (default 1)")
-    g.add_argument("--generator-angle", type=angles_deg, metavar="DEG[,DEG...]",
-                   help="also write the deformed assembly (DXF + PNG) at these generator angles, degrees")
+    g.add_argument(
+        "--out", metavar="DIR", help="output folder (default: output/<design name>); created when the files are written"
+    )
+    g.add_argument(
+        "--chord-tol-um",
+        type=positive_float(0.0, 100.0, "um"),
+        default=1.0,
+        help="largest distance between outline and exact curve, um (default 1)",
+    )
+    g.add_argument(
+        "--generator-angle",
+        type=angles_deg,
+        metavar="DEG[,DEG...]",
+        help="also write the deformed assembly (DXF + PNG) at these generator angles, degrees",
+    )
     g.add_argument("--no-stl", action="store_true", help="skip the STL solids (and the import of the 3D libraries)")
-    g.add_argument("--force", action="store_true",
-                   help="replace the files that a different design file of the same name wrote in --out")
-    g.add_argument("--json", action="store_true", help="print the report (as in <design>.report.json) to stdout instead of the summary")
-    g.add_argument("--progress", action="store_true", help="progress bar (fraction, ETA) on stderr even when it is not a terminal or with --quiet; "
-                   "by default it is drawn only on a terminal")
+    g.add_argument(
+        "--force",
+        action="store_true",
+        help="replace the files that a different design file of the same name wrote in --out",
+    )
+    g.add_argument(
+        "--json",
+        action="store_true",
+        help="print the report (as in <design>.report.json) to stdout instead of the summary",
+    )
+    g.add_argument(
+        "--progress",
+        action="store_true",
+        help="progress bar (fraction, ETA) on stderr even when it is not a terminal or with --quiet; "
+        "by default it is drawn only on a terminal",
+    )
     g.add_argument("--quiet", action="store_true", help="print nothing on success")
     add_memory_flag(g)
     g.set_defaults(func=cmd_generate)

@@ -32,8 +32,10 @@ def cmd_kinematics(args) -> int:
     print(f"  rigid gear fixed:      u_hg = {r['u_hg']:g}  (flexspline turns {sense(r['u_hg'])})")
     print(f"  flexspline fixed:      u_hb = {r['u_hb']:g}  (rigid gear turns {sense(r['u_hb'])})")
     z_ref = d.z_rigid if d.fixed == "rigid" else d.z_flex
-    print(f"  mesh period (perfect gears): {360.0 / z_ref:.6g} deg of generator rotation "
-          f"(the {'rigid' if d.fixed == 'rigid' else 'flexspline'} teeth pass one pitch)")
+    print(
+        f"  mesh period (perfect gears): {360.0 / z_ref:.6g} deg of generator rotation "
+        f"(the {'rigid' if d.fixed == 'rigid' else 'flexspline'} teeth pass one pitch)"
+    )
     if not design.external:
         return EXIT_OK
     from ..atomic import atomic_batch
@@ -53,29 +55,48 @@ def cmd_kinematics(args) -> int:
     np.savetxt(buf, rows, delimiter=",", header=header, comments="", fmt="%.9g")
     from ..export.figures import velocities_png
 
-    png = velocities_png(vel, f"{d.name}: external ring generator velocities, omega_h = {args.omega_h:g} rad/s, a_w = {a_w:.3f} mm")
+    png = velocities_png(
+        vel, f"{d.name}: external ring generator velocities, omega_h = {args.omega_h:g} rad/s, a_w = {a_w:.3f} mm"
+    )
     stem = Path(args.design).stem
     with atomic_batch() as batch:
         Path(batch.temp_path(out / f"{stem}_velocities.csv")).write_text(buf.getvalue())
         Path(batch.temp_path(out / f"{stem}_velocities.png")).write_bytes(png)
     i = int(np.argmax(np.abs(vel.V_sl)))
     print(f"  external ring generator, omega_h = {args.omega_h:g} rad/s, a_w = {a_w:.4f} mm:")
-    print(f"    washer speed V_d = {vel.V_d[0]:.4g} mm/s; largest sliding speed |V_sl| = {abs(vel.V_sl[i]):.4g} mm/s at phi = {np.rad2deg(phi[i]):.1f} deg")
+    print(
+        f"    washer speed V_d = {vel.V_d[0]:.4g} mm/s; largest sliding speed |V_sl| = {abs(vel.V_sl[i]):.4g} mm/s at phi = {np.rad2deg(phi[i]):.1f} deg"
+    )
     print(f"  wrote {stem}_velocities.csv and .png to {out}/")
     return EXIT_OK
-
 
 
 def register(sub) -> None:
     """Add the subcommand to the ``wgcad`` parser's subparsers."""
     import argparse
 
-    k = sub.add_parser("kinematics", help="gear ratios; velocities of the external ring generator (CSV + PNG)",
-                       epilog=EPILOG, formatter_class=argparse.RawDescriptionHelpFormatter)
+    k = sub.add_parser(
+        "kinematics",
+        help="gear ratios; velocities of the external ring generator (CSV + PNG)",
+        epilog=EPILOG,
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
     k.add_argument("design", help="design file (TOML), e.g. templates/d3_external.toml")
-    k.add_argument("--out", metavar="DIR", help="output folder of the velocity CSV and PNG (external deformation only; default: output/<design name>)")
-    k.add_argument("--omega-h", type=positive_float(0.0, 1e6, "rad/s"), default=1.0,
-                   help="generator speed, rad/s (default 1: velocities per rad/s; [S3] uses 210)")
-    k.add_argument("--eccentricity", type=positive_float(0.0, 100.0, "mm"), default=None,
-                   help="washer crank eccentricity a_w, mm (default W0)")
+    k.add_argument(
+        "--out",
+        metavar="DIR",
+        help="output folder of the velocity CSV and PNG (external deformation only; default: output/<design name>)",
+    )
+    k.add_argument(
+        "--omega-h",
+        type=positive_float(0.0, 1e6, "rad/s"),
+        default=1.0,
+        help="generator speed, rad/s (default 1: velocities per rad/s; [S3] uses 210)",
+    )
+    k.add_argument(
+        "--eccentricity",
+        type=positive_float(0.0, 100.0, "mm"),
+        default=None,
+        help="washer crank eccentricity a_w, mm (default W0)",
+    )
     k.set_defaults(func=cmd_kinematics)

@@ -30,7 +30,9 @@ def torque_levels(text: str) -> list[float]:
         else:
             out = [float(x) for x in text.split(",")]
     except ValueError:
-        raise DesignError("--torque-nm", f"expected START:STOP:STEP, a value or a comma list of torques in N m, got '{text}'") from None
+        raise DesignError(
+            "--torque-nm", f"expected START:STOP:STEP, a value or a comma list of torques in N m, got '{text}'"
+        ) from None
     for t in out:
         if not (math.isfinite(t) and t >= 0):
             raise DesignError("--torque-nm", f"torques must be >= 0 N m, got {t:g}")
@@ -40,25 +42,50 @@ def torque_levels(text: str) -> list[float]:
 def register_args(a) -> None:
     """Add the load flags to the ``audit`` subparser."""
     g = a.add_argument_group("under load (elastic contact model; needs [bearing] in the design)")
-    g.add_argument("--torque-nm", metavar="SPEC", nargs="?", const=RATED,
-                   help="output torques: START:STOP:STEP (e.g. 0:3000:250), a value or a list; without SPEC, 0 to the "
-                   "design's [load] rated_torque_nm in 12 steps; exit 1 when the entry gap Delta closes at a requested load")
-    g.add_argument("--cam-offset-um", type=float, default=None, help="cam axis offset e_h, um (default: [load] of the design, else 0)")
-    g.add_argument("--cam-offset-deg", type=float, default=None, help="direction of e_h from the major axis, deg (default: [load], else 0)")
-    g.add_argument("--compare", metavar="DESIGN2", help="also sweep DESIGN2 and plot both designs' entry gap against torque "
-                   "for e_h = 0 and the given offset (40 um if none): PATH_compare.png")
+    g.add_argument(
+        "--torque-nm",
+        metavar="SPEC",
+        nargs="?",
+        const=RATED,
+        help="output torques: START:STOP:STEP (e.g. 0:3000:250), a value or a list; without SPEC, 0 to the "
+        "design's [load] rated_torque_nm in 12 steps; exit 1 when the entry gap Delta closes at a requested load",
+    )
+    g.add_argument(
+        "--cam-offset-um",
+        type=float,
+        default=None,
+        help="cam axis offset e_h, um (default: [load] of the design, else 0)",
+    )
+    g.add_argument(
+        "--cam-offset-deg",
+        type=float,
+        default=None,
+        help="direction of e_h from the major axis, deg (default: [load], else 0)",
+    )
+    g.add_argument(
+        "--compare",
+        metavar="DESIGN2",
+        help="also sweep DESIGN2 and plot both designs' entry gap against torque "
+        "for e_h = 0 and the given offset (40 um if none): PATH_compare.png",
+    )
 
 
 def _summary(name: str, res: dict) -> str:
-    lines = [f"{name}: under load (elastic contact model, {len(res['model']['sections_z_mm'])} sections), "
-             f"cam offset {res['cam_offset_um']:g} um at {res['cam_offset_deg']:g} deg"]
+    lines = [
+        f"{name}: under load (elastic contact model, {len(res['model']['sections_z_mm'])} sections), "
+        f"cam offset {res['cam_offset_um']:g} um at {res['cam_offset_deg']:g} deg"
+    ]
     mnt = res["model"].get("mounted")
     if mnt:
-        lines.append(f"  on the cam at no load: W0 {mnt['w0_um']:.1f} um at the major axis (the design's), the rim within "
-                     f"{mnt['largest_departure_from_law_um']:.1f} um of the law (largest at {mnt['departure_at_deg']:+.1f} deg), "
-                     f"held by {mnt['balls_in_contact']} balls of {mnt['ball_preload_n']:.0f} N")
-    lines.append("  torque N m | entry gap Delta um (where)           | tip crossing um | teeth in contact | max tooth force N | "
-                 "max ball load N | generator N m | wind-up arcmin | secant N m/rad | tangent N m/rad")
+        lines.append(
+            f"  on the cam at no load: W0 {mnt['w0_um']:.1f} um at the major axis (the design's), the rim within "
+            f"{mnt['largest_departure_from_law_um']:.1f} um of the law (largest at {mnt['departure_at_deg']:+.1f} deg), "
+            f"held by {mnt['balls_in_contact']} balls of {mnt['ball_preload_n']:.0f} N"
+        )
+    lines.append(
+        "  torque N m | entry gap Delta um (where)           | tip crossing um | teeth in contact | max tooth force N | "
+        "max ball load N | generator N m | wind-up arcmin | secant N m/rad | tangent N m/rad"
+    )
     for k, lv in enumerate(res["levels"]):
         sec = res["secant_stiffness_nm_per_rad"][k]
         tan = res["tangent_stiffness_nm_per_rad"][k - 1] if k else None
@@ -66,40 +93,53 @@ def _summary(name: str, res: dict) -> str:
         at = lv.get("entry_gap_at")
         where = "" if not at else f"{at['tooth_angle_deg']:+6.1f} deg z {at['section_z_mm']:g} {at['edge']}"
         cr = "none" if lv.get("crossing_gap_um") is None else f"{lv['crossing_gap_um']:.3f}"
-        lines.append(f"  {lv['torque_nm']:10g} | {eg:>9} {where:<25} | {cr:>15} | {lv['teeth_in_contact']:16d} | "
-                     f"{lv['largest_tooth_force_n']:17.1f} | {lv['max_ball_load_n']:15.1f} | {lv['generator_torque_nm']:13.3f} | "
-                     f"{lv['wind_up_arcmin']:14.4f} | " + ("-" if sec is None else f"{sec:14.4g}") + " | "
-                     + ("-" if tan is None else f"{tan:.4g}"))
+        lines.append(
+            f"  {lv['torque_nm']:10g} | {eg:>9} {where:<25} | {cr:>15} | {lv['teeth_in_contact']:16d} | "
+            f"{lv['largest_tooth_force_n']:17.1f} | {lv['max_ball_load_n']:15.1f} | {lv['generator_torque_nm']:13.3f} | "
+            f"{lv['wind_up_arcmin']:14.4f} | "
+            + ("-" if sec is None else f"{sec:14.4g}")
+            + " | "
+            + ("-" if tan is None else f"{tan:.4g}")
+        )
     top = res["levels"][-1]
-    lines.append(f"  at {top['torque_nm']:g} N m: smallest clearance of unloaded pairs "
-                 + ("-" if top["min_clearance_um"] is None else f"{top['min_clearance_um']:.3f} um")
-                 + f", largest contact approach (teeth pressed into each other, contact not interference) {top['max_contact_approach_um']:.3f} um"
-                 + f", largest ball Hertz pressure {top['max_ball_pressure_mpa']:.0f} MPa")
+    lines.append(
+        f"  at {top['torque_nm']:g} N m: smallest clearance of unloaded pairs "
+        + ("-" if top["min_clearance_um"] is None else f"{top['min_clearance_um']:.3f} um")
+        + f", largest contact approach (teeth pressed into each other, contact not interference) {top['max_contact_approach_um']:.3f} um"
+        + f", largest ball Hertz pressure {top['max_ball_pressure_mpa']:.0f} MPa"
+    )
     for sec in top["sections"]:
         zones = ", ".join("-" if z is None else f"{z[0]:+.1f}..{z[1]:+.1f} deg" for z in sec["zone_deg"])
-        lines.append(f"    section z = {sec['section_z_mm']:g} mm: {sec['teeth_in_contact']} {'tooth' if sec['teeth_in_contact'] == 1 else 'teeth'} in contact "
-                     f"({sec['working_flank_contacts']} working, {sec['non_working_flank_contacts']} non-working flanks), zones per wave {zones}")
+        lines.append(
+            f"    section z = {sec['section_z_mm']:g} mm: {sec['teeth_in_contact']} {'tooth' if sec['teeth_in_contact'] == 1 else 'teeth'} in contact "
+            f"({sec['working_flank_contacts']} working, {sec['non_working_flank_contacts']} non-working flanks), zones per wave {zones}"
+        )
     worst = max(lv["residuals"]["equilibrium"] for lv in res["levels"])
     lin = max(lv["residuals"]["linearisation_mm"] for lv in res["levels"])
-    lines.append(f"  residuals: equilibrium {worst:.1e} (relative), nonlinear contact law {1e3 * lin:.3f} um; "
-                 f"{res['elapsed_s']:.2f} s")
+    lines.append(
+        f"  residuals: equilibrium {worst:.1e} (relative), nonlinear contact law {1e3 * lin:.3f} um; "
+        f"{res['elapsed_s']:.2f} s"
+    )
     if res["entry_gap_closes"]:
         lines.append("  ENTRY GAP CLOSES under load: tip interference")
     return "\n".join(lines)
 
 
 def _sweep(path, torques, e_um, e_deg, sections, progress):
-    from ..elastic.model import build_model
-    from ..elastic.sweep import torque_sweep
     from ..design import load_design
     from ..drive import build_drive
+    from ..elastic.model import build_model
+    from ..elastic.sweep import torque_sweep
 
     drive = build_drive(load_design(path))
     if drive.design.imperfections.any:
         # the load audit models perfect parts: silently dropping the errors would report another drive
-        raise DesignError("imperfections", "the load audit (--torque-nm) models perfect parts and this design has "
-                          "[imperfections]: its KE under load is `wgcad ke --torque-nm`, its no-load clearance `wgcad audit` "
-                          "without --torque-nm; for the perfect drive's load audit remove the table")
+        raise DesignError(
+            "imperfections",
+            "the load audit (--torque-nm) models perfect parts and this design has "
+            "[imperfections]: its KE under load is `wgcad ke --torque-nm`, its no-load clearance `wgcad audit` "
+            "without --torque-nm; for the perfect drive's load audit remove the table",
+        )
     ld = drive.design.load
     e_um = ld.cam_offset_um if e_um is None else e_um
     e_deg = ld.cam_offset_deg if e_deg is None else e_deg
@@ -121,8 +161,11 @@ def _levels(args) -> list[float]:
 
     rated = load_design(args.design).load.rated_torque_nm
     if rated is None or not rated > 0:
-        raise DesignError("load.rated_torque_nm", "--torque-nm without a value sweeps 0 to the rated torque: give "
-                          "[load] rated_torque_nm > 0 in the design or a SPEC to the flag")
+        raise DesignError(
+            "load.rated_torque_nm",
+            "--torque-nm without a value sweeps 0 to the rated torque: give "
+            "[load] rated_torque_nm > 0 in the design or a SPEC to the flag",
+        )
     return [rated * i / RATED_STEPS for i in range(RATED_STEPS + 1)]
 
 
@@ -143,8 +186,13 @@ def run_load(args) -> int:
         for path in (args.design, args.compare):
             for eu in (0.0, e):
                 d2, r2 = _sweep(path, torques, eu, args.cam_offset_deg or 0.0, args.sections, prog)
-                compare.append({"label": f"{d2.design.drive.name}, e_h = {eu:g} um", "torque_nm": [lv["torque_nm"] for lv in r2["levels"]],
-                                "entry_gap_um": [lv["entry_gap_um"] for lv in r2["levels"]]})
+                compare.append(
+                    {
+                        "label": f"{d2.design.drive.name}, e_h = {eu:g} um",
+                        "torque_nm": [lv["torque_nm"] for lv in r2["levels"]],
+                        "entry_gap_um": [lv["entry_gap_um"] for lv in r2["levels"]],
+                    }
+                )
         res["compare"] = compare
     with atomic_batch() as batch:
         if args.json:
@@ -154,17 +202,40 @@ def run_load(args) -> int:
 
             p = Path(args.plot)
             name = res["design"]
-            series = [{"label": f"{name}, e_h = {res['cam_offset_um']:g} um", "torque_nm": [lv["torque_nm"] for lv in res["levels"]],
-                       "entry_gap_um": [lv["entry_gap_um"] for lv in res["levels"]]}]
+            series = [
+                {
+                    "label": f"{name}, e_h = {res['cam_offset_um']:g} um",
+                    "torque_nm": [lv["torque_nm"] for lv in res["levels"]],
+                    "entry_gap_um": [lv["entry_gap_um"] for lv in res["levels"]],
+                }
+            ]
             Path(batch.temp_path(p.with_name(f"{p.stem}_entry_gap.png"))).write_bytes(
-                entry_gap_png(series, f"{name}: entry gap against output torque (smallest over waves and sections)", res["interference_tol_um"]))
+                entry_gap_png(
+                    series,
+                    f"{name}: entry gap against output torque (smallest over waves and sections)",
+                    res["interference_tol_um"],
+                )
+            )
             Path(batch.temp_path(p.with_name(f"{p.stem}_forces.png"))).write_bytes(
-                force_distribution_png(res["levels"], f"{name}: tooth forces (all sections) and ball loads around the rim"))
+                force_distribution_png(
+                    res["levels"], f"{name}: tooth forces (all sections) and ball loads around the rim"
+                )
+            )
             if compare:
                 Path(batch.temp_path(p.with_name(f"{p.stem}_compare.png"))).write_bytes(
-                    entry_gap_png(compare, "entry gap against output torque: tooth forms and cam offsets", res["interference_tol_um"]))
+                    entry_gap_png(
+                        compare,
+                        "entry gap against output torque: tooth forms and cam offsets",
+                        res["interference_tol_um"],
+                    )
+                )
     if not args.quiet:
         print(_summary(res["design"], res))
         for c in compare or []:
-            print("  compare " + c["label"] + ": entry gap um " + ", ".join("none" if g is None else f"{g:.2f}" for g in c["entry_gap_um"]))
+            print(
+                "  compare "
+                + c["label"]
+                + ": entry gap um "
+                + ", ".join("none" if g is None else f"{g:.2f}" for g in c["entry_gap_um"])
+            )
     return EXIT_INTERFERENCE if res["entry_gap_closes"] else EXIT_OK

@@ -130,8 +130,10 @@ class Manifest:
         prev = self.previous
         if prev is None or force or prev.get("source") == self.source:
             return
-        raise OutputError(f"{self.folder}: holds the files of another design file named {self.stem} "
-                          f"({prev.get('source')}); give another --out, or --force to replace them")
+        raise OutputError(
+            f"{self.folder}: holds the files of another design file named {self.stem} "
+            f"({prev.get('source')}); give another --out, or --force to replace them"
+        )
 
     def stale_files(self, new_names) -> tuple[list[Path], list[str]]:
         """Files of the previous run not written again: (to remove, kept because they changed)."""
@@ -143,8 +145,14 @@ class Manifest:
             if not isinstance(entry, dict):
                 continue
             name = entry.get("name")
-            if (not isinstance(name, str) or name in new or name in ("", ".", "..") or "/" in name
-                    or os.sep in name or name.startswith(".")):
+            if (
+                not isinstance(name, str)
+                or name in new
+                or name in ("", ".", "..")
+                or "/" in name
+                or os.sep in name
+                or name.startswith(".")
+            ):
                 continue  # only plain names in this folder, never hidden files (temporaries, manifests)
             p = self.folder / name
             try:
@@ -161,7 +169,9 @@ class Manifest:
 
     def document(self, written: list[tuple[Path, str]]) -> str:
         """The manifest of this run: ``written`` is a list of (final path, temporary file with its content)."""
-        files = [{"name": Path(final).name, "size": os.path.getsize(temp), "sha256": _sha256(temp)}
-                 for final, temp in written]
+        files = [
+            {"name": Path(final).name, "size": os.path.getsize(temp), "sha256": _sha256(temp)}
+            for final, temp in written
+        ]
         doc = {"written_by": "wgcad generate", "design": self.stem, "source": self.source, "files": files}
         return json.dumps(doc, indent=1) + "\n"

@@ -27,7 +27,9 @@ def formats(text: str) -> list[str]:
 
 def _jsonable(v):
     if isinstance(v, dict):
-        return {k: _jsonable(x) for k, x in v.items() if k not in ("plug_outline", "neutral_line", "meshes", "build_meshes")}
+        return {
+            k: _jsonable(x) for k, x in v.items() if k not in ("plug_outline", "neutral_line", "meshes", "build_meshes")
+        }
     if isinstance(v, float):
         return round(v, 6)
     return v
@@ -35,11 +37,11 @@ def _jsonable(v):
 
 def cmd_parts(args) -> int:
     t0 = time.perf_counter()
+    from ..atomic import atomic_batch, ensure_writable_dir
     from ..design import load_design
     from ..design.parts import load_parts, part_sizes
     from ..drive import build_drive
     from ..errors import GeometryError
-    from ..atomic import atomic_batch, ensure_writable_dir
     from ..export.parts import build_parts
 
     design = load_design(args.design)
@@ -66,9 +68,17 @@ def cmd_parts(args) -> int:
                 solids[p.name] = p.solid()
     ensure_writable_dir(out)
     files = []
-    report = {"design": str(args.design), "chord_tol_mm": tol, "dxf_style": args.dxf_style, "formats": fmts,
-              "sizes_mm": _jsonable(sizes.values), "derived_from_gear_size": list(sizes.derived), "parts": {}}
+    report = {
+        "design": str(args.design),
+        "chord_tol_mm": tol,
+        "dxf_style": args.dxf_style,
+        "formats": fmts,
+        "sizes_mm": _jsonable(sizes.values),
+        "derived_from_gear_size": list(sizes.derived),
+        "parts": {},
+    }
     with atomic_batch() as batch:
+
         def target(name):
             path = out / name
             files.append(path)
@@ -96,7 +106,10 @@ def cmd_parts(args) -> int:
         if "3mf" in fmts:
             from ..export.threemf import write_3mf
 
-            write_3mf(target(f"{stem}_parts.3mf"), {p.name: meshes[p.name] for p in parts if not p.name.startswith("assembly")})
+            write_3mf(
+                target(f"{stem}_parts.3mf"),
+                {p.name: meshes[p.name] for p in parts if not p.name.startswith("assembly")},
+            )
             for p in parts:
                 if p.name.startswith("assembly"):
                     write_3mf(target(f"{stem}_{p.name}.3mf"), {f"{p.name}_{k}": m for k, m in p.info["meshes"].items()})
@@ -115,18 +128,39 @@ def cmd_parts(args) -> int:
 
 def register(sub) -> None:
     """Add the subcommand to the ``wgcad`` parser's subparsers."""
-    g = sub.add_parser("parts", help="write the parts a shop makes: cup flexspline, generator plug, rigid gear (DXF, SVG, STL, 3MF, STEP)",
-                       epilog=EPILOG, formatter_class=argparse.RawDescriptionHelpFormatter)
+    g = sub.add_parser(
+        "parts",
+        help="write the parts a shop makes: cup flexspline, generator plug, rigid gear (DXF, SVG, STL, 3MF, STEP)",
+        epilog=EPILOG,
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
     g.add_argument("design", help="design file (TOML); sizes of the parts from its optional [parts] table")
     g.add_argument("--out", help="output folder (default: output/<design name>)")
-    g.add_argument("--format", type=formats, default=list(FORMATS), metavar="FMT[,FMT...]",
-                   help=f"file formats to write (default all: {','.join(FORMATS)})")
-    g.add_argument("--dxf-style", choices=("arcs", "polyline"), default="arcs",
-                   help="tooth outlines in DXF/SVG as tangent arcs (default) or straight segments")
-    g.add_argument("--chord-tol-um", type=positive_float(0.0, 100.0, "um"), default=1.0,
-                   help="largest distance between written geometry and exact curve, um (default 1)")
-    g.add_argument("--generator-angle", type=angles_deg, metavar="DEG[,DEG...]",
-                   help="also write the deformed assembly (STL/3MF meshes) at these generator angles, degrees")
+    g.add_argument(
+        "--format",
+        type=formats,
+        default=list(FORMATS),
+        metavar="FMT[,FMT...]",
+        help=f"file formats to write (default all: {','.join(FORMATS)})",
+    )
+    g.add_argument(
+        "--dxf-style",
+        choices=("arcs", "polyline"),
+        default="arcs",
+        help="tooth outlines in DXF/SVG as tangent arcs (default) or straight segments",
+    )
+    g.add_argument(
+        "--chord-tol-um",
+        type=positive_float(0.0, 100.0, "um"),
+        default=1.0,
+        help="largest distance between written geometry and exact curve, um (default 1)",
+    )
+    g.add_argument(
+        "--generator-angle",
+        type=angles_deg,
+        metavar="DEG[,DEG...]",
+        help="also write the deformed assembly (STL/3MF meshes) at these generator angles, degrees",
+    )
     g.add_argument("--json", action="store_true", help="print parts.json to stdout instead of the summary")
     g.add_argument("--quiet", action="store_true", help="print nothing on success")
     g.set_defaults(func=cmd_parts)

@@ -78,7 +78,7 @@ class Progress:
         self.stage = str(stage)
         self._draw(force=True)
 
-    def span(self, lo: float, hi: float, stage: str | None = None) -> "Progress":
+    def span(self, lo: float, hi: float, stage: str | None = None) -> Progress:
         """Map the following ``(done, total)`` calls onto ``[lo, hi]`` of the whole bar; returns self."""
         self._lo, self._hi = float(lo), float(hi)
         self.set(self._lo, stage)

@@ -34,13 +34,15 @@ def _scheduler(text: str) -> str:
 
 
 def cmd_sweep(args) -> int:
-    from ..errors import DesignError, OutputError
     from ..atomic import atomic_batch, check_writable_dir
+    from ..errors import DesignError, OutputError
     from ..sweep.spec import load_spec
     from .common import Progress, want_progress
 
     if args.scheduler and args.workers is not None:
-        raise DesignError("--workers", "starts a local cluster; with --scheduler the scheduler's workers are used: give one of them")
+        raise DesignError(
+            "--workers", "starts a local cluster; with --scheduler the scheduler's workers are used: give one of them"
+        )
     spec = load_spec(args.spec)
     out = Path(args.out) if args.out else Path("output") / f"sweep_{Path(args.spec).stem}"
     check_writable_dir(out)
@@ -76,7 +78,9 @@ def cmd_sweep(args) -> int:
     bar.close()
     if not args.quiet:
         print(format_summary(summ, info))
-        print(f"  results: {out}/chunks ({store.fmt}), {out}/summary.json" + ("" if args.no_plots else f", {out}/*.png"))
+        print(
+            f"  results: {out}/chunks ({store.fmt}), {out}/summary.json" + ("" if args.no_plots else f", {out}/*.png")
+        )
     return EXIT_OK
 
 
@@ -84,16 +88,36 @@ def register(sub) -> None:
     """Add the subcommand to the ``wgcad`` parser's subparsers."""
     import argparse
 
-    s = sub.add_parser("sweep", help="tolerance Monte Carlo or design study over a sweep spec, on Dask; resumable",
-                       epilog=EPILOG + "  4    the Dask cluster failed (a worker died, the scheduler went away): the chunks done are kept, run again to resume\n", formatter_class=argparse.RawDescriptionHelpFormatter,
-                       description="Runs every sample of SPEC not yet stored in --out (rerun after an interruption: only "
-                                   "the missing samples are computed). Example spec: templates/sweeps/d2_tolerance_sweep.toml")
-    s.add_argument("spec", help="sweep spec (TOML): [sweep] design, samples, seed; [parameters.TABLE.KEY]; [figures] record; [limits]")
-    s.add_argument("--scheduler", type=_scheduler, help="address of a running Dask scheduler, tcp://HOST:PORT (default: a local cluster)")
-    s.add_argument("--workers", type=_count(0, 4096, "worker processes"), default=None,
-                   help="worker processes of the local cluster (default: one per core; 0: in this process without Dask)")
-    s.add_argument("--batch", type=_count(1, 1_000_000, "samples per task"), default=None,
-                   help="samples per task (default: the spec's sweep.batch, else chosen by measuring a probe task)")
+    s = sub.add_parser(
+        "sweep",
+        help="tolerance Monte Carlo or design study over a sweep spec, on Dask; resumable",
+        epilog=EPILOG
+        + "  4    the Dask cluster failed (a worker died, the scheduler went away): the chunks done are kept, run again to resume\n",
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+        description="Runs every sample of SPEC not yet stored in --out (rerun after an interruption: only "
+        "the missing samples are computed). Example spec: templates/sweeps/d2_tolerance_sweep.toml",
+    )
+    s.add_argument(
+        "spec",
+        help="sweep spec (TOML): [sweep] design, samples, seed; [parameters.TABLE.KEY]; [figures] record; [limits]",
+    )
+    s.add_argument(
+        "--scheduler",
+        type=_scheduler,
+        help="address of a running Dask scheduler, tcp://HOST:PORT (default: a local cluster)",
+    )
+    s.add_argument(
+        "--workers",
+        type=_count(0, 4096, "worker processes"),
+        default=None,
+        help="worker processes of the local cluster (default: one per core; 0: in this process without Dask)",
+    )
+    s.add_argument(
+        "--batch",
+        type=_count(1, 1_000_000, "samples per task"),
+        default=None,
+        help="samples per task (default: the spec's sweep.batch, else chosen by measuring a probe task)",
+    )
     s.add_argument("--out", help="results folder (default output/sweep_SPECNAME); reused to resume")
     s.add_argument("--summary-only", action="store_true", help="compute nothing: summarise the samples stored in --out")
     s.add_argument("--no-plots", action="store_true", help="no PNGs")

@@ -71,8 +71,12 @@ class RunEstimate:
     memory_mb: float
 
     def as_dict(self) -> dict:
-        return {"vertices_per_tooth": dict(self.vertices_per_tooth), "outline_vertices": self.outline_vertices,
-                "audit_samples": self.audit_samples, "memory_mb": round(self.memory_mb, 1)}
+        return {
+            "vertices_per_tooth": dict(self.vertices_per_tooth),
+            "outline_vertices": self.outline_vertices,
+            "audit_samples": self.audit_samples,
+            "memory_mb": round(self.memory_mb, 1),
+        }
 
 
 def outline_vertices_per_tooth(form: str, module: float, tol: float) -> int:
@@ -80,9 +84,19 @@ def outline_vertices_per_tooth(form: str, module: float, tol: float) -> int:
     return int(ceil(_VERTS_A + _VERTS_B.get(form, max(_VERTS_B.values())) * sqrt(module / tol)))
 
 
-def estimate_run(design, tol: float = constants.CHORD_TOL, *, angles: int = 0, sections: int = 1,
-                 use_period: bool = True, use_waves: bool = True, use_mirror: bool = True,
-                 bound: bool = True, exports: bool = True, vertices_per_tooth: dict | None = None) -> RunEstimate:
+def estimate_run(
+    design,
+    tol: float = constants.CHORD_TOL,
+    *,
+    angles: int = 0,
+    sections: int = 1,
+    use_period: bool = True,
+    use_waves: bool = True,
+    use_mirror: bool = True,
+    bound: bool = True,
+    exports: bool = True,
+    vertices_per_tooth: dict | None = None,
+) -> RunEstimate:
     """Estimate the outline sizes, audit samples and peak memory of a run, from the design alone.
 
     Parameters
@@ -125,14 +139,18 @@ def estimate_run(design, tol: float = constants.CHORD_TOL, *, angles: int = 0, s
         n_u = n_s // fold if use_period else n_s
         batch = n_u * secs if not bound else max(1, n_u * secs // _BOUND_BATCH_DIVISOR)
         p = verts["flexspline"] + 2  # a tooth polygon: one pitch closed through the body
-        mem += (n_s * _PER_SAMPLE_B + n_u * secs * _PER_UNIQUE_SECTION_B
-                + n_u * 0.5 * p * 16.0  # radial bound: the tip half of every distinct tooth angle, placed
-                + batch * p * _PER_BATCH_VERTEX_B)
+        mem += (
+            n_s * _PER_SAMPLE_B
+            + n_u * secs * _PER_UNIQUE_SECTION_B
+            + n_u * 0.5 * p * 16.0  # radial bound: the tip half of every distinct tooth angle, placed
+            + batch * p * _PER_BATCH_VERTEX_B
+        )
     return RunEstimate(verts, int(n_out), int(samples), mem / 1e6)
 
 
-def check_budget(est: RunEstimate, max_memory_mb: float | None = DEFAULT_MAX_MEMORY_MB,
-                 flag: str = "--max-memory-mb") -> RunEstimate:
+def check_budget(
+    est: RunEstimate, max_memory_mb: float | None = DEFAULT_MAX_MEMORY_MB, flag: str = "--max-memory-mb"
+) -> RunEstimate:
     """Refuse a run whose estimated memory exceeds ``max_memory_mb`` (None: no limit).
 
     Raises
@@ -144,7 +162,10 @@ def check_budget(est: RunEstimate, max_memory_mb: float | None = DEFAULT_MAX_MEM
         what = f"{est.outline_vertices} outline vertices"
         if est.audit_samples:
             what += f", {est.audit_samples} audit samples"
-        raise DesignError(flag, f"this run needs about {est.memory_mb:.0f} MB ({what}), more than the budget of "
-                                f"{max_memory_mb:g} MB; raise {flag}, or coarsen --chord-tol-um / --step-deg, "
-                                "or reduce the tooth counts")
+        raise DesignError(
+            flag,
+            f"this run needs about {est.memory_mb:.0f} MB ({what}), more than the budget of "
+            f"{max_memory_mb:g} MB; raise {flag}, or coarsen --chord-tol-um / --step-deg, "
+            "or reduce the tooth counts",
+        )
     return est

@@ -59,7 +59,9 @@ def read_design_text(path) -> str:
         if not stat.S_ISREG(st.st_mode):
             raise InputFileError(f"{p}: the design file is {_kind(st.st_mode)}, not a regular file")
         if st.st_size > MAX_DESIGN_BYTES:
-            raise InputFileError(f"{p}: design file of {st.st_size} bytes is larger than the limit of {MAX_DESIGN_BYTES} bytes")
+            raise InputFileError(
+                f"{p}: design file of {st.st_size} bytes is larger than the limit of {MAX_DESIGN_BYTES} bytes"
+            )
         chunks, size = [], 0
         while True:  # the size may change while reading: read at most one byte past the limit
             b = os.read(fd, MAX_DESIGN_BYTES + 1 - size)

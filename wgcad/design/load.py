@@ -14,44 +14,177 @@ __all__ = ["MaterialSpec", "BearingSpec", "LoadSpec", "validate_load_tables", "r
 class MaterialSpec:
     """``[material]``: the flexspline and bearing material and the rim's bending section."""
 
-    youngs_modulus_gpa: float = _key("Young's modulus of the flexspline and bearing material (steel 206)", unit="GPa", lo=0.0, lo_open=True, hi=1200.0, why="above 0; no engineering material is stiffer than ~1200 GPa", default=206.0)
-    poisson: float = _key("Poisson's ratio of the material", lo=0.0, hi=0.5, hi_open=True, why="a stable isotropic solid has 0 <= nu < 0.5", default=0.3)
+    youngs_modulus_gpa: float = _key(
+        "Young's modulus of the flexspline and bearing material (steel 206)",
+        unit="GPa",
+        lo=0.0,
+        lo_open=True,
+        hi=1200.0,
+        why="above 0; no engineering material is stiffer than ~1200 GPa",
+        default=206.0,
+    )
+    poisson: float = _key(
+        "Poisson's ratio of the material",
+        lo=0.0,
+        hi=0.5,
+        hi_open=True,
+        why="a stable isotropic solid has 0 <= nu < 0.5",
+        default=0.3,
+    )
     #: thickness of a plain ring as stiff in bending as the toothed rim, mm;
     #: default rim_thickness + 0.3 (tip - root radius) (docs/models.md 4.1: teeth
     #: add little bending stiffness because the spaces interrupt them)
-    rim_equivalent_thickness_mm: float | None = _key("thickness of a plain ring as stiff in bending as the toothed rim", unit="mm", lo=0.0, lo_open=True, hi=100.0, why="a positive wall, at most the 100 mm no thin-ring model covers", default=None, default_doc="rim_thickness + 0.3 (tip - root radius)")
+    rim_equivalent_thickness_mm: float | None = _key(
+        "thickness of a plain ring as stiff in bending as the toothed rim",
+        unit="mm",
+        lo=0.0,
+        lo_open=True,
+        hi=100.0,
+        why="a positive wall, at most the 100 mm no thin-ring model covers",
+        default=None,
+        default_doc="rim_thickness + 0.3 (tip - root radius)",
+    )
     #: thickness of the cup wall between the toothed rim and the diaphragm, mm;
     #: default = flexspline.rim_thickness
-    cup_wall_thickness_mm: float | None = _key("thickness of the cup wall between toothed rim and diaphragm", unit="mm", lo=0.0, lo_open=True, hi=100.0, why="a positive wall, at most the 100 mm no thin-ring model covers", default=None, default_doc="flexspline.rim_thickness")
+    cup_wall_thickness_mm: float | None = _key(
+        "thickness of the cup wall between toothed rim and diaphragm",
+        unit="mm",
+        lo=0.0,
+        lo_open=True,
+        hi=100.0,
+        why="a positive wall, at most the 100 mm no thin-ring model covers",
+        default=None,
+        default_doc="flexspline.rim_thickness",
+    )
 
 
 @dataclass(frozen=True)
 class BearingSpec:
     """``[bearing]``: the flexible bearing between cam and flexspline."""
 
-    balls: int | None = _key("rolling bodies in the flexible bearing", lo=3, hi=1000, why="at least 3 to hold the ring; 1000 is beyond any flexible bearing", default=None, default_doc="required by the load model")
-    ball_diameter_mm: float | None = _key("ball diameter", unit="mm", lo=0.0, lo_open=True, hi=200.0, why="positive; 200 mm is beyond any flexible bearing", default=None, default_doc="required by the load model")
-    width_mm: float | None = _key("bearing width", unit="mm", lo=0.0, lo_open=True, hi=1000.0, why="positive; a sanity bound", default=None, default_doc="required by the load model")
-    outer_ring_thickness_mm: float | None = _key("outer ring thickness under the raceway", unit="mm", lo=0.0, lo_open=True, hi=100.0, why="positive; a thin ring", default=None, default_doc="required by the load model")
-    internal_clearance_um: float = _key("radial gap at a ball inside the bearing", unit="um", lo=0.0, hi=1000.0, why="a gap, not an interference; above 1 mm no bearing carries the cam", default=0.0)
-    fit_clearance_um: float = _key("radial gap between the bearing outer ring and the flexspline bore", unit="um", lo=0.0, hi=1000.0, why="a gap, not an interference; above 1 mm the cam law is lost", default=0.0)
-    groove_conformity: float = _key("groove radius / ball diameter", lo=0.5, lo_open=True, hi=1.0, hi_open=True, why="above 0.5 or the ball jams in its groove; below 1 for a groove at all", default=0.52)
+    balls: int | None = _key(
+        "rolling bodies in the flexible bearing",
+        lo=3,
+        hi=1000,
+        why="at least 3 to hold the ring; 1000 is beyond any flexible bearing",
+        default=None,
+        default_doc="required by the load model",
+    )
+    ball_diameter_mm: float | None = _key(
+        "ball diameter",
+        unit="mm",
+        lo=0.0,
+        lo_open=True,
+        hi=200.0,
+        why="positive; 200 mm is beyond any flexible bearing",
+        default=None,
+        default_doc="required by the load model",
+    )
+    width_mm: float | None = _key(
+        "bearing width",
+        unit="mm",
+        lo=0.0,
+        lo_open=True,
+        hi=1000.0,
+        why="positive; a sanity bound",
+        default=None,
+        default_doc="required by the load model",
+    )
+    outer_ring_thickness_mm: float | None = _key(
+        "outer ring thickness under the raceway",
+        unit="mm",
+        lo=0.0,
+        lo_open=True,
+        hi=100.0,
+        why="positive; a thin ring",
+        default=None,
+        default_doc="required by the load model",
+    )
+    internal_clearance_um: float = _key(
+        "radial gap at a ball inside the bearing",
+        unit="um",
+        lo=0.0,
+        hi=1000.0,
+        why="a gap, not an interference; above 1 mm no bearing carries the cam",
+        default=0.0,
+    )
+    fit_clearance_um: float = _key(
+        "radial gap between the bearing outer ring and the flexspline bore",
+        unit="um",
+        lo=0.0,
+        hi=1000.0,
+        why="a gap, not an interference; above 1 mm the cam law is lost",
+        default=0.0,
+    )
+    groove_conformity: float = _key(
+        "groove radius / ball diameter",
+        lo=0.5,
+        lo_open=True,
+        hi=1.0,
+        hi_open=True,
+        why="above 0.5 or the ball jams in its groove; below 1 for a groove at all",
+        default=0.52,
+    )
 
 
 @dataclass(frozen=True)
 class LoadSpec:
     """``[load]``: the operating load of the drive."""
 
-    rated_torque_nm: float | None = _key("output torque the load audit sweeps to by default", unit="N m", lo=0.0, hi=1e7, why="not negative; 10 MN m is beyond any harmonic drive", default=None)
-    cam_offset_um: float = _key("radial offset e_h of the cam axis from the rigid gear's", unit="um", lo=0.0, hi=10000.0, why="a magnitude (the direction is cam_offset_deg); 10 mm is far beyond any mounting error", default=0.0)
-    cam_offset_deg: float = _key("direction of e_h from the generator's major axis", unit="deg", lo=-360.0, hi=360.0, why="one turn either way", default=0.0)
-    ball_phase_deg: float = _key("angle of the first ball from the major axis", unit="deg", lo=-360.0, hi=360.0, why="one turn either way", default=0.0)
+    rated_torque_nm: float | None = _key(
+        "output torque the load audit sweeps to by default",
+        unit="N m",
+        lo=0.0,
+        hi=1e7,
+        why="not negative; 10 MN m is beyond any harmonic drive",
+        default=None,
+    )
+    cam_offset_um: float = _key(
+        "radial offset e_h of the cam axis from the rigid gear's",
+        unit="um",
+        lo=0.0,
+        hi=10000.0,
+        why="a magnitude (the direction is cam_offset_deg); 10 mm is far beyond any mounting error",
+        default=0.0,
+    )
+    cam_offset_deg: float = _key(
+        "direction of e_h from the generator's major axis",
+        unit="deg",
+        lo=-360.0,
+        hi=360.0,
+        why="one turn either way",
+        default=0.0,
+    )
+    ball_phase_deg: float = _key(
+        "angle of the first ball from the major axis",
+        unit="deg",
+        lo=-360.0,
+        hi=360.0,
+        why="one turn either way",
+        default=0.0,
+    )
     #: radial stiffness with which the flexspline's supports hold the toothed rim centred, N/mm: a cup's wall
     #: bending and shearing as a thin tube from the diaphragm (docs/models.md 4.1); 0 lets the rim float
     #: radial stiffness of the cam's support (input shaft and its bearings), N/mm: the balls' imbalance moves the
     #: cam against it (docs/models.md 4.1); 0 for a floating (self-centring) generator, e.g. on an Oldham coupling
-    cam_support_stiffness_n_per_mm: float | None = _key("radial stiffness holding the cam on the drive axis (0: floating generator)", unit="N/mm", lo=0.0, hi=1e9, why="not negative; 1e9 N/mm is a rigid support", default=None, default_doc="rigid (the cam held where its offset puts it)")
-    rim_lateral_stiffness_n_per_mm: float | None = _key("radial stiffness holding the toothed rim on the drive axis (0: floating)", unit="N/mm", lo=0.0, hi=1e9, why="not negative; 1e9 N/mm is a rigid support", default=None, default_doc="the cup wall as a thin tube from the diaphragm to the generator centre line; 0 without [generator] cone_length")
+    cam_support_stiffness_n_per_mm: float | None = _key(
+        "radial stiffness holding the cam on the drive axis (0: floating generator)",
+        unit="N/mm",
+        lo=0.0,
+        hi=1e9,
+        why="not negative; 1e9 N/mm is a rigid support",
+        default=None,
+        default_doc="rigid (the cam held where its offset puts it)",
+    )
+    rim_lateral_stiffness_n_per_mm: float | None = _key(
+        "radial stiffness holding the toothed rim on the drive axis (0: floating)",
+        unit="N/mm",
+        lo=0.0,
+        hi=1e9,
+        why="not negative; 1e9 N/mm is a rigid support",
+        default=None,
+        default_doc="the cup wall as a thin tube from the diaphragm to the generator centre line; 0 without [generator] cone_length",
+    )
 
 
 def _nonneg(where: str, value) -> None:

@@ -92,8 +92,12 @@ def parse_parts(data) -> PartsSpec:
             if isinstance(value, bool) or not isinstance(value, int) or not 1 <= value <= MAX_BOLTS:
                 raise DesignError(where, f"must be a whole number 1..{MAX_BOLTS}, got {value!r}")
         else:
-            if (isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value)
-                    or not 0 < value <= MAX_PART_MM):
+            if (
+                isinstance(value, bool)
+                or not isinstance(value, (int, float))
+                or not math.isfinite(value)
+                or not 0 < value <= MAX_PART_MM
+            ):
                 raise DesignError(where, f"must be a positive number of mm up to {MAX_PART_MM:g}, got {value!r}")
             value = float(value)
         kw[key] = value
@@ -157,7 +161,10 @@ def part_sizes(spec: PartsSpec, drive) -> PartSizes:
     default("cup_bolt_circle_diameter", _r(0.5 * v["hub_bore_diameter"] + r_in))
     default("cup_bolt_count", 8)
     annulus = r_in - 0.5 * v["hub_bore_diameter"]
-    default("cup_bolt_hole_diameter", _r(min(annulus / 3.0, 0.5 * math.pi * v["cup_bolt_circle_diameter"] / v["cup_bolt_count"])))
+    default(
+        "cup_bolt_hole_diameter",
+        _r(min(annulus / 3.0, 0.5 * math.pi * v["cup_bolt_circle_diameter"] / v["cup_bolt_count"])),
+    )
     default("bearing_thickness", _r(0.06 * 2.0 * (r_in if not ext else drive.r_m)))
     default("bearing_width", _r(0.8 * bw))
     R_rim = drive.rigid_rim_radius
@@ -174,27 +181,67 @@ def part_sizes(spec: PartsSpec, drive) -> PartSizes:
 
     # --- rules (each names the key the user sets) ---
     if v["shell_thickness"] > h1:
-        raise DesignError("parts.shell_thickness", f"{v['shell_thickness']:g} mm is thicker than the rim under the teeth (flexspline.rim_thickness {h1:g} mm)")
+        raise DesignError(
+            "parts.shell_thickness",
+            f"{v['shell_thickness']:g} mm is thicker than the rim under the teeth (flexspline.rim_thickness {h1:g} mm)",
+        )
     if not ext:
         room = v["cup_length"] - bw
         if v["cup_length"] <= bw:
-            raise DesignError("parts.cup_length", f"{v['cup_length']:g} mm leaves no shell behind the {bw:g} mm toothed rim")
+            raise DesignError(
+                "parts.cup_length", f"{v['cup_length']:g} mm leaves no shell behind the {bw:g} mm toothed rim"
+            )
         if v["diaphragm_thickness"] >= room:
-            raise DesignError("parts.diaphragm_thickness", f"{v['diaphragm_thickness']:g} mm is thicker than the cup behind the toothed rim ({room:g} mm = cup_length - face_width)")
+            raise DesignError(
+                "parts.diaphragm_thickness",
+                f"{v['diaphragm_thickness']:g} mm is thicker than the cup behind the toothed rim ({room:g} mm = cup_length - face_width)",
+            )
         if v["hub_bore_diameter"] >= 2.0 * r_in:
-            raise DesignError("parts.hub_bore_diameter", f"{v['hub_bore_diameter']:g} mm leaves no diaphragm inside the cup bore {2 * r_in:.3f} mm")
-        _bolts("cup", v["cup_bolt_circle_diameter"], v["cup_bolt_hole_diameter"], v["cup_bolt_count"],
-               0.5 * v["hub_bore_diameter"], r_in, "the hub bore", "the cup wall")
+            raise DesignError(
+                "parts.hub_bore_diameter",
+                f"{v['hub_bore_diameter']:g} mm leaves no diaphragm inside the cup bore {2 * r_in:.3f} mm",
+            )
+        _bolts(
+            "cup",
+            v["cup_bolt_circle_diameter"],
+            v["cup_bolt_hole_diameter"],
+            v["cup_bolt_count"],
+            0.5 * v["hub_bore_diameter"],
+            r_in,
+            "the hub bore",
+            "the cup wall",
+        )
     if ext:
-        _bolts("flange", v["flange_bolt_circle_diameter"], dh, v["flange_bolt_count"], R_rim,
-               min(drive.rigid.r_f, drive.rigid.r_a), "the bore", "the root circle")
+        _bolts(
+            "flange",
+            v["flange_bolt_circle_diameter"],
+            dh,
+            v["flange_bolt_count"],
+            R_rim,
+            min(drive.rigid.r_f, drive.rigid.r_a),
+            "the bore",
+            "the root circle",
+        )
     else:
         if v["flange_outer_diameter"] <= 2.0 * R_rim:
-            raise DesignError("parts.flange_outer_diameter", f"{v['flange_outer_diameter']:g} mm must exceed the rigid gear's outer diameter {2 * R_rim:.3f} mm")
-        _bolts("flange", v["flange_bolt_circle_diameter"], dh, v["flange_bolt_count"], R_rim,
-               0.5 * v["flange_outer_diameter"], "the gear body", "the flange rim")
+            raise DesignError(
+                "parts.flange_outer_diameter",
+                f"{v['flange_outer_diameter']:g} mm must exceed the rigid gear's outer diameter {2 * R_rim:.3f} mm",
+            )
+        _bolts(
+            "flange",
+            v["flange_bolt_circle_diameter"],
+            dh,
+            v["flange_bolt_count"],
+            R_rim,
+            0.5 * v["flange_outer_diameter"],
+            "the gear body",
+            "the flange rim",
+        )
     if v["flange_thickness"] > bw:
-        raise DesignError("parts.flange_thickness", f"{v['flange_thickness']:g} mm is thicker than the gear (face_width {bw:g} mm)")
+        raise DesignError(
+            "parts.flange_thickness", f"{v['flange_thickness']:g} mm is thicker than the gear (face_width {bw:g} mm)"
+        )
     if v["bearing_width"] > (v["cup_length"] if not ext else bw):
         raise DesignError("parts.bearing_width", f"{v['bearing_width']:g} mm is longer than the cup")
     return PartSizes(v, tuple(derived))
@@ -208,4 +255,6 @@ def _bolts(prefix, bc_d, hole_d, count, r_lo, r_hi, inner, outer):
     if r + 0.5 * hole_d >= r_hi:
         raise DesignError(key, f"{bc_d:g} mm with {hole_d:g} mm holes cuts through {outer} (radius {r_hi:.3f} mm)")
     if count > 1 and bc_d * math.sin(math.pi / count) <= hole_d:
-        raise DesignError(f"parts.{prefix}_bolt_count", f"{count} holes of {hole_d:g} mm overlap on a {bc_d:g} mm bolt circle")
+        raise DesignError(
+            f"parts.{prefix}_bolt_count", f"{count} holes of {hole_d:g} mm overlap on a {bc_d:g} mm bolt circle"
+        )

@@ -84,8 +84,16 @@ def design_keys_markdown() -> str:
             meta = key_meta(f)
             choices = meta.get("choices")
             bounds = bound_text(meta) if not choices else "one of " + ", ".join(f'"{c}"' for c in choices)
-            row = [f"`{f.name}`", _type_name(f.type), meta.get("unit", ""), _default(f, meta), bounds,
-                   meta.get("rule", ""), meta.get("doc", ""), meta.get("why", "")]
+            row = [
+                f"`{f.name}`",
+                _type_name(f.type),
+                meta.get("unit", ""),
+                _default(f, meta),
+                bounds,
+                meta.get("rule", ""),
+                meta.get("doc", ""),
+                meta.get("why", ""),
+            ]
             out.append("| " + " | ".join(_cell(c) for c in row) + " |")
     out.append(_parts_section())
     return "\n".join(out) + "\n"
@@ -95,12 +103,15 @@ def _parts_section() -> str:
     """``[parts]`` (read by ``wgcad parts`` only): every key optional, derived from the gear size when absent."""
     from .parts import MAX_BOLTS, MAX_PART_MM, PARTS_DOC, PartsSpec, part_sizes
 
-    lines = ["\n## [parts] (optional table, read by `wgcad parts`)\n",
-             "Sizes of the flexspline cup, the wave-generator plug and the rigid gear's body. Every key is optional; "
-             "an absent key is derived from the gear size (rules below the table); the derived sizes are then checked "
-             "to fit together (bolt circles within their annuli, holes not overlapping, a diaphragm within the cup, "
-             "a bearing that fits the plug).\n",
-             "| key | type | unit | default | bounds | meaning |", "|---|---|---|---|---|---|"]
+    lines = [
+        "\n## [parts] (optional table, read by `wgcad parts`)\n",
+        "Sizes of the flexspline cup, the wave-generator plug and the rigid gear's body. Every key is optional; "
+        "an absent key is derived from the gear size (rules below the table); the derived sizes are then checked "
+        "to fit together (bolt circles within their annuli, holes not overlapping, a diaphragm within the cup, "
+        "a bearing that fits the plug).\n",
+        "| key | type | unit | default | bounds | meaning |",
+        "|---|---|---|---|---|---|",
+    ]
     for f in fields(PartsSpec):
         count = f.name.endswith("_count")
         bounds = f"1 <= value <= {MAX_BOLTS}" if count else f"0 < value <= {MAX_PART_MM:g}"

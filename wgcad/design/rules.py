@@ -14,8 +14,8 @@ from __future__ import annotations
 
 import math
 import reprlib
+from collections.abc import Callable
 from dataclasses import MISSING, dataclass, field, fields
-from typing import Callable
 
 from ..errors import DesignError
 
@@ -33,8 +33,20 @@ class Rel:
         return float(self.fn(ctx))
 
 
-def key(doc: str, *, unit: str = "", lo=None, hi=None, lo_open: bool = False, hi_open: bool = False,
-        choices: tuple | None = None, rule: str = "", why: str = "", default=MISSING, default_doc: str | None = None):
+def key(
+    doc: str,
+    *,
+    unit: str = "",
+    lo=None,
+    hi=None,
+    lo_open: bool = False,
+    hi_open: bool = False,
+    choices: tuple | None = None,
+    rule: str = "",
+    why: str = "",
+    default=MISSING,
+    default_doc: str | None = None,
+):
     """A dataclass field of a design table with its documented rule.
 
     Parameters
@@ -55,8 +67,18 @@ def key(doc: str, *, unit: str = "", lo=None, hi=None, lo_open: bool = False, hi
     default_doc : str, optional
         How the default reads in the reference when it is not a plain value.
     """
-    meta = {"doc": doc, "unit": unit, "lo": lo, "hi": hi, "lo_open": lo_open, "hi_open": hi_open,
-            "choices": choices, "rule": rule, "why": why, "default_doc": default_doc}
+    meta = {
+        "doc": doc,
+        "unit": unit,
+        "lo": lo,
+        "hi": hi,
+        "lo_open": lo_open,
+        "hi_open": hi_open,
+        "choices": choices,
+        "rule": rule,
+        "why": why,
+        "default_doc": default_doc,
+    }
     return field(default=default, metadata={"wgcad": meta})
 
 

@@ -39,29 +39,63 @@ _P = " (checked when the gears are built)"
 class DriveSpec:
     """``[drive]``: the pair of gears and how the drive is used."""
 
-    name: str = _key("name printed in summaries and pictures", rule="1 to 200 characters, one line",
-                    why="it is printed on one line of the summary and in picture titles")
-    module: float = _key("module m", unit="mm", lo=0.02, hi=20.0, rule="> 0",
-                        why="fine-module gears start near 0.05 mm and harmonic drives use 0.1-1.5 mm; "
-                            "outside [0.02, 20] mm the 1 um default chord tolerance is coarser than the teeth "
-                            "or the outlines need millions of vertices")
-    z_flex: int = _key("teeth of the flexspline z_g", unit="teeth", lo=8, hi=3000, rule=">= 8",
-                      why="below 8 teeth involutes undercut whatever the shift; catalogue harmonic drives "
-                          "have 50-700 teeth, 3000 leaves a wide margin and keeps outlines and audits in memory")
-    z_rigid: int = _key("teeth of the rigid gear z_b", unit="teeth", lo=8, hi=3000,
-                       rule="z_rigid - z_flex (external deformation: z_flex - z_rigid) a positive multiple of waves; "
-                            "the teeth must meet on the major axis" + _P,
-                       why="as z_flex; a rigid gear so much larger than the flexspline that the teeth never "
-                           "meet is refused when the drive is built")
-    face_width: float = _key("toothed face width b_w", unit="mm", lo=0.0, lo_open=True,
-                            hi=Rel("d_flex", lambda c: c["d_flex"]),
-                            why="harmonic drives have b_w/d of 0.1-0.3; wider than the pitch diameter the plane "
-                                "cross-section model of the rim (docs/models.md 3.1) no longer holds")
-    waves: int = _key("waves n_w of the generator", unit="", lo=2, hi=8, default=2,
-                     why="one wave only shifts the rim off-centre; drives use 2 or 3, and the laws other than "
-                         "harmonic have exactly 2")
-    deformation: str = _key("\"internal\": generator inside; \"external\": ring washers outside [S3]",
-                           choices=("internal", "external"), default="internal")
+    name: str = _key(
+        "name printed in summaries and pictures",
+        rule="1 to 200 characters, one line",
+        why="it is printed on one line of the summary and in picture titles",
+    )
+    module: float = _key(
+        "module m",
+        unit="mm",
+        lo=0.02,
+        hi=20.0,
+        rule="> 0",
+        why="fine-module gears start near 0.05 mm and harmonic drives use 0.1-1.5 mm; "
+        "outside [0.02, 20] mm the 1 um default chord tolerance is coarser than the teeth "
+        "or the outlines need millions of vertices",
+    )
+    z_flex: int = _key(
+        "teeth of the flexspline z_g",
+        unit="teeth",
+        lo=8,
+        hi=3000,
+        rule=">= 8",
+        why="below 8 teeth involutes undercut whatever the shift; catalogue harmonic drives "
+        "have 50-700 teeth, 3000 leaves a wide margin and keeps outlines and audits in memory",
+    )
+    z_rigid: int = _key(
+        "teeth of the rigid gear z_b",
+        unit="teeth",
+        lo=8,
+        hi=3000,
+        rule="z_rigid - z_flex (external deformation: z_flex - z_rigid) a positive multiple of waves; "
+        "the teeth must meet on the major axis" + _P,
+        why="as z_flex; a rigid gear so much larger than the flexspline that the teeth never "
+        "meet is refused when the drive is built",
+    )
+    face_width: float = _key(
+        "toothed face width b_w",
+        unit="mm",
+        lo=0.0,
+        lo_open=True,
+        hi=Rel("d_flex", lambda c: c["d_flex"]),
+        why="harmonic drives have b_w/d of 0.1-0.3; wider than the pitch diameter the plane "
+        "cross-section model of the rim (docs/models.md 3.1) no longer holds",
+    )
+    waves: int = _key(
+        "waves n_w of the generator",
+        unit="",
+        lo=2,
+        hi=8,
+        default=2,
+        why="one wave only shifts the rim off-centre; drives use 2 or 3, and the laws other than "
+        "harmonic have exactly 2",
+    )
+    deformation: str = _key(
+        '"internal": generator inside; "external": ring washers outside [S3]',
+        choices=("internal", "external"),
+        default="internal",
+    )
     fixed: str = _key("the member held still", choices=("rigid", "flexspline"), default="rigid")
     rotation: str = _key("generator direction seen from the open end", choices=("ccw", "cw"), default="ccw")
 
@@ -71,85 +105,174 @@ class ToothFormSpec:
     """``[tooth]``: tooth form shared by both gears (docs/models.md 2)."""
 
     form: str = _key("tooth form", choices=("involute", "cycloidal"), default="involute")
-    pressure_angle_deg: float = _key("pressure angle alpha (involute)", unit="deg", lo=5.0, hi=45.0, default=20.0,
-                                    why="standard 20 deg; harmonic drives use 20-30 deg; below 5 deg the base circle "
-                                        "is the pitch circle, above 45 deg the teeth are pointed")
-    addendum_coef: float = _key("addendum coefficient h_a*", lo=0.1, hi=2.0, default=1.0,
-                               why="harmonic drives use short teeth (0.5-1); above 2 the teeth are pointed for any shift")
-    clearance_coef: float | None = _key("root clearance coefficient c*", lo=0.0, hi=1.0, default=None,
-                                       default_doc="0.25 involute, 0.1 cycloidal",
-                                       why="usual 0.1-0.4; more than a module of root clearance only thins the rim")
+    pressure_angle_deg: float = _key(
+        "pressure angle alpha (involute)",
+        unit="deg",
+        lo=5.0,
+        hi=45.0,
+        default=20.0,
+        why="standard 20 deg; harmonic drives use 20-30 deg; below 5 deg the base circle "
+        "is the pitch circle, above 45 deg the teeth are pointed",
+    )
+    addendum_coef: float = _key(
+        "addendum coefficient h_a*",
+        lo=0.1,
+        hi=2.0,
+        default=1.0,
+        why="harmonic drives use short teeth (0.5-1); above 2 the teeth are pointed for any shift",
+    )
+    clearance_coef: float | None = _key(
+        "root clearance coefficient c*",
+        lo=0.0,
+        hi=1.0,
+        default=None,
+        default_doc="0.25 involute, 0.1 cycloidal",
+        why="usual 0.1-0.4; more than a module of root clearance only thins the rim",
+    )
 
 
 @dataclass(frozen=True)
 class GearSpec:
     """``[flexspline]`` / ``[rigid]``: one gear's teeth and body."""
 
-    rim_thickness: float = _key("flexspline: rim under the teeth h1; rigid: wall beyond the root circle", unit="mm",
-                               lo=Rel("0.1 m", lambda c: 0.1 * c["m"]), hi=Rel("d", lambda c: c["d"]), rule="> 0",
-                               why="flexspline rims are 0.5-2 m thick, rigid walls several m; thinner than 0.1 m "
-                                   "is foil, thicker than the gear's pitch diameter d no longer a ring")
-    shift: float = _key("profile shift coefficient x (involute; 0 for cycloidal)", lo=-5.0, hi=10.0, default=0.0,
-                       rule="involute: no undercut, tip thickness >= 0.2 m" + _P,
-                       why="harmonic drives use x up to about 4 (D1: 3.1/3.2); beyond these limits the teeth are "
-                           "pointed or the space closed anyway")
-    tip_radius: float | None = _key("tip radius, overrides the standard tip", unit="mm",
-                                   lo=Rel("r - 15 m", lambda c: c["r"] - 15 * c["m"]),
-                                   hi=Rel("r + 15 m", lambda c: c["r"] + 15 * c["m"]), default=None,
-                                   default_doc="standard (docs/models.md 2.1, 2.2)",
-                                   rule="> 0; external teeth: outside the root; internal: inside" + _P,
-                                   why="the band the shift, addendum and clearance bounds allow around the pitch radius r")
-    root_radius: float | None = _key("root radius, overrides the standard root", unit="mm",
-                                    lo=Rel("r - 15 m", lambda c: c["r"] - 15 * c["m"]),
-                                    hi=Rel("r + 15 m", lambda c: c["r"] + 15 * c["m"]), default=None,
-                                    default_doc="standard (docs/models.md 2.1, 2.2)", rule="> 0" + _P,
-                                    why="as tip_radius")
-    thinning: float = _key("tooth-thickness allowance at the pitch circle (backlash)", unit="mm", default=0.0,
-                          rule="|thinning| < half the pitch, pi m / 2",
-                          why="a thinning of half the pitch removes the tooth")
-    fillet_coef: float = _key("root fillet radius / m (involute)", lo=0.0, hi=2.0, default=0.25,
-                             rule="the fillet must fit the root space" + _P,
-                             why="usual 0.25-0.38; the largest fillet that fits is searched in [0, 2]")
-    measure_diameter: float | None = _key("diameter at which the report gives the tooth thickness (arc and chordal)",
-                                         unit="mm", lo=Rel("d - 30 m", lambda c: c["d"] - 30 * c["m"]),
-                                         hi=Rel("d + 30 m", lambda c: c["d"] + 30 * c["m"]), default=None,
-                                         default_doc="none (mid-depth only)",
-                                         rule="on the flanks (checked when the report is made)",
-                                         why="as tip_radius, on the diameter")
-    pin_diameter: float | None = _key("pin (ball) diameter of the dimension over / between pins", unit="mm",
-                                     lo=Rel("0.1 m", lambda c: 0.1 * c["m"]), hi=Rel("5 m", lambda c: 5.0 * c["m"]),
-                                     default=None, default_doc="chosen: contact nearest mid-flank, pin standing out",
-                                     rule="touches both flanks (checked when the report is made)",
-                                     why="measuring pins are about 1.5-1.9 m; a pin outside [0.1 m, 5 m] cannot touch both flanks")
+    rim_thickness: float = _key(
+        "flexspline: rim under the teeth h1; rigid: wall beyond the root circle",
+        unit="mm",
+        lo=Rel("0.1 m", lambda c: 0.1 * c["m"]),
+        hi=Rel("d", lambda c: c["d"]),
+        rule="> 0",
+        why="flexspline rims are 0.5-2 m thick, rigid walls several m; thinner than 0.1 m "
+        "is foil, thicker than the gear's pitch diameter d no longer a ring",
+    )
+    shift: float = _key(
+        "profile shift coefficient x (involute; 0 for cycloidal)",
+        lo=-5.0,
+        hi=10.0,
+        default=0.0,
+        rule="involute: no undercut, tip thickness >= 0.2 m" + _P,
+        why="harmonic drives use x up to about 4 (D1: 3.1/3.2); beyond these limits the teeth are "
+        "pointed or the space closed anyway",
+    )
+    tip_radius: float | None = _key(
+        "tip radius, overrides the standard tip",
+        unit="mm",
+        lo=Rel("r - 15 m", lambda c: c["r"] - 15 * c["m"]),
+        hi=Rel("r + 15 m", lambda c: c["r"] + 15 * c["m"]),
+        default=None,
+        default_doc="standard (docs/models.md 2.1, 2.2)",
+        rule="> 0; external teeth: outside the root; internal: inside" + _P,
+        why="the band the shift, addendum and clearance bounds allow around the pitch radius r",
+    )
+    root_radius: float | None = _key(
+        "root radius, overrides the standard root",
+        unit="mm",
+        lo=Rel("r - 15 m", lambda c: c["r"] - 15 * c["m"]),
+        hi=Rel("r + 15 m", lambda c: c["r"] + 15 * c["m"]),
+        default=None,
+        default_doc="standard (docs/models.md 2.1, 2.2)",
+        rule="> 0" + _P,
+        why="as tip_radius",
+    )
+    thinning: float = _key(
+        "tooth-thickness allowance at the pitch circle (backlash)",
+        unit="mm",
+        default=0.0,
+        rule="|thinning| < half the pitch, pi m / 2",
+        why="a thinning of half the pitch removes the tooth",
+    )
+    fillet_coef: float = _key(
+        "root fillet radius / m (involute)",
+        lo=0.0,
+        hi=2.0,
+        default=0.25,
+        rule="the fillet must fit the root space" + _P,
+        why="usual 0.25-0.38; the largest fillet that fits is searched in [0, 2]",
+    )
+    measure_diameter: float | None = _key(
+        "diameter at which the report gives the tooth thickness (arc and chordal)",
+        unit="mm",
+        lo=Rel("d - 30 m", lambda c: c["d"] - 30 * c["m"]),
+        hi=Rel("d + 30 m", lambda c: c["d"] + 30 * c["m"]),
+        default=None,
+        default_doc="none (mid-depth only)",
+        rule="on the flanks (checked when the report is made)",
+        why="as tip_radius, on the diameter",
+    )
+    pin_diameter: float | None = _key(
+        "pin (ball) diameter of the dimension over / between pins",
+        unit="mm",
+        lo=Rel("0.1 m", lambda c: 0.1 * c["m"]),
+        hi=Rel("5 m", lambda c: 5.0 * c["m"]),
+        default=None,
+        default_doc="chosen: contact nearest mid-flank, pin standing out",
+        rule="touches both flanks (checked when the report is made)",
+        why="measuring pins are about 1.5-1.9 m; a pin outside [0.1 m, 5 m] cannot touch both flanks",
+    )
 
 
 @dataclass(frozen=True)
 class GeneratorSpec:
     """``[generator]``: the wave generator and its deformation law (docs/models.md 3)."""
 
-    law: str = _key("deformation law of the neutral line", choices=LAW_NAMES, default="harmonic",
-                   rule="external deformation: external_ring only; internal: all others")
-    w0_coef: float = _key("radial deformation on the major axis W0 / m", lo=0.0, lo_open=True, hi=5.0, default=1.0,
-                         rule="W0 < r_m / 4 (checked when the law is built)",
-                         why="W0 is about k m for a tooth difference of k waves; the ring model of docs/models.md 3.1 "
-                             "needs W0 small against the rim radius")
-    beta_deg: float | None = _key("disc wrap / force half-angle beta", unit="deg", lo=0.0, hi=90.0, lo_open=True,
-                                 hi_open=True, default=None, default_doc="none; required by disc, four_force, external_ring",
-                                 rule="only for disc, four_force, external_ring; four_force: not in (40.71, 49.29)",
-                                 why="an angle inside a quarter wave")
-    offset: float = _key("ellipse law: neutral line = the cam ellipse offset outward by this", unit="mm", lo=0.0,
-                        hi=Rel("r_flex / 2", lambda c: 0.5 * c["r_flex"]), default=0.0, rule="only for the ellipse law",
-                        why="the offset is the bearing and half the rim around the cam: a fraction of the radius")
-    cone_length: float | None = _key("cup length l, diaphragm to open end (coning); none = no coning", unit="mm",
-                                    lo=0.0, lo_open=True, hi=Rel("10 d_flex", lambda c: 10.0 * c["d_flex"]), default=None,
-                                    default_doc="none (no coning)",
-                                    rule="together with generator_z; at least drive.face_width",
-                                    why="the toothed face lies on the cup; cups are 0.5-1.3 d long")
-    generator_z: float | None = _key("generator centre line z_h from the open end", unit="mm", lo=0.0,
-                                    hi=Rel("cone_length / 2", lambda c: 0.5 * c["cone_length"]), default=None,
-                                    default_doc="none (no coning)", rule="together with cone_length",
-                                    why="W0 at the open end is W0 l / (l - z_h) (docs/models.md 3.1): z_h <= l/2 keeps it "
-                                        "within 2 W0; generators sit near the open end")
+    law: str = _key(
+        "deformation law of the neutral line",
+        choices=LAW_NAMES,
+        default="harmonic",
+        rule="external deformation: external_ring only; internal: all others",
+    )
+    w0_coef: float = _key(
+        "radial deformation on the major axis W0 / m",
+        lo=0.0,
+        lo_open=True,
+        hi=5.0,
+        default=1.0,
+        rule="W0 < r_m / 4 (checked when the law is built)",
+        why="W0 is about k m for a tooth difference of k waves; the ring model of docs/models.md 3.1 "
+        "needs W0 small against the rim radius",
+    )
+    beta_deg: float | None = _key(
+        "disc wrap / force half-angle beta",
+        unit="deg",
+        lo=0.0,
+        hi=90.0,
+        lo_open=True,
+        hi_open=True,
+        default=None,
+        default_doc="none; required by disc, four_force, external_ring",
+        rule="only for disc, four_force, external_ring; four_force: not in (40.71, 49.29)",
+        why="an angle inside a quarter wave",
+    )
+    offset: float = _key(
+        "ellipse law: neutral line = the cam ellipse offset outward by this",
+        unit="mm",
+        lo=0.0,
+        hi=Rel("r_flex / 2", lambda c: 0.5 * c["r_flex"]),
+        default=0.0,
+        rule="only for the ellipse law",
+        why="the offset is the bearing and half the rim around the cam: a fraction of the radius",
+    )
+    cone_length: float | None = _key(
+        "cup length l, diaphragm to open end (coning); none = no coning",
+        unit="mm",
+        lo=0.0,
+        lo_open=True,
+        hi=Rel("10 d_flex", lambda c: 10.0 * c["d_flex"]),
+        default=None,
+        default_doc="none (no coning)",
+        rule="together with generator_z; at least drive.face_width",
+        why="the toothed face lies on the cup; cups are 0.5-1.3 d long",
+    )
+    generator_z: float | None = _key(
+        "generator centre line z_h from the open end",
+        unit="mm",
+        lo=0.0,
+        hi=Rel("cone_length / 2", lambda c: 0.5 * c["cone_length"]),
+        default=None,
+        default_doc="none (no coning)",
+        rule="together with cone_length",
+        why="W0 at the open end is W0 l / (l - z_h) (docs/models.md 3.1): z_h <= l/2 keeps it "
+        "within 2 W0; generators sit near the open end",
+    )
 
 
 @dataclass(frozen=True)
@@ -314,7 +437,10 @@ def validate(d: Design) -> Design:
             if val is not None:
                 _positive(f"{name}.{key}", val)
         if abs(gs.thinning) >= 0.5 * math.pi * dr.module:
-            raise DesignError(f"{name}.thinning", f"must be smaller than half the pitch ({0.5 * math.pi * dr.module:.4f} mm), got {gs.thinning:g}")
+            raise DesignError(
+                f"{name}.thinning",
+                f"must be smaller than half the pitch ({0.5 * math.pi * dr.module:.4f} mm), got {gs.thinning:g}",
+            )
     laws = ("external_ring",) if dr.deformation == "external" else tuple(x for x in LAW_NAMES if x != "external_ring")
     _choice("generator.law", g.law, laws)
     if g.law != "harmonic" and dr.waves != 2:
@@ -328,7 +454,9 @@ def validate(d: Design) -> Design:
     if g.offset < 0:
         raise DesignError("generator.offset", f"must be >= 0, got {g.offset:g}")
     if g.beta_deg is not None and g.law not in _BETA_LAWS:
-        raise DesignError("generator.beta_deg", f"is not used by the {g.law} law (only by {', '.join(_BETA_LAWS)}); remove it")
+        raise DesignError(
+            "generator.beta_deg", f"is not used by the {g.law} law (only by {', '.join(_BETA_LAWS)}); remove it"
+        )
     if g.offset != 0.0 and g.law != "ellipse":
         raise DesignError("generator.offset", f"is used only by the ellipse law, not by {g.law}; remove it")
     if (g.cone_length is None) != (g.generator_z is None):
@@ -336,9 +464,14 @@ def validate(d: Design) -> Design:
     if g.cone_length is not None:
         _positive("generator.cone_length", g.cone_length)
         if not 0.0 <= g.generator_z < g.cone_length:
-            raise DesignError("generator.generator_z", f"must be in [0, cone_length = {g.cone_length:g}) mm, got {g.generator_z:g}")
+            raise DesignError(
+                "generator.generator_z", f"must be in [0, cone_length = {g.cone_length:g}) mm, got {g.generator_z:g}"
+            )
         if dr.face_width > g.cone_length:
-            raise DesignError("drive.face_width", f"face width {dr.face_width:g} mm exceeds generator.cone_length {g.cone_length:g} mm")
+            raise DesignError(
+                "drive.face_width",
+                f"face width {dr.face_width:g} mm exceeds generator.cone_length {g.cone_length:g} mm",
+            )
     # the bounds relative to the design's own sizes (docs/design-keys.md)
     check_bounds(d, _TABLES, passes=(1,))
     validate_sectors(d.sectors, dr.z_flex, dr.z_rigid, dr.waves)

@@ -60,14 +60,52 @@ class SectorsSpec:
         major axis on the nearest sector boundary).
     """
 
-    kinds: tuple = _key("kind of each sector, counter-clockwise: \"transmission\" or \"coupling\"", rule="2 x drive.waves sectors, kinds alternating, sectors a half turn apart identical", default=())
-    teeth: tuple = _key("teeth in each sector", unit="teeth", rule="one count per sector; sum of teeth / pitch_z over the sectors = 1 (the sectors fill the circle)", default=())
-    pitch_z: tuple | None = _key("pitch of each sector as the tooth count of a whole gear of that pitch", rule="coupling sectors: drive.z_flex; transmission sectors: any other", default=None, default_doc="drive.z_rigid (transmission), drive.z_flex (coupling)")
-    start_deg: float = _key("angle where the first sector begins, counter-clockwise from +x", unit="deg", lo=-360.0, hi=360.0, why="one turn either way", default=0.0)
-    heights: str = _key("coupling-tooth heights that are built", rule="closed_form | simulated | full | list", default="closed_form")
-    heights_mm: tuple | None = _key("with heights = \"list\": tooth heights (root to tip) of one coupling sector from its first tooth on", unit="mm", rule="one per coupling tooth, each > 0 and at most the full tooth height", default=None)
-    tip_clearance_um: float = _key("smallest tip clearance the simulated heights keep", unit="um", lo=0.0, hi=1000.0, hi_open=True, why="not negative; a millimetre of tip clearance leaves no tooth of a fine-module sector gear", default=10.0)
-    assign: str = _key("how the closed form assigns a generator angle to a tooth", rule="register | boundary", default="register")
+    kinds: tuple = _key(
+        'kind of each sector, counter-clockwise: "transmission" or "coupling"',
+        rule="2 x drive.waves sectors, kinds alternating, sectors a half turn apart identical",
+        default=(),
+    )
+    teeth: tuple = _key(
+        "teeth in each sector",
+        unit="teeth",
+        rule="one count per sector; sum of teeth / pitch_z over the sectors = 1 (the sectors fill the circle)",
+        default=(),
+    )
+    pitch_z: tuple | None = _key(
+        "pitch of each sector as the tooth count of a whole gear of that pitch",
+        rule="coupling sectors: drive.z_flex; transmission sectors: any other",
+        default=None,
+        default_doc="drive.z_rigid (transmission), drive.z_flex (coupling)",
+    )
+    start_deg: float = _key(
+        "angle where the first sector begins, counter-clockwise from +x",
+        unit="deg",
+        lo=-360.0,
+        hi=360.0,
+        why="one turn either way",
+        default=0.0,
+    )
+    heights: str = _key(
+        "coupling-tooth heights that are built", rule="closed_form | simulated | full | list", default="closed_form"
+    )
+    heights_mm: tuple | None = _key(
+        'with heights = "list": tooth heights (root to tip) of one coupling sector from its first tooth on',
+        unit="mm",
+        rule="one per coupling tooth, each > 0 and at most the full tooth height",
+        default=None,
+    )
+    tip_clearance_um: float = _key(
+        "smallest tip clearance the simulated heights keep",
+        unit="um",
+        lo=0.0,
+        hi=1000.0,
+        hi_open=True,
+        why="not negative; a millimetre of tip clearance leaves no tooth of a fine-module sector gear",
+        default=10.0,
+    )
+    assign: str = _key(
+        "how the closed form assigns a generator angle to a tooth", rule="register | boundary", default="register"
+    )
 
     @property
     def active(self) -> bool:
@@ -75,7 +113,7 @@ class SectorsSpec:
         return len(self.kinds) > 0
 
     @classmethod
-    def from_table(cls, table: str, data) -> "SectorsSpec":
+    def from_table(cls, table: str, data) -> SectorsSpec:
         """Build from the TOML table (lists become tuples); types checked, rules by :func:`validate_sectors`."""
         if not isinstance(data, dict):
             raise DesignError(table, f"must be a table [{table}], got {type(data).__name__}")
@@ -149,7 +187,9 @@ def validate_sectors(spec: SectorsSpec, z_flex: int, z_rigid: int, waves: int) -
             raise DesignError(f"{t}.kinds[{i}]", f"must be one of {', '.join(KINDS)}; got '{k}'")
     if n != 2 * waves:
         # one transmission and one coupling sector per wave: each wave end passes both kinds per wave period
-        raise DesignError(f"{t}.kinds", f"must list 2 x drive.waves = {2 * waves} sectors (one of each kind per wave), got {n}")
+        raise DesignError(
+            f"{t}.kinds", f"must list 2 x drive.waves = {2 * waves} sectors (one of each kind per wave), got {n}"
+        )
     if len(spec.teeth) != n:
         raise DesignError(f"{t}.teeth", f"must list one tooth count per sector ({n} kinds), got {len(spec.teeth)}")
     for i, z in enumerate(spec.teeth):
@@ -157,7 +197,10 @@ def validate_sectors(spec: SectorsSpec, z_flex: int, z_rigid: int, waves: int) -
             raise DesignError(f"{t}.teeth[{i}]", f"must be at least 2 teeth, got {z}")
     for i in range(n):
         if spec.kinds[i] == spec.kinds[(i + 1) % n]:
-            raise DesignError(f"{t}.kinds", f"sectors {i} and {(i + 1) % n} are both {spec.kinds[i]}: transmission and coupling sectors must alternate")
+            raise DesignError(
+                f"{t}.kinds",
+                f"sectors {i} and {(i + 1) % n} are both {spec.kinds[i]}: transmission and coupling sectors must alternate",
+            )
     pz = sector_pitch_z(spec, z_flex, z_rigid)
     if len(pz) != n:
         raise DesignError(f"{t}.pitch_z", f"must list one pitch per sector ({n}), got {len(pz)}")
@@ -166,19 +209,31 @@ def validate_sectors(spec: SectorsSpec, z_flex: int, z_rigid: int, waves: int) -
             raise DesignError(f"{t}.pitch_z[{i}]", f"must be > 0, got {p:g}")
     if z_flex % waves:
         # opposite sectors identical only mesh alike if the flexspline is too
-        raise DesignError("drive.z_flex", f"must be a multiple of drive.waves = {waves} for a sectored rigid gear (opposite sectors identical), got {z_flex}")
+        raise DesignError(
+            "drive.z_flex",
+            f"must be a multiple of drive.waves = {waves} for a sectored rigid gear (opposite sectors identical), got {z_flex}",
+        )
     step = n // waves
     for i in range(n):
         j = (i + step) % n
         if (spec.kinds[i], spec.teeth[i], pz[i]) != (spec.kinds[j], spec.teeth[j], pz[j]):
-            raise DesignError(f"{t}.teeth", f"sectors {i} and {j} lie a wave apart and must be identical (kind, teeth, pitch): "
-                                            f"{spec.kinds[i]} {spec.teeth[i]} x 2pi/{pz[i]:g} vs {spec.kinds[j]} {spec.teeth[j]} x 2pi/{pz[j]:g}")
+            raise DesignError(
+                f"{t}.teeth",
+                f"sectors {i} and {j} lie a wave apart and must be identical (kind, teeth, pitch): "
+                f"{spec.kinds[i]} {spec.teeth[i]} x 2pi/{pz[i]:g} vs {spec.kinds[j]} {spec.teeth[j]} x 2pi/{pz[j]:g}",
+            )
     for i, (k, p) in enumerate(zip(spec.kinds, pz)):
         if k == "coupling" and abs(p - z_flex) > 1e-9 * z_flex:
-            raise DesignError(f"{t}.pitch_z[{i}]", f"a coupling sector has the flexspline's pitch: pitch_z = drive.z_flex = {z_flex}, got {p:g}")
+            raise DesignError(
+                f"{t}.pitch_z[{i}]",
+                f"a coupling sector has the flexspline's pitch: pitch_z = drive.z_flex = {z_flex}, got {p:g}",
+            )
         if k == "transmission" and abs(p - z_flex) <= 1e-9 * z_flex:
-            raise DesignError(f"{t}.pitch_z[{i}]", f"a transmission sector needs a pitch other than the flexspline's (pitch_z != {z_flex}); "
-                                                   "with equal pitch it is a coupling")
+            raise DesignError(
+                f"{t}.pitch_z[{i}]",
+                f"a transmission sector needs a pitch other than the flexspline's (pitch_z != {z_flex}); "
+                "with equal pitch it is a coupling",
+            )
     cover = sum(z / p for z, p in zip(spec.teeth, pz))  # in turns: sum of teeth x pitch / 2 pi
     if abs(cover - 1.0) > _FILL_TOL:
         detail = " + ".join(f"{z} x 360/{p:g}" for z, p in zip(spec.teeth, pz))
@@ -189,12 +244,14 @@ def validate_sectors(spec: SectorsSpec, z_flex: int, z_rigid: int, waves: int) -
         zc = [z for k, z in zip(spec.kinds, spec.teeth) if k == "coupling"][0]
         if spec.heights_mm is None or len(spec.heights_mm) != zc:
             got = "none" if spec.heights_mm is None else len(spec.heights_mm)
-            raise DesignError(f"{t}.heights_mm", f"heights = \"list\" needs one height per coupling tooth ({zc}), got {got}")
+            raise DesignError(
+                f"{t}.heights_mm", f'heights = "list" needs one height per coupling tooth ({zc}), got {got}'
+            )
         for i, h in enumerate(spec.heights_mm):
             if not h > 0:
                 raise DesignError(f"{t}.heights_mm[{i}]", f"must be > 0 mm, got {h:g}")
     elif spec.heights_mm is not None:
-        raise DesignError(f"{t}.heights_mm", f"is used only with heights = \"list\", not \"{spec.heights}\"; remove it")
+        raise DesignError(f"{t}.heights_mm", f'is used only with heights = "list", not "{spec.heights}"; remove it')
     if not 0.0 <= spec.tip_clearance_um < 1000.0:
         raise DesignError(f"{t}.tip_clearance_um", f"must be in [0, 1000) um, got {spec.tip_clearance_um:g}")
     return spec

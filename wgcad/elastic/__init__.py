@@ -6,4 +6,13 @@ from wgcad.elastic.ring import Ring
 from wgcad.elastic.solve import ContactSolveError, solve_contact_qp
 from wgcad.elastic.state import LoadState, solve_load
 
-__all__ = ["Ring", "LoadedLaw", "ElasticModel", "build_model", "LoadState", "solve_load", "ContactSolveError", "solve_contact_qp"]
+__all__ = [
+    "Ring",
+    "LoadedLaw",
+    "ElasticModel",
+    "build_model",
+    "LoadState",
+    "solve_load",
+    "ContactSolveError",
+    "solve_contact_qp",
+]

@@ -31,8 +31,9 @@ class Anderson:
         self.X, self.G, self.last = [], [], np.inf
 
     def _vec(self, loads, rigid):
-        return np.concatenate([loads[:, :2].ravel(), loads[:, 2] / _LEVER,
-                               _KREF * np.array([rigid[0], rigid[1], rigid[2] * self.r_m])])
+        return np.concatenate(
+            [loads[:, :2].ravel(), loads[:, 2] / _LEVER, _KREF * np.array([rigid[0], rigid[1], rigid[2] * self.r_m])]
+        )
 
     def step(self, loads, rigid, loads_new, rigid_new, change):
         if self.depth == 0:
@@ -44,7 +45,7 @@ class Anderson:
         self.last = change
         self.X.append(self._vec(loads, rigid))
         self.G.append(self._vec(loads_new, rigid_new))
-        self.X, self.G = self.X[-(self.depth + 1):], self.G[-(self.depth + 1):]
+        self.X, self.G = self.X[-(self.depth + 1) :], self.G[-(self.depth + 1) :]
         if len(self.X) < 2:
             return loads_new, np.array(rigid_new, dtype=float)
         R = [g - x for g, x in zip(self.G, self.X)]
@@ -55,6 +56,6 @@ class Anderson:
         n = len(loads)
         out = np.empty_like(loads)
         out[:, 0], out[:, 1] = y[: 2 * n].reshape(n, 2).T
-        out[:, 2] = y[2 * n: 3 * n] * _LEVER
-        r = y[3 * n:] / _KREF
+        out[:, 2] = y[2 * n : 3 * n] * _LEVER
+        r = y[3 * n :] / _KREF
         return out, np.array([r[0], r[1], r[2] / self.r_m])

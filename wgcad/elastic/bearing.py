@@ -29,9 +29,12 @@ class HertzPoint:
     q: float
 
     @classmethod
-    def from_curvatures(cls, inv_rx: float, inv_ry: float, e_prime: float) -> "HertzPoint":
+    def from_curvatures(cls, inv_rx: float, inv_ry: float, e_prime: float) -> HertzPoint:
         if not (inv_rx > 0 and inv_ry > 0):
-            raise DesignError("bearing.groove_conformity", "the ball-raceway curvature sums must be positive (conformity > 0.5, ball smaller than the ring)")
+            raise DesignError(
+                "bearing.groove_conformity",
+                "the ball-raceway curvature sums must be positive (conformity > 0.5, ball smaller than the ring)",
+            )
         rx, ry = 1.0 / inv_rx, 1.0 / inv_ry
         R = 1.0 / (inv_rx + inv_ry)
         alpha = ry / rx
@@ -46,7 +49,9 @@ class HertzPoint:
         return cls(float(c), float(q))
 
 
-def ball_contact(ball_d: float, race_r_outer: float, conformity: float, e_prime: float) -> tuple[HertzPoint, HertzPoint]:
+def ball_contact(
+    ball_d: float, race_r_outer: float, conformity: float, e_prime: float
+) -> tuple[HertzPoint, HertzPoint]:
     """Inner (convex race on the cam) and outer (concave race) contacts of one ball.
 
     ``race_r_outer`` is the outer raceway's radius at the ball contact (mm);
@@ -57,7 +62,9 @@ def ball_contact(ball_d: float, race_r_outer: float, conformity: float, e_prime:
     inv_groove = 1.0 / (conformity * ball_d)
     r_in = race_r_outer - ball_d
     if r_in <= 0:
-        raise DesignError("bearing.ball_diameter_mm", f"{ball_d:g} mm leaves no inner raceway inside {race_r_outer:g} mm")
+        raise DesignError(
+            "bearing.ball_diameter_mm", f"{ball_d:g} mm leaves no inner raceway inside {race_r_outer:g} mm"
+        )
     inner = HertzPoint.from_curvatures(inv_ball + 1.0 / r_in, inv_ball - inv_groove, e_prime)
     outer = HertzPoint.from_curvatures(inv_ball - 1.0 / race_r_outer, inv_ball - inv_groove, e_prime)
     return inner, outer

@@ -120,8 +120,10 @@ def _solve_mount(model, rows: BallRows) -> MountedState:
         if done:
             break
     else:
-        raise ContactSolveError("the rim does not settle on the cam: ball forces still changing after "
-                                f"{_HERTZ_PASSES} Hertz re-linearisations")
+        raise ContactSolveError(
+            "the rim does not settle on the cam: ball forces still changing after "
+            f"{_HERTZ_PASSES} Hertz re-linearisations"
+        )
     loads = np.zeros((len(tab.angles), 3))
     np.add.at(loads, idx, -F[:, None] * rows.b)
     el = tab.tooth_field(loads)

@@ -75,11 +75,11 @@ class LoadedLaw(Law):
         object.__setattr__(self, "loads", loads)
         object.__setattr__(self, "rigid", tuple(float(x) for x in self.rigid))
 
-    def with_w0(self, w0: float) -> "LoadedLaw":
+    def with_w0(self, w0: float) -> LoadedLaw:
         """The loaded law of the section whose nominal amplitude is ``w0`` (coning scales the elastic field alike)."""
         return replace(self, section=self.centre.with_w0(w0), scale=float(w0) / float(self.centre.w0))
 
-    def shifted(self, phase: float) -> "LoadedLaw":
+    def shifted(self, phase: float) -> LoadedLaw:
         """This state seen from ``phase`` further on: ``state(phi) -> state(phi + phase)`` (e.g. ``pi`` for the other wave)."""
         return replace(self, phase=self.phase + float(phase))
 
@@ -122,7 +122,7 @@ def _unique_eval(fn, arrays):
     out, at = {}, 0
     for k in keys:
         n = uniq[k].size
-        out[k] = tuple(r[at:at + n] for r in res)
+        out[k] = tuple(r[at : at + n] for r in res)
         at += n
     return [out[a.tobytes()] for a in arrays]
 
@@ -168,7 +168,9 @@ def displacements_many(laws, phis) -> list[tuple]:
         (nw, nv, _), (ew, ev, eth) = nom[k], el[k]
         dx, dy, rot = law.rigid
         c, s = np.cos(p), np.sin(p)
-        out[k] = (law.scale * ew + dx * c + dy * s - rot * nv,
-                  law.scale * ev - dx * s + dy * c + rot * (law.r_m + nw),
-                  law.scale * eth + rot)
+        out[k] = (
+            law.scale * ew + dx * c + dy * s - rot * nv,
+            law.scale * ev - dx * s + dy * c + rot * (law.r_m + nw),
+            law.scale * eth + rot,
+        )
     return out

@@ -2,8 +2,6 @@
 
 from __future__ import annotations
 
-
-
 import numpy as np
 
 from wgcad.clearance.engine import Scene
@@ -39,6 +37,7 @@ def _poses_many(scene: Scene, laws, phis):
 
 def law_poses(scene: Scene, laws):
     """The pose function of :mod:`wgcad.clearance.entry` over ``laws`` (passage ``k`` = ``laws[k]``): all laws in one go."""
+
     def poses(phi, k):
         phi = np.asarray(phi, dtype=float)
         k = np.asarray(k)
@@ -49,6 +48,7 @@ def law_poses(scene: Scene, laws):
         for idx, (r, sh) in zip(sel, _poses_many(scene, [laws[j] for j in ks], [phi[i] for i in sel])):
             rot[idx], shift[idx] = r, sh
         return rot, shift
+
     return poses
 
 

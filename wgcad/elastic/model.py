@@ -73,6 +73,7 @@ class ElasticModel:
         """Stiffness of each rigid-body freedom of the contact problem: rim ``dx, dy`` (its support), rim rotation
         (free: the torque balances it), cam ``dx, dy`` (its support; inf: held), N/mm and N mm/rad."""
         return np.array([self.lateral_stiffness, self.lateral_stiffness, 0.0, self.cam_stiffness, self.cam_stiffness])
+
     #: results reused between load states of this model (the tooth pairs measured at the nominal state)
     cache: dict = field(default_factory=dict, repr=False, compare=False)
 
@@ -121,7 +122,9 @@ def build_model(drive, sections: int = 3) -> ElasticModel:
     """
     d = drive.design
     if drive.external:
-        raise DesignError("drive.deformation", "the load model covers internal deformation (generator inside the flexspline) only")
+        raise DesignError(
+            "drive.deformation", "the load model covers internal deformation (generator inside the flexspline) only"
+        )
     if not (isinstance(sections, int) and sections >= 1):
         raise DesignError("sections", f"must be a whole number >= 1, got {sections!r}")
     br = require_bearing(d)
@@ -151,10 +154,15 @@ def build_model(drive, sections: int = 3) -> ElasticModel:
     e_prime = E / (1.0 - mat.poisson**2)
     race_r = drive.flex_rim_radius - br.outer_ring_thickness_mm
     if race_r - br.ball_diameter_mm <= 0:
-        raise DesignError("bearing.ball_diameter_mm", f"ball {br.ball_diameter_mm:g} mm does not fit inside the outer ring (raceway radius {race_r:g} mm)")
+        raise DesignError(
+            "bearing.ball_diameter_mm",
+            f"ball {br.ball_diameter_mm:g} mm does not fit inside the outer ring (raceway radius {race_r:g} mm)",
+        )
     inner, outer = ball_contact(br.ball_diameter_mm, race_r, br.groove_conformity, e_prime)
     psi = np.deg2rad(d.load.ball_phase_deg) + 2.0 * pi * np.arange(br.balls) / br.balls
-    bearing = FlexibleBearing(psi, 1e-3 * (br.internal_clearance_um + br.fit_clearance_um), inner.c + outer.c, max(inner.q, outer.q))
+    bearing = FlexibleBearing(
+        psi, 1e-3 * (br.internal_clearance_um + br.fit_clearance_um), inner.c + outer.c, max(inner.q, outer.q)
+    )
     zs = drive.sections(sections)
     widths = np.full(1, bw) if sections == 1 else bw * np.diff(np.concatenate([[0.0], 0.5 * (zs[1:] + zs[:-1]), [bw]]))
     scene = Scene(drive)
@@ -165,11 +173,28 @@ def build_model(drive, sections: int = 3) -> ElasticModel:
     tables = ring_tables(ring, d.drive.z_flex, psi, laws, drive.law)
     k_lat = d.load.rim_lateral_stiffness_n_per_mm
     if k_lat is None:
-        k_lat = cup_lateral_stiffness(E, G, r_c, t_cup, d.generator.cone_length - d.generator.generator_z) if f is not None else 0.0
+        k_lat = (
+            cup_lateral_stiffness(E, G, r_c, t_cup, d.generator.cone_length - d.generator.generator_z)
+            if f is not None
+            else 0.0
+        )
     k_cam = d.load.cam_support_stiffness_n_per_mm
-    return ElasticModel(drive, scene, ring, bearing, teeth, zs, widths, np.asarray(f_of(zs), dtype=float),
-                        float(k_cup), 1.0 if scene.working == "upper" else -1.0, parts, tables, float(k_lat),
-                        float("inf") if k_cam is None else float(k_cam))
+    return ElasticModel(
+        drive,
+        scene,
+        ring,
+        bearing,
+        teeth,
+        zs,
+        widths,
+        np.asarray(f_of(zs), dtype=float),
+        float(k_cup),
+        1.0 if scene.working == "upper" else -1.0,
+        parts,
+        tables,
+        float(k_lat),
+        float("inf") if k_cam is None else float(k_cam),
+    )
 
 
 def cup_lateral_stiffness(E: float, G: float, r: float, t: float, length: float) -> float:

@@ -56,7 +56,7 @@ class MeasuredPairs:
         self.lever = float(np.hypot(loc[:, 0], loc[:, 1]).max())
         self.measured = 0
 
-    def copy(self) -> "MeasuredPairs":
+    def copy(self) -> MeasuredPairs:
         new = object.__new__(MeasuredPairs)
         new.__dict__.update({k: (v.copy() if isinstance(v, np.ndarray) else v) for k, v in self.__dict__.items()})
         return new
@@ -104,7 +104,10 @@ class MeasuredPairs:
         c, sn = np.cos(ph), np.sin(ph)
         n, p = g.normal, g.point
         rel = p - origin[t]
-        b = np.stack([n[:, 0] * c + n[:, 1] * sn, -n[:, 0] * sn + n[:, 1] * c, rel[:, 0] * n[:, 1] - rel[:, 1] * n[:, 0]], axis=-1)
+        b = np.stack(
+            [n[:, 0] * c + n[:, 1] * sn, -n[:, 0] * sn + n[:, 1] * c, rel[:, 0] * n[:, 1] - rel[:, 1] * n[:, 0]],
+            axis=-1,
+        )
         A = np.stack([n[:, 0], n[:, 1], p[:, 0] * n[:, 1] - p[:, 1] * n[:, 0]], axis=-1)
         self.have[k] = True
         self.gap[k] = g.gap

@@ -151,7 +151,9 @@ class Ring:
         if not (np.isfinite(self.r) and self.r > 0):
             raise DesignError("flexspline.rim_thickness", f"ring radius must be > 0 mm, got {self.r:g}")
         if not (np.isfinite(self.EI) and self.EI > 0):
-            raise DesignError("material.youngs_modulus_gpa", f"ring bending stiffness must be > 0, got {self.EI:g} N mm^2")
+            raise DesignError(
+                "material.youngs_modulus_gpa", f"ring bending stiffness must be > 0, got {self.EI:g} N mm^2"
+            )
 
     def _vfields(self, x, order):
         """v-field kernels and their derivatives 0..order+2 along phi, per load type: (3, order+3, ...)."""
@@ -214,5 +216,4 @@ class Ring:
                 d[i] += vf[i] @ loads[:, j]
         v, v1, v2, v3 = d
         r = self.r
-        return {"w": -v1, "dw": -v2, "d2w": -v3, "v": v, "dv": v1,
-                "theta": (v + v2) / r, "dtheta": (v1 + v3) / r}
+        return {"w": -v1, "dw": -v2, "d2w": -v3, "v": v, "dv": v1, "theta": (v + v2) / r, "dtheta": (v1 + v3) / r}

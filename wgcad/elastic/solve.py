@@ -143,7 +143,9 @@ def solve_contact_qp(M, q, A, f, active=None, tol_gap: float = 1e-12, max_iter: 
             flip = np.zeros(m, dtype=bool)
             flip[j] = True
         act ^= flip
-    raise ContactSolveError(f"contact solver: no convergence in {max_iter} block pivots ({best} contacts still infeasible)")
+    raise ContactSolveError(
+        f"contact solver: no convergence in {max_iter} block pivots ({best} contacts still infeasible)"
+    )
 
 
 def _finish(M, q, A, f, F, a, gap, it, tol_gap) -> QPSolution:

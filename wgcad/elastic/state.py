@@ -14,9 +14,9 @@ from .anderson import Anderson
 from .cam import ball_rows, cam_excess, generator_torque, mounted
 from .loaded import LoadedLaw
 from .model import ElasticModel
+from .pairs import GAP_MARGIN, MeasuredPairs
 from .solve import ContactSolveError, solve_supported
 from .tables import Compliance
-from .pairs import GAP_MARGIN, MeasuredPairs
 
 __all__ = ["LoadState", "solve_load", "POSITION_TOL", "RADIAL_MARGIN", "GAP_MARGIN"]
 
@@ -189,8 +189,14 @@ def _assemble(model: ElasticModel, pairs: MeasuredPairs, keys, el, rigid, e, F_p
     o_t, s_t = model.teeth.tangent(F_prev_teeth, width, FORCE_FLOOR)
     s_t = s_t + model.teeth.bending(pairs.point[keys], pairs.normal[keys], width)
     q_t = pairs.q_geo[keys] + o_t
-    return (np.concatenate([idx_b, tooth]), np.concatenate([b_b, pairs.b[keys]]), np.concatenate([np.ones(Z), f_t]),
-            np.concatenate([A_b, np.pad(pairs.A[keys], ((0, 0), (0, 2)))]), np.concatenate([q_b, q_t]), np.concatenate([s_b, s_t]))
+    return (
+        np.concatenate([idx_b, tooth]),
+        np.concatenate([b_b, pairs.b[keys]]),
+        np.concatenate([np.ones(Z), f_t]),
+        np.concatenate([A_b, np.pad(pairs.A[keys], ((0, 0), (0, 2)))]),
+        np.concatenate([q_b, q_t]),
+        np.concatenate([s_b, s_t]),
+    )
 
 
 def _first_guess(model: ElasticModel, keys, q, Z: int, torque_nm: float):
@@ -220,8 +226,15 @@ def _dense_loads(n: int, idx, F, f, b) -> np.ndarray:
     return out
 
 
-def solve_load(model: ElasticModel, torque_nm: float, cam_offset_um: float = 0.0, cam_offset_deg: float = 0.0,
-               tol: float = POSITION_TOL, warm: "LoadState | None" = None, tooth_errors=None) -> LoadState:
+def solve_load(
+    model: ElasticModel,
+    torque_nm: float,
+    cam_offset_um: float = 0.0,
+    cam_offset_deg: float = 0.0,
+    tol: float = POSITION_TOL,
+    warm: LoadState | None = None,
+    tooth_errors=None,
+) -> LoadState:
     """Solve the drive under output torque ``torque_nm`` with the cam axis offset by ``cam_offset_um`` at ``cam_offset_deg``.
 
     Generator at angle 0 (major axis on +x, tooth 0 on it, rigid gear fixed).
@@ -295,8 +308,11 @@ def solve_load(model: ElasticModel, torque_nm: float, cam_offset_um: float = 0.0
         t0 = time.perf_counter()
         rot, shift, origin, el, cand = _poses(model, loads, rigid, tooth_errors)
         if cand.size == 0 and torque_nm > 0:
-            raise DesignError("generator.w0_coef", "the flexspline teeth never reach the rigid teeth (no tooth tip within "
-                              f"{RADIAL_MARGIN:g} mm of the rigid tip circle): no torque can be carried")
+            raise DesignError(
+                "generator.w0_coef",
+                "the flexspline teeth never reach the rigid teeth (no tooth tip within "
+                f"{RADIAL_MARGIN:g} mm of the rigid tip circle): no torque can be carried",
+            )
         keys = pairs.update(rot, shift, origin, el, cand, rigid) if cand.size else np.zeros(0, dtype=int)
         t1 = time.perf_counter()
         idx, b, f, A, q, s_c = _assemble(model, pairs, keys, el, rigid, e, F_ball, F_teeth_prev[keys])
@@ -313,14 +329,23 @@ def solve_load(model: ElasticModel, torque_nm: float, cam_offset_um: float = 0.0
                 M = M.with_contact(s_c)
                 active = F > 0
             try:
-                sol = solve_supported(M, q, A, f_ext, model.support_stiffness,
-                                      active=active if (it or h) else _first_guess(model, keys, q, Z, torque_nm))
+                sol = solve_supported(
+                    M,
+                    q,
+                    A,
+                    f_ext,
+                    model.support_stiffness,
+                    active=active if (it or h) else _first_guess(model, keys, q, Z, torque_nm),
+                )
                 cam_shift = sol.a[3:].copy()
                 sol = replace(sol, a=sol.a[:3])
             except ContactSolveError as exc:
                 if torque_nm > 0 and len(keys) and "balance" in str(exc):
-                    raise DesignError("generator.w0_coef", f"no set of tooth contacts can carry {torque_nm:g} N m: the teeth never meet "
-                                      "on the working flanks") from None
+                    raise DesignError(
+                        "generator.w0_coef",
+                        f"no set of tooth contacts can carry {torque_nm:g} N m: the teeth never meet "
+                        "on the working flanks",
+                    ) from None
                 raise
             pivots += sol.iterations
             F_h, F = (F if h else None), sol.F
@@ -369,9 +394,11 @@ def solve_load(model: ElasticModel, torque_nm: float, cam_offset_um: float = 0.0
         prev_active = np.zeros(n_keys, dtype=bool)
         prev_active[keys] = F[Z:] > 0
     else:
-        raise ContactSolveError(f"the elastic model did not converge at {torque_nm:g} N m: tooth positions still moving by "
-                                f"{1e3 * change:.3g} um after {_MAX_LINEARISATIONS} re-linearisations; a looser tolerance, "
-                                "a nearby torque or more side clearance may let it settle")
+        raise ContactSolveError(
+            f"the elastic model did not converge at {torque_nm:g} N m: tooth positions still moving by "
+            f"{1e3 * change:.3g} um after {_MAX_LINEARISATIONS} re-linearisations; a looser tolerance, "
+            "a nearby torque or more side clearance may let it settle"
+        )
     # the reported state is the last contact solution itself (not a relaxed mixture): its forces, points and
     # normals are in equilibrium to round-off; the exact gaps are then measured on the final poses
     keys, F, sol, idx, b, f, point, normal = last
@@ -384,8 +411,10 @@ def solve_load(model: ElasticModel, torque_nm: float, cam_offset_um: float = 0.0
     keys2, gaps2, exact2 = pairs2.report(*_poses(model, loads, rigid, tooth_errors), rigid)
     t_geo += time.perf_counter() - t0
     psi, law_loads = _merge_loads(tab.angles, loads)
-    laws = [LoadedLaw(centre, model.section_law(i), model.ring, psi, law_loads, model.scales[i], tuple(rigid))
-            for i in range(len(model.zs))]
+    laws = [
+        LoadedLaw(centre, model.section_law(i), model.ring, psi, law_loads, model.scales[i], tuple(rigid))
+        for i in range(len(model.zs))
+    ]
     n_t = len(keys)
     sec_t, tooth_t = np.divmod(keys // 2, tab.z_g)
     if n_t:
@@ -404,7 +433,7 @@ def solve_load(model: ElasticModel, torque_nm: float, cam_offset_um: float = 0.0
     cb, sb = np.cos(model.bearing.psi), np.sin(model.bearing.psi)
     w_nom, v_nom, _ = tab.centre_ball
     rows = ball_rows(model, cam_excess(model), e)
-    U_b = (tab.influence[3 * tab.z_g:] @ loads.ravel()).reshape(-1, 3)
+    U_b = (tab.influence[3 * tab.z_g :] @ loads.ravel()).reshape(-1, 3)
     gap_b = rows.q - (rows.b * U_b).sum(axis=1) - rows.A @ np.concatenate([rigid, cam_shift])
     appr_b = model.bearing.approach(F_ball)
     # exact complementarity of the nonlinear contacts: gap + approach >= 0, F >= 0, F (gap + approach) = 0
@@ -439,8 +468,19 @@ def solve_load(model: ElasticModel, torque_nm: float, cam_offset_um: float = 0.0
         "settled_by_relaxation": relaxed,
     }
     # the torque the balls put on the cam (docs/models.md 4.1)
-    return LoadState(model, float(torque_nm), e, laws, rigid, contacts, residuals, {"geometry": t_geo, "solver": t_sol}, pairs2,
-                     generator_torque(rows, F_ball), cam_shift)
+    return LoadState(
+        model,
+        float(torque_nm),
+        e,
+        laws,
+        rigid,
+        contacts,
+        residuals,
+        {"geometry": t_geo, "solver": t_sol},
+        pairs2,
+        generator_torque(rows, F_ball),
+        cam_shift,
+    )
 
 
 def _displaced(points: np.ndarray, tooth_errors) -> np.ndarray:

@@ -44,12 +44,18 @@ def level_summary(st: LoadState, entry=None) -> dict:
         for i, law in enumerate(st.laws):
             p = next(gp)
             ok = bool(np.isfinite(p.delta))
-            entries.append({"wave": w, "section_z_mm": float(m.zs[i]),
-                            "entry_gap_um": round(1e3 * p.delta, 4) if ok else None,
-                            "tooth_angle_deg": _deg(p.delta_phi + phase) if ok else None,
-                            "edge": p.delta_edge or None, "kind": p.delta_kind or None,
-                            "crossing_um": round(1e3 * min(p.crossing_gaps), 4) if ok else None,
-                            "crossing_tooth_angle_deg": _deg(p.crossing + phase) if ok else None})
+            entries.append(
+                {
+                    "wave": w,
+                    "section_z_mm": float(m.zs[i]),
+                    "entry_gap_um": round(1e3 * p.delta, 4) if ok else None,
+                    "tooth_angle_deg": _deg(p.delta_phi + phase) if ok else None,
+                    "edge": p.delta_edge or None,
+                    "kind": p.delta_kind or None,
+                    "crossing_um": round(1e3 * min(p.crossing_gaps), 4) if ok else None,
+                    "crossing_tooth_angle_deg": _deg(p.crossing + phase) if ok else None,
+                }
+            )
     gaps = [e["entry_gap_um"] for e in entries if e["entry_gap_um"] is not None]
     cross = [e["crossing_um"] for e in entries if e["crossing_um"] is not None]
     at = min((e for e in entries if e["entry_gap_um"] is not None), key=lambda e: e["entry_gap_um"], default=None)
@@ -64,13 +70,15 @@ def level_summary(st: LoadState, entry=None) -> dict:
                 zone.append([_deg(ph.min() + w * pi), _deg(ph.max() + w * pi)])
             else:
                 zone.append(None)
-        sections.append({
-            "section_z_mm": float(m.zs[i]),
-            "teeth_in_contact": int(len(np.unique(c["tooth"][sel]))),
-            "working_flank_contacts": int((sel & (c["flank"] == working)).sum()),
-            "non_working_flank_contacts": int((sel & (c["flank"] != working)).sum()),
-            "zone_deg": zone,
-        })
+        sections.append(
+            {
+                "section_z_mm": float(m.zs[i]),
+                "teeth_in_contact": int(len(np.unique(c["tooth"][sel]))),
+                "working_flank_contacts": int((sel & (c["flank"] == working)).sum()),
+                "non_working_flank_contacts": int((sel & (c["flank"] != working)).sum()),
+                "zone_deg": zone,
+            }
+        )
     # force per tooth (all sections and flanks), for the distribution
     tid = c["tooth"][tooth]
     per_tooth = np.zeros(m.drive.design.drive.z_flex)
@@ -82,7 +90,9 @@ def level_summary(st: LoadState, entry=None) -> dict:
     return {
         "torque_nm": st.torque_nm,
         "entry_gap_um": min(gaps) if gaps else None,
-        "entry_gap_at": None if at is None else {k: at[k] for k in ("wave", "section_z_mm", "tooth_angle_deg", "edge", "kind")},
+        "entry_gap_at": None
+        if at is None
+        else {k: at[k] for k in ("wave", "section_z_mm", "tooth_angle_deg", "edge", "kind")},
         "crossing_gap_um": min(cross) if cross else None,
         "entry": entries,
         "min_clearance_um": round(1e3 * float(c["gap"][free].min()), 4) if free.any() else None,
@@ -118,13 +128,24 @@ def mounted_summary(model: ElasticModel, e) -> dict:
     law = model.drive.law.state(phi).w
     dev = w - law
     i = int(np.argmax(np.abs(dev)))
-    return {"w0_um": round(1e3 * mt.w0, 3), "cam_excess": round(cam_excess(model), 6),
-            "largest_departure_from_law_um": round(1e3 * float(dev[i]), 3), "departure_at_deg": _deg(phi[i]),
-            "balls_in_contact": int((mt.force > 0).sum()), "ball_preload_n": round(float(mt.force.max()), 3)}
+    return {
+        "w0_um": round(1e3 * mt.w0, 3),
+        "cam_excess": round(cam_excess(model), 6),
+        "largest_departure_from_law_um": round(1e3 * float(dev[i]), 3),
+        "departure_at_deg": _deg(phi[i]),
+        "balls_in_contact": int((mt.force > 0).sum()),
+        "ball_preload_n": round(float(mt.force.max()), 3),
+    }
 
 
-def torque_sweep(model: ElasticModel, torques_nm, cam_offset_um: float = 0.0, cam_offset_deg: float = 0.0,
-                 tol: float | None = None, progress=None) -> dict:
+def torque_sweep(
+    model: ElasticModel,
+    torques_nm,
+    cam_offset_um: float = 0.0,
+    cam_offset_deg: float = 0.0,
+    tol: float | None = None,
+    progress=None,
+) -> dict:
     """Solve every torque level (each warm-started from the previous) and summarise.
 
     Returns
@@ -146,7 +167,7 @@ def torque_sweep(model: ElasticModel, torques_nm, cam_offset_um: float = 0.0, ca
     t1 = time.perf_counter()
     n_e = 2 * len(model.zs)
     gaps = entry_gaps(model.scene, [law for st in states for law in _entry_laws(st)])
-    levels = [level_summary(st, gaps[k * n_e:(k + 1) * n_e]) for k, st in enumerate(states)]
+    levels = [level_summary(st, gaps[k * n_e : (k + 1) * n_e]) for k, st in enumerate(states)]
     t_summary = time.perf_counter() - t1
     # stiffness as catalogues state it: secant from the first level (zero load when the sweep starts there) and
     # tangent, estimated by the increment between neighbouring levels

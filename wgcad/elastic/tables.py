@@ -121,7 +121,7 @@ class Compliance:
             self._have[new] = True
         return self._D[:, W]
 
-    def with_support(self, At: np.ndarray, c) -> "Compliance":
+    def with_support(self, At: np.ndarray, c) -> Compliance:
         """The same compliance plus elastic supports of rigid-body freedoms: ``At diag(c) At'`` (``At`` ``(m, k)``: each
         contact's ``A`` rows for those freedoms, ``c`` ``(k,)`` the supports' compliances). Contact forces move the
         bodies by ``-c At' F`` against their supports, which every gap feels (docs/models.md 4.1)."""
@@ -137,7 +137,7 @@ class Compliance:
         new.diag = self.diag + (new._At * new._At * new._c_sup).sum(axis=1)
         return new
 
-    def with_contact(self, s: np.ndarray) -> "Compliance":
+    def with_contact(self, s: np.ndarray) -> Compliance:
         """The same ring part with contact compliances ``s`` ``(m,)`` on the diagonal (the columns built so far kept)."""
         new = object.__new__(Compliance)
         new.__dict__.update(self.__dict__)

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from dataclasses import dataclass
+
 import numpy as np
 import shapely
 
@@ -169,8 +170,10 @@ def flank_contacts(scene: Scene, rot: np.ndarray, shift: np.ndarray) -> dict[str
     lo, up, _ = scene.neighbours(shift, rot)
     # both neighbours in one batch: pairs 0..K-1 with the lower rigid tooth, K..2K-1 with the upper
     g = pair_contacts(scene, np.concatenate([rot, rot]), np.concatenate([shift, shift]), np.concatenate([lo, up]))
-    return {key: ContactGeometry(g.gap[sl], g.point[sl], g.normal[sl], g.rigid[sl])
-            for key, sl in (("lower", slice(0, K)), ("upper", slice(K, 2 * K)))}
+    return {
+        key: ContactGeometry(g.gap[sl], g.point[sl], g.normal[sl], g.rigid[sl])
+        for key, sl in (("lower", slice(0, K)), ("upper", slice(K, 2 * K)))
+    }
 
 
 def pair_contacts(scene: Scene, rot: np.ndarray, shift: np.ndarray, rigid: np.ndarray) -> ContactGeometry:
@@ -196,8 +199,9 @@ def pair_contacts(scene: Scene, rot: np.ndarray, shift: np.ndarray, rigid: np.nd
         touch = np.nonzero(np.maximum(d_f, d_r) <= 0.0)[0]
         if touch.size:  # touching without a vertex inside
             k = over[touch]
-            seg = shapely.get_coordinates(shapely.shortest_line(shapely.get_exterior_ring(geoms[k]),
-                                                                shapely.get_exterior_ring(rg[k]))).reshape(-1, 2, 2)
+            seg = shapely.get_coordinates(
+                shapely.shortest_line(shapely.get_exterior_ring(geoms[k]), shapely.get_exterior_ring(rg[k]))
+            ).reshape(-1, 2, 2)
             point[k], other[k] = seg[:, 0], seg[:, 1]
     # the contact normal is the normal of the smoother outline there: a tip corner pressing on a
     # flank acts along the flank's normal (vertex normals interpolated, so it does not jump)
@@ -254,4 +258,3 @@ class ToothCompliance:
         """Secant compliance ``hertz(Q)/Q`` with ``Q`` floored at ``q_floor`` N, mm/N."""
         Q = np.maximum(np.asarray(Q, dtype=float), q_floor)
         return self.hertz(Q, width) / Q
-

@@ -18,7 +18,16 @@ from dataclasses import dataclass
 
 import numpy as np
 
-__all__ = ["ArcPath", "fit_pieces", "fit_gear", "arc_points", "arc_deviation", "bulge_centres", "segment_tangents", "path_area"]
+__all__ = [
+    "ArcPath",
+    "fit_pieces",
+    "fit_gear",
+    "arc_points",
+    "arc_deviation",
+    "bulge_centres",
+    "segment_tangents",
+    "path_area",
+]
 
 #: Curve points checked per biarc while fitting (the curve->arc distance).
 #: The independent check, :func:`arc_deviation`, samples the arcs instead.
@@ -62,7 +71,7 @@ class ArcPath:
             out[-1] = self.end
         return out
 
-    def rotated(self, angle: float) -> "ArcPath":
+    def rotated(self, angle: float) -> ArcPath:
         """The same path turned by ``angle`` about the origin (bulges are invariant)."""
         c, s = np.cos(angle), np.sin(angle)
         v = self.vertices
@@ -223,9 +232,13 @@ def _fit_piece(piece, index: int, tol: float, out_v, out_b, out_s):
             # samples (near a cycloid's cusp the curvature is unbounded); measure arc points
             # against a dense polyline of the curve, which can only overstate their distance
             # by the polyline's own sagitta (taken off the tolerance)
-            arcs = arc_points(np.array([pa, joint]), np.array([joint, pb]), np.array([b0, b1]), N_CHECK + 2).reshape(-1, 2)
+            arcs = arc_points(np.array([pa, joint]), np.array([joint, pb]), np.array([b0, b1]), N_CHECK + 2).reshape(
+                -1, 2
+            )
             dense = piece.point(np.linspace(a, b, DENSE))
-            sag = _dist_to_polyline(piece.point(0.5 * (np.linspace(a, b, DENSE)[1:] + np.linspace(a, b, DENSE)[:-1])), dense).max()
+            sag = _dist_to_polyline(
+                piece.point(0.5 * (np.linspace(a, b, DENSE)[1:] + np.linspace(a, b, DENSE)[:-1])), dense
+            ).max()
             back = _dist_to_polyline(arcs, dense).max()
             if back > tol - sag:
                 dev = np.append(dev, back)
@@ -268,7 +281,12 @@ def fit_pieces(pieces, tol: float, closed: bool = True) -> ArcPath:
     for i, p in enumerate(pieces):
         _fit_piece(p, i, tol, out_v, out_b, out_s)
     end = None if closed else pieces[-1].point(np.array([pieces[-1].t1]))[0]
-    return ArcPath(np.asarray(out_v, dtype=float), np.asarray(out_b, dtype=float), np.asarray(out_s, dtype=float).reshape(-1, 4), end)
+    return ArcPath(
+        np.asarray(out_v, dtype=float),
+        np.asarray(out_b, dtype=float),
+        np.asarray(out_s, dtype=float).reshape(-1, 4),
+        end,
+    )
 
 
 def arc_deviation(path: ArcPath, pieces, n_per_arc: int = 64, newton_steps: int = 8) -> np.ndarray:
@@ -347,8 +365,11 @@ def fit_gear(gear, tol: float) -> ArcPath:
     pieces = list(gear.pieces)
     one = fit_pieces(pieces, tol, closed=False)
     turned = [one.rotated(k * gear.pitch_angle + gear.spec.phase) for k in range(gear.spec.z)]
-    return ArcPath(np.concatenate([t.vertices for t in turned]), np.tile(one.bulges, gear.spec.z),
-                   np.concatenate([t.source for t in turned]))
+    return ArcPath(
+        np.concatenate([t.vertices for t in turned]),
+        np.tile(one.bulges, gear.spec.z),
+        np.concatenate([t.source for t in turned]),
+    )
 
 
 def segment_tangents(path: ArcPath) -> tuple[np.ndarray, np.ndarray]:

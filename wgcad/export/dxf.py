@@ -11,10 +11,10 @@ import ezdxf
 import numpy as np
 from ezdxf.lldxf.validator import is_valid_layer_name
 
-from wgcad.errors import InputFileError
-from wgcad.constants import DUPLICATE_TOL  # noqa: F401  (re-exported for callers)
-from wgcad.export.arcs import arc_points
 from wgcad.atomic import atomic_writer
+from wgcad.constants import DUPLICATE_TOL  # noqa: F401  (re-exported for callers)
+from wgcad.errors import InputFileError
+from wgcad.export.arcs import arc_points
 from wgcad.export.rings import clean_outline, min_spacing
 
 __all__ = ["DxfLayer", "build_dxf", "write_dxf", "read_dxf", "audit_dxf", "clean_outline", "clean_path"]
@@ -89,7 +89,9 @@ class DxfLayer:
             if v.ndim != 2 or v.shape[1] != 2 or b.shape != (len(v),):
                 raise ValueError(f"layer {self.name}: path {k} must be (N, 2) vertices and (N,) bulges")
             if not (np.all(np.isfinite(v)) and np.all(np.abs(b) <= 1.0)):
-                raise ValueError(f"layer {self.name}: path {k} needs finite vertices and |bulge| <= 1 (at most half circles)")
+                raise ValueError(
+                    f"layer {self.name}: path {k} needs finite vertices and |bulge| <= 1 (at most half circles)"
+                )
             paths.append((_readonly(v), _readonly(b)))
         texts = []
         for k, t in enumerate(self.texts):
@@ -104,7 +106,7 @@ class DxfLayer:
         object.__setattr__(self, "color", int(self.color))
 
 
-def build_dxf(layers) -> "ezdxf.document.Drawing":
+def build_dxf(layers) -> ezdxf.document.Drawing:
     """Build an in-memory DXF R2010 drawing of the layers.
 
     Each outline becomes one closed LWPOLYLINE (after :func:`clean_outline`),
@@ -252,7 +254,7 @@ def write_dxf(path: str | os.PathLike, layers) -> None:
         # same design give byte-identical files (reproducible output).
         with _fixed_metadata():
             _canonical_classes(doc)
-            with open(temp, "wt", encoding=doc.output_encoding, errors="dxfreplace") as fp:
+            with open(temp, "w", encoding=doc.output_encoding, errors="dxfreplace") as fp:
                 doc.write(fp)
 
 
@@ -280,7 +282,7 @@ def _canonical_classes(doc) -> None:
     section.classes = OrderedDict(head + rest)
 
 
-def _readfile(path) -> "ezdxf.document.Drawing":
+def _readfile(path) -> ezdxf.document.Drawing:
     try:
         return ezdxf.readfile(path)
     except OSError as exc:
@@ -331,7 +333,9 @@ def read_dxf(path: str | os.PathLike) -> dict:
             if np.any(values[:, 2:4] != 0):
                 raise InputFileError(f"{where} has widths (outlines must be plain lines and arcs)")
             if np.any(values[:, 4] != 0):
-                entry["paths"].append((np.array(values[:, :2], dtype=np.float64), np.array(values[:, 4], dtype=np.float64)))
+                entry["paths"].append(
+                    (np.array(values[:, :2], dtype=np.float64), np.array(values[:, 4], dtype=np.float64))
+                )
             else:
                 entry["outlines"].append(np.array(values[:, :2], dtype=np.float64))
         elif kind == "CIRCLE":

@@ -106,7 +106,13 @@ def assembly_figure(scene: dict, title: str, entry_deg: float = 50.0, rows: int 
     r_out = 1.03 * max(ro_r, float(np.max(rr)), r_m)
     for s_, col, name in ((0.0, "tab:red", "major axis"), (pi / scene["waves"], "tab:green", "minor axis")):
         aa = a + s_
-        ax0.plot([-r_out * np.cos(aa), r_out * np.cos(aa)], [-r_out * np.sin(aa), r_out * np.sin(aa)], color=col, lw=1.0, ls="--")
+        ax0.plot(
+            [-r_out * np.cos(aa), r_out * np.cos(aa)],
+            [-r_out * np.sin(aa), r_out * np.sin(aa)],
+            color=col,
+            lw=1.0,
+            ls="--",
+        )
         x, y, ha, va = _axis_label_pos(aa, 1.05 * r_out)
         ax0.text(x, y, name, color=col, fontsize=9, ha=ha, va=va)
     lim = 1.45 * r_out
@@ -115,9 +121,11 @@ def assembly_figure(scene: dict, title: str, entry_deg: float = 50.0, rows: int 
     ax0.set_aspect("equal")
     ax0.set_title(f"whole drive, schematic:\ndeformation exaggerated x{k:g}", fontsize=10)
     hand, _ = ax0.get_legend_handles_labels()
-    hand += [Patch(fc="0.80", ec="0.3", label="rigid gear (close-ups, true shape and scale)"),
-             Patch(fc="tab:blue", alpha=0.45, ec="tab:blue", label="flexspline teeth (close-ups)"),
-             Line2D([], [], ls="", label="numbers above each close-up: the flexspline\ntooth's angle from the major axis")]
+    hand += [
+        Patch(fc="0.80", ec="0.3", label="rigid gear (close-ups, true shape and scale)"),
+        Patch(fc="tab:blue", alpha=0.45, ec="tab:blue", label="flexspline teeth (close-ups)"),
+        Line2D([], [], ls="", label="numbers above each close-up: the flexspline\ntooth's angle from the major axis"),
+    ]
     ax0.legend(handles=hand, fontsize=_LEGEND_PT, loc="upper center", bbox_to_anchor=(0.5, 0.0))
     ax0.axis("off")
 
@@ -160,8 +168,10 @@ def assembly_figure(scene: dict, title: str, entry_deg: float = 50.0, rows: int 
         if i == 0:
             top.set_xlabel("flexspline tooth angle from the major axis", fontsize=9, color="tab:blue")
         if i == rows - 1:
-            ax.set_xlabel(f"arc length at r_ref = {r_ref:.2f} mm from the major axis, mm "
-                          f"(entry side {'+' if sgn > 0 else '-'})", fontsize=9)
+            ax.set_xlabel(
+                f"arc length at r_ref = {r_ref:.2f} mm from the major axis, mm (entry side {'+' if sgn > 0 else '-'})",
+                fontsize=9,
+            )
     fig.suptitle(title, fontsize=11)
     return fig
 
@@ -260,14 +270,37 @@ def clearance_profile_figure(profile: dict, title: str):
     marks = [profile["worst_um"], tol]
     if np.isfinite(profile.get("entry_um", np.nan)):
         marks.append(profile["entry_um"])
-        ax.plot([profile["entry_deg"]], [profile["entry_um"]], "v", color="tab:green", ms=9, zorder=5,
-                label=profile.get("entry_label", "entry gap") + f" {profile['entry_um']:.2f} um at {profile['entry_deg']:+.1f}°")
+        ax.plot(
+            [profile["entry_deg"]],
+            [profile["entry_um"]],
+            "v",
+            color="tab:green",
+            ms=9,
+            zorder=5,
+            label=profile.get("entry_label", "entry gap")
+            + f" {profile['entry_um']:.2f} um at {profile['entry_deg']:+.1f}°",
+        )
     if np.isfinite(profile.get("entry2_um", np.nan)):
         marks.append(profile["entry2_um"])
-        ax.plot([profile["entry2_deg"]], [profile["entry2_um"]], "v", color="tab:purple", ms=9, zorder=5,
-                label=profile.get("entry2_label", "entry gap") + f"\n{profile['entry2_um']:.2f} um at {profile['entry2_deg']:+.1f}°")
-    ax.plot([profile["worst_deg"]], [profile["worst_um"]], "o", color="tab:red", ms=8, zorder=5,
-            label=profile.get("worst_label", "minimum") + f" {profile['worst_um']:.2f} um at {profile['worst_deg']:+.1f}°")
+        ax.plot(
+            [profile["entry2_deg"]],
+            [profile["entry2_um"]],
+            "v",
+            color="tab:purple",
+            ms=9,
+            zorder=5,
+            label=profile.get("entry2_label", "entry gap")
+            + f"\n{profile['entry2_um']:.2f} um at {profile['entry2_deg']:+.1f}°",
+        )
+    ax.plot(
+        [profile["worst_deg"]],
+        [profile["worst_um"]],
+        "o",
+        color="tab:red",
+        ms=8,
+        zorder=5,
+        label=profile.get("worst_label", "minimum") + f" {profile['worst_um']:.2f} um at {profile['worst_deg']:+.1f}°",
+    )
     # y: from the deepest point to above the highest marker; the curves rise to
     # millimetres out of mesh, and showing that would flatten the engagement
     lo = min(min(lows), profile["worst_um"], -tol)
@@ -280,19 +313,29 @@ def clearance_profile_figure(profile: dict, title: str):
     ticks = np.arange(-np.floor(half / 15) * 15, half + 1e-9, 15.0)
     ticks = np.unique(np.concatenate([ticks, [ph[0], ph[-1]]]))
     names = {0.0: "\nmajor axis"}
-    ax.set_xticks(ticks, labels=[f"{t:g}" + (names.get(round(t, 6), "") if abs(t) < half - 1e-6 else "\nminor axis") for t in ticks])
+    ax.set_xticks(
+        ticks,
+        labels=[f"{t:g}" + (names.get(round(t, 6), "") if abs(t) < half - 1e-6 else "\nminor axis") for t in ticks],
+    )
     # a break is worth a word only where the exchanged values are on the scale
     fold_x = sorted({round(float(x), 1) for x, y in fold_x if y <= top})
     for fx in fold_x:
         ax.axvline(fx, color="0.4", lw=1.0, ls=":")
     handles, _ = ax.get_legend_handles_labels()
     if fold_x:
-        handles.append(Line2D([], [], color="0.4", lw=1.0, ls=":",
-                              label="break at {}°: the tooth stands tip to tip with\n"
-                                    "a rigid tooth, which passes from one flank's side\n"
-                                    "to the other's: the two curves exchange values\n"
-                                    "there (not a jump in clearance)"
-                              .format(", ".join(f"{x:+.1f}" for x in fold_x))))
+        handles.append(
+            Line2D(
+                [],
+                [],
+                color="0.4",
+                lw=1.0,
+                ls=":",
+                label="break at {}°: the tooth stands tip to tip with\n"
+                "a rigid tooth, which passes from one flank's side\n"
+                "to the other's: the two curves exchange values\n"
+                "there (not a jump in clearance)".format(", ".join(f"{x:+.1f}" for x in fold_x)),
+            )
+        )
     handles.append(Line2D([], [], ls="", label=f"curves above {top:.0f} um not shown\n(teeth out of mesh)"))
     _legend_outside(ax, handles=handles)
     ax.tick_params(labelsize=9)
@@ -325,7 +368,10 @@ def clearance_vs_angle_figure(angles_deg, working_um, nonworking_um, tol_um: flo
 
     fig, axs = plt.subplots(2, 1, figsize=(13, 6.4), sharex=True, layout="constrained", dpi=DPI)
     ang = np.asarray(angles_deg, float)
-    for ax, y, name, style in ((axs[0], working_um, "working flank", "-"), (axs[1], nonworking_um, "non-working flank", "--")):
+    for ax, y, name, style in (
+        (axs[0], working_um, "working flank", "-"),
+        (axs[1], nonworking_um, "non-working flank", "--"),
+    ):
         y = np.asarray(y, float)
         fin = y[np.isfinite(y)]
         y_min, y_max = (float(fin.min()), float(fin.max())) if fin.size else (0.0, 0.0)
@@ -342,8 +388,11 @@ def clearance_vs_angle_figure(angles_deg, working_um, nonworking_um, tol_um: flo
             where += f"; grey band: contact within +-{tol_um:g} um"
         if lo < 0.0 < hi:
             ax.axhline(0.0, color="k", lw=0.8)
-        ax.set_title(f"{name}: {y_min:.3f} to {y_max:.3f} um, ripple {rip:.3f} um peak to peak ({where})",
-                     fontsize=9.5, loc="left")
+        ax.set_title(
+            f"{name}: {y_min:.3f} to {y_max:.3f} um, ripple {rip:.3f} um peak to peak ({where})",
+            fontsize=9.5,
+            loc="left",
+        )
         ax.set_ylabel("smallest clearance, um", fontsize=9.5)
         ax.tick_params(labelsize=9)
         ax.grid(alpha=0.3)
@@ -352,7 +401,9 @@ def clearance_vs_angle_figure(angles_deg, working_um, nonworking_um, tol_um: flo
     return fig
 
 
-def clearance_vs_angle_png(angles_deg: np.ndarray, working_um: np.ndarray, nonworking_um: np.ndarray, tol_um: float, title: str) -> bytes:
+def clearance_vs_angle_png(
+    angles_deg: np.ndarray, working_um: np.ndarray, nonworking_um: np.ndarray, tol_um: float, title: str
+) -> bytes:
     """Smallest clearance over all teeth against the generator angle, one panel per flank, as PNG bytes.
 
     Each panel's y range is the curve's own range plus a margin, stated in
@@ -377,9 +428,13 @@ def tightest_spot_figure(flex_teeth: np.ndarray, labels, rigid_teeth: np.ndarray
         for t in rigid_teeth:
             ax.add_patch(Polygon(_unroll(t, r_ref, a_ref), closed=True, fc="0.8", ec="0.3", lw=0.6))
         for t in flex_teeth:
-            ax.add_patch(Polygon(_unroll(t, r_ref, a_ref), closed=True, fc="tab:blue", alpha=0.4, ec="tab:blue", lw=0.7))
+            ax.add_patch(
+                Polygon(_unroll(t, r_ref, a_ref), closed=True, fc="tab:blue", alpha=0.4, ec="tab:blue", lw=0.7)
+            )
         for poly in overlap:
-            ax.add_patch(Polygon(_unroll(poly, r_ref, a_ref), closed=True, fc="tab:red", ec="tab:red", lw=0.8, alpha=0.9))
+            ax.add_patch(
+                Polygon(_unroll(poly, r_ref, a_ref), closed=True, fc="tab:red", ec="tab:red", lw=0.8, alpha=0.9)
+            )
         ax.set_aspect("equal")
         ax.set_xlabel("arc length from the tooth, mm", fontsize=9.5)
         ax.set_ylabel("radius - r, mm", fontsize=9.5)
@@ -398,7 +453,9 @@ def tightest_spot_figure(flex_teeth: np.ndarray, labels, rigid_teeth: np.ndarray
     top = axs[0].secondary_xaxis("top")
     top.set_xticks([float(u[:, 0].mean()) for u in tops], labels=list(labels))
     top.tick_params(labelsize=MIN_FONT_PT, colors="tab:blue", length=3)
-    top.set_xlabel("flexspline tooth angle from the major axis (red: overlap of the worst tooth)", fontsize=9, color="tab:blue")
+    top.set_xlabel(
+        "flexspline tooth angle from the major axis (red: overlap of the worst tooth)", fontsize=9, color="tab:blue"
+    )
     mid = _unroll(flex_teeth[len(flex_teeth) // 2], r_ref, a_ref)
     if overlap:
         o = np.vstack([_unroll(p, r_ref, a_ref) for p in overlap])
@@ -429,15 +486,40 @@ def velocities_figure(vel, title: str):
     ph = np.rad2deg(vel.phi)
     fig, axs = plt.subplots(2, 2, figsize=(15, 9), sharex=True, layout="constrained", dpi=DPI)
     (a_rad, a_tan), (a_sl, a_th) = axs
-    a_rad.plot(ph, vel.V_w, color="C0", lw=1.6,
-               label="V_w = dw/dt: radial speed of the neutral line\n(= V_wK of the outer surface K: w_K = w + h_c/2)")
-    a_rad.plot(ph, vel.V_dw, color="C1", lw=1.3, ls="--", label="V_dw = a_w omega_h sin(phi):\nradial component of the washer speed")
+    a_rad.plot(
+        ph,
+        vel.V_w,
+        color="C0",
+        lw=1.6,
+        label="V_w = dw/dt: radial speed of the neutral line\n(= V_wK of the outer surface K: w_K = w + h_c/2)",
+    )
+    a_rad.plot(
+        ph,
+        vel.V_dw,
+        color="C1",
+        lw=1.3,
+        ls="--",
+        label="V_dw = a_w omega_h sin(phi):\nradial component of the washer speed",
+    )
     a_rad.set_title("radial speeds", fontsize=10)
     dv = float(np.max(np.abs(vel.V_vK - vel.V_v)))
     a_tan.plot(ph, vel.V_v, color="C2", lw=2.6, alpha=0.6, label="V_v = dv/dt: tangential speed of the neutral line")
-    a_tan.plot(ph, vel.V_vK, color="k", lw=1.0, ls="--",
-               label=f"V_vK = V_v + (h_c/2) dtheta/dt: tangential speed of\nthe outer surface K (at most {dv:.3g} mm/s from V_v)")
-    a_tan.plot(ph, vel.V_dv, color="C3", lw=1.3, ls="-.", label="V_dv = a_w omega_h cos(phi):\ntangential component of the washer speed")
+    a_tan.plot(
+        ph,
+        vel.V_vK,
+        color="k",
+        lw=1.0,
+        ls="--",
+        label=f"V_vK = V_v + (h_c/2) dtheta/dt: tangential speed of\nthe outer surface K (at most {dv:.3g} mm/s from V_v)",
+    )
+    a_tan.plot(
+        ph,
+        vel.V_dv,
+        color="C3",
+        lw=1.3,
+        ls="-.",
+        label="V_dv = a_w omega_h cos(phi):\ntangential component of the washer speed",
+    )
     a_tan.set_title("tangential speeds", fontsize=10)
     a_sl.plot(ph, vel.V_sl, color="C4", lw=1.6, label="V_sl = V_d - V_v: sliding speed\nbetween washer and flexspline")
     a_sl.plot(ph, vel.V_d, color="0.4", lw=1.2, ls=":", label="V_d = omega_h a_w: speed of every washer point")
@@ -453,7 +535,9 @@ def velocities_figure(vel, title: str):
         ax.axhline(0.0, color="0.5", lw=0.6)
         ax.grid(alpha=0.3)
         ax.tick_params(labelsize=9)
-        ax.legend(fontsize=_LEGEND_PT, loc="upper center", bbox_to_anchor=(0.5, -0.12 if ax in axs[1] else -0.04), ncol=1)
+        ax.legend(
+            fontsize=_LEGEND_PT, loc="upper center", bbox_to_anchor=(0.5, -0.12 if ax in axs[1] else -0.04), ncol=1
+        )
     fig.suptitle(title, fontsize=11)
     return fig
 

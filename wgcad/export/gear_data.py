@@ -85,9 +85,14 @@ def pin_dimension(gear, pin_diameter: float | None = None) -> dict | None:
     if not (p["pin_stands_out_of_the_teeth"] and p["pin_clear_of_the_root"]):
         return None
     M = p["between_pins_mm" if sp.internal else "over_pins_mm"]
-    return {"pin_diameter_mm": p["pin_diameter_mm"], "M_mm": M, "pin_centre_radius_mm": 0.5 * p["pin_centre_diameter_mm"],
-            "contact_radius_mm": 0.5 * p["contact_diameter_mm"], "kind": "between pins" if sp.internal else "over pins",
-            "rule": p["pin_diameter_source"]}
+    return {
+        "pin_diameter_mm": p["pin_diameter_mm"],
+        "M_mm": M,
+        "pin_centre_radius_mm": 0.5 * p["pin_centre_diameter_mm"],
+        "contact_radius_mm": 0.5 * p["contact_diameter_mm"],
+        "kind": "between pins" if sp.internal else "over pins",
+        "rule": p["pin_diameter_source"],
+    }
 
 
 def gear_data(gear, tol: float) -> dict:

@@ -30,13 +30,23 @@ def entry_passages_figure(phi_h_deg, gap_um, section, sections_z, perfect_um, to
         sel = si == s
         lab = "no coning" if z is None else f"z = {z:g} mm"
         if sel.any():
-            ax.plot(ph[sel], g[sel], ".", ms=3.5, color=f"C{s}", label=f"{lab}: {int(sel.sum())} passages, "
-                    f"{g[sel].min():.2f} to {g[sel].max():.2f} um")
+            ax.plot(
+                ph[sel],
+                g[sel],
+                ".",
+                ms=3.5,
+                color=f"C{s}",
+                label=f"{lab}: {int(sel.sum())} passages, {g[sel].min():.2f} to {g[sel].max():.2f} um",
+            )
         if s < len(perfect_um) and np.isfinite(perfect_um[s]):
-            ax.axhline(perfect_um[s], color=f"C{s}", ls="--", lw=1.0, label=f"{lab}: perfect parts {perfect_um[s]:.2f} um")
+            ax.axhline(
+                perfect_um[s], color=f"C{s}", ls="--", lw=1.0, label=f"{lab}: perfect parts {perfect_um[s]:.2f} um"
+            )
     fin = g[np.isfinite(g)]
     if fin.size and fin.min() < tol_um:
-        ax.axhspan(min(fin.min(), -tol_um), tol_um, color="0.88", zorder=0, label=f"closed (below the {tol_um:g} um tolerance)")
+        ax.axhspan(
+            min(fin.min(), -tol_um), tol_um, color="0.88", zorder=0, label=f"closed (below the {tol_um:g} um tolerance)"
+        )
     ax.set_xlabel("generator angle at the crossing, deg", fontsize=10)
     ax.set_ylabel("entry gap, um (polygon figures)", fontsize=10)
     ax.tick_params(labelsize=max(9, MIN_FONT_PT))

@@ -2,10 +2,10 @@
 
 from __future__ import annotations
 
-
 import numpy as np
 
-from .mpl import png_bytes, pyplot as _plt
+from .mpl import png_bytes
+from .mpl import pyplot as _plt
 
 __all__ = ["ke_png", "install_png", "flank_png", "ke_load_png"]
 
@@ -21,7 +21,9 @@ def ke_png(title: str, res, orders, amp, expected: dict, intrinsic=None) -> byte
     plt = _plt()
     fig, ax = plt.subplots(3, 1, figsize=(11, 10), dpi=90)
     turns = np.abs(res.phi_h) / (2 * np.pi)
-    ax[0].plot(turns, res.ke * _AS, lw=0.4, color="k", label=f"KE ({res.engagement}), {res.ke_pp * _AS:.2f}'' peak to peak")
+    ax[0].plot(
+        turns, res.ke * _AS, lw=0.4, color="k", label=f"KE ({res.engagement}), {res.ke_pp * _AS:.2f}'' peak to peak"
+    )
     ax[0].set_xlabel("generator turns (one flexspline revolution)")
     ax[0].set_ylabel("KE, arcsec")
     ax[0].legend(fontsize=8, loc="upper right")
@@ -32,8 +34,15 @@ def ke_png(title: str, res, orders, amp, expected: dict, intrinsic=None) -> byte
     ax[1].plot(deg, res.ke[:n] * _AS, ".-", ms=3, lw=0.8, color="k", label="KE")
     if intrinsic is not None:
         m = min(n, len(intrinsic.ke))
-        ax[1].plot(np.degrees(np.abs(intrinsic.phi_h[:m])), intrinsic.ke[:m] * _AS, ".-", ms=3, lw=0.8,
-                   color="tab:orange", label=f"perfect parts, {intrinsic.ke_pp * _AS:.3f}'' peak to peak")
+        ax[1].plot(
+            np.degrees(np.abs(intrinsic.phi_h[:m])),
+            intrinsic.ke[:m] * _AS,
+            ".-",
+            ms=3,
+            lw=0.8,
+            color="tab:orange",
+            label=f"perfect parts, {intrinsic.ke_pp * _AS:.3f}'' peak to peak",
+        )
     ax[1].set_xlabel("generator angle, deg (the first mesh periods)")
     ax[1].set_ylabel("KE, arcsec")
     ax[1].legend(fontsize=8, loc="upper right")
@@ -66,7 +75,9 @@ def install_png(title: str, rigid_deg, rigid_pp, best_deg, best_pp, flex_deg=Non
     ax.plot(rigid_deg, np.asarray(rigid_pp) * _AS, "o-", ms=3, label="rigid gear installation angle")
     if flex_deg is not None:
         ax.plot(flex_deg, np.asarray(flex_pp) * _AS, "s-", ms=3, label="flexspline angular position")
-    ax.plot([best_deg], [best_pp * _AS], "r*", ms=12, label=f"best rigid angle {best_deg:.1f} deg: {best_pp * _AS:.1f}''")
+    ax.plot(
+        [best_deg], [best_pp * _AS], "r*", ms=12, label=f"best rigid angle {best_deg:.1f} deg: {best_pp * _AS:.1f}''"
+    )
     ax.set_xlabel("angle, deg")
     ax.set_ylabel("largest KE, arcsec")
     ax.grid(alpha=0.3)
@@ -76,8 +87,11 @@ def install_png(title: str, rigid_deg, rigid_pp, best_deg, best_pp, flex_deg=Non
 
 
 #: plain names of the engagement types of [S2] in the figure's legend
-_ENGAGEMENT_NAMES = {"double": "double-flank (both flanks in contact)", "single_left": "single-flank, working flanks",
-                     "single_right": "single-flank, the other flanks"}
+_ENGAGEMENT_NAMES = {
+    "double": "double-flank (both flanks in contact)",
+    "single_left": "single-flank, working flanks",
+    "single_right": "single-flank, the other flanks",
+}
 
 
 def flank_png(title: str, turns, errors: dict, zones=("major axis", "second wave")) -> bytes:
@@ -89,8 +103,11 @@ def flank_png(title: str, turns, errors: dict, zones=("major axis", "second wave
     """
     plt = _plt()
     fig, ax = plt.subplots(2, 1, figsize=(12, 7.5), dpi=110, sharex=True)
-    styles = {"double": dict(lw=1.1, color="k"), "single_left": dict(lw=0.7, color="tab:red", alpha=0.8),
-              "single_right": dict(lw=0.7, color="tab:blue", alpha=0.8)}
+    styles = {
+        "double": dict(lw=1.1, color="k"),
+        "single_left": dict(lw=0.7, color="tab:red", alpha=0.8),
+        "single_right": dict(lw=0.7, color="tab:blue", alpha=0.8),
+    }
     for (zi, eng), fe in errors.items():
         st = dict(styles[eng])
         if zi:
@@ -113,17 +130,32 @@ def ke_load_png(title: str, res, loaded: list) -> bytes:
     plt = _plt()
     fig, ax = plt.subplots(1, 1, figsize=(11, 5.2), dpi=150)
     turns = np.abs(res.phi_h) / (2 * np.pi)
-    ax.plot(turns, res.ke * _AS, lw=0.4, color="0.55", label=f"no load, every angle: {res.ke_pp * _AS:.2f}'' peak to peak")
+    ax.plot(
+        turns, res.ke * _AS, lw=0.4, color="0.55", label=f"no load, every angle: {res.ke_pp * _AS:.2f}'' peak to peak"
+    )
     if loaded:
         L = loaded[0]
         idx = L.periods * res.n_per_mesh
         nl = (res.ke[idx] - res.ke[idx[0]]) * _AS
-        ax.plot(np.abs(L.phi_h) / (2 * np.pi), nl, "s", ms=3.5, mfc="none", color="k",
-                label=f"no load at the loaded samples' angles: {nl.max() - nl.min():.2f}'' peak to peak")
+        ax.plot(
+            np.abs(L.phi_h) / (2 * np.pi),
+            nl,
+            "s",
+            ms=3.5,
+            mfc="none",
+            color="k",
+            label=f"no load at the loaded samples' angles: {nl.max() - nl.min():.2f}'' peak to peak",
+        )
     for i, L in enumerate(loaded):
         t = np.abs(L.phi_h) / (2 * np.pi)
-        ax.plot(t, L.ke * _AS, "o", ms=2.5, color=f"C{i}",
-                label=f"{L.torque_nm:g} N m: {L.ke_pp * _AS:.2f}'' peak to peak at {len(L.ke)} whole mesh periods")
+        ax.plot(
+            t,
+            L.ke * _AS,
+            "o",
+            ms=2.5,
+            color=f"C{i}",
+            label=f"{L.torque_nm:g} N m: {L.ke_pp * _AS:.2f}'' peak to peak at {len(L.ke)} whole mesh periods",
+        )
     ax.set_xlabel("generator turns (one flexspline revolution)")
     ax.set_ylabel("KE, arcsec (each curve from its first sample)")
     ax.legend(fontsize=8.5, loc="upper left", bbox_to_anchor=(1.01, 1.0), borderaxespad=0.0)

@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-
 import numpy as np
 
 from .mpl import png_bytes, pyplot
@@ -41,7 +40,9 @@ def entry_gap_png(series: list, title: str, tol_um: float = 1.0) -> bytes:
     if log:  # series of very different size (e.g. involute ~5 um, cycloidal ~180 um): both readable
         ax.set_yscale("symlog", linthresh=10.0)
     ax.set_xlabel("output torque M_c, N m")
-    ax.set_ylabel("entry gap Delta [S1], um (below 0: tips interfere)" + (", linear below 10 um, log above" if log else ""))
+    ax.set_ylabel(
+        "entry gap Delta [S1], um (below 0: tips interfere)" + (", linear below 10 um, log above" if log else "")
+    )
     ax.set_title(title, fontsize=10)
     ax.grid(True, alpha=0.3)
     ax.legend(fontsize=8)

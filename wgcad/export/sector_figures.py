@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-
 import numpy as np
 
 from .mpl import png_bytes, pyplot
@@ -25,11 +24,29 @@ def _shade_sectors(ax, bounds_deg, kinds, lo, hi):
         if hi <= a or lo >= b:
             continue
         ax.axvspan(max(a, lo), min(b, hi), color="tab:green" if k == "coupling" else "tab:orange", alpha=0.08, lw=0)
-        ax.text(0.5 * (max(a, lo) + min(b, hi)), 1.0, k, transform=ax.get_xaxis_transform(), ha="center", va="bottom", fontsize=8)
+        ax.text(
+            0.5 * (max(a, lo) + min(b, hi)),
+            1.0,
+            k,
+            transform=ax.get_xaxis_transform(),
+            ha="center",
+            va="bottom",
+            fontsize=8,
+        )
 
 
-def heights_png(title: str, centres_deg, bounds_deg, kinds, full_mm: float, closed_mm, simulated_mm, built_mm,
-                boundary_mm=None, tip_clearance_um: float = 0.0) -> bytes:
+def heights_png(
+    title: str,
+    centres_deg,
+    bounds_deg,
+    kinds,
+    full_mm: float,
+    closed_mm,
+    simulated_mm,
+    built_mm,
+    boundary_mm=None,
+    tip_clearance_um: float = 0.0,
+) -> bytes:
     """Tooth heights over half the gear (one wave: a coupling and a transmission sector): closed form, simulated, built; and their difference."""
     plt, fig, (ax, ax2) = _fig(2, (11, 7.5), sharex=True, gridspec_kw={"height_ratios": [2.2, 1]})
     c = np.asarray(centres_deg)
@@ -38,11 +55,33 @@ def heights_png(title: str, centres_deg, bounds_deg, kinds, full_mm: float, clos
     _shade_sectors(ax, np.asarray(bounds_deg), kinds, lo, hi)
     ax.axhline(1e3 * full_mm, color="0.5", lw=1, ls=":", label=f"full height {1e3 * full_mm:.1f} um")
     if boundary_mm is not None:
-        ax.plot(c[sel], 1e3 * np.asarray(boundary_mm)[sel], "^-", color="tab:gray", ms=4, lw=1,
-                label="closed form, axis on the sector boundary (patent reading)")
-    ax.plot(c[sel], 1e3 * np.asarray(closed_mm)[sel], "o-", color="tab:blue", ms=4, lw=1.2, label="closed form (theory 2.3), out-of-register angle")
-    ax.plot(c[sel], 1e3 * np.asarray(simulated_mm)[sel], "s-", color="tab:red", ms=3.5, lw=1.2,
-            label=f"simulated: largest keeping {tip_clearance_um:g} um tip clearance")
+        ax.plot(
+            c[sel],
+            1e3 * np.asarray(boundary_mm)[sel],
+            "^-",
+            color="tab:gray",
+            ms=4,
+            lw=1,
+            label="closed form, axis on the sector boundary (patent reading)",
+        )
+    ax.plot(
+        c[sel],
+        1e3 * np.asarray(closed_mm)[sel],
+        "o-",
+        color="tab:blue",
+        ms=4,
+        lw=1.2,
+        label="closed form (theory 2.3), out-of-register angle",
+    )
+    ax.plot(
+        c[sel],
+        1e3 * np.asarray(simulated_mm)[sel],
+        "s-",
+        color="tab:red",
+        ms=3.5,
+        lw=1.2,
+        label=f"simulated: largest keeping {tip_clearance_um:g} um tip clearance",
+    )
     ax.plot(c[sel], 1e3 * np.asarray(built_mm)[sel], "x", color="k", ms=7, label="built")
     ax.set_ylabel("tooth height h_i, um (root to tip)")
     ax.set_ylim(0, 1e3 * full_mm * 1.12)
@@ -70,8 +109,15 @@ def motion_png(title: str, phi_h_deg, phi_g_deg, phases: list, bounds_deg, kinds
     ax.plot(phi_h_deg, phi_g_deg, color="tab:blue", lw=1.5)
     for p in phases:
         if p["kind"] == "dwell":
-            ax.text(0.5 * (p["start_deg"] + p["end_deg"]), 0.02, f"dwell\n{p['length_deg']:.2f} deg", transform=ax.get_xaxis_transform(),
-                    ha="center", fontsize=8, color="tab:green")
+            ax.text(
+                0.5 * (p["start_deg"] + p["end_deg"]),
+                0.02,
+                f"dwell\n{p['length_deg']:.2f} deg",
+                transform=ax.get_xaxis_transform(),
+                ha="center",
+                fontsize=8,
+                color="tab:green",
+            )
     ax.set_ylabel("output (flexspline) rotation phi_g, deg")
     ax.grid(alpha=0.3)
     ax.set_title(title, fontsize=10)
@@ -104,7 +150,13 @@ def audit_png(title: str, centres_deg, bounds_deg, kinds, curves: dict, tol_um: 
         ax.plot(c[ok], v[ok], mk, ms=4, label=name)
         bad = ok & (v <= tol_um)
         ax.plot(c[bad], v[bad], mk, ms=7, mfc="none", mec="red")
-    ax.axhline(tol_um, color="red", lw=0.8, ls="--", label=f"contact tolerance {tol_um:g} um: at or below = tip-to-tip (red rings)")
+    ax.axhline(
+        tol_um,
+        color="red",
+        lw=0.8,
+        ls="--",
+        label=f"contact tolerance {tol_um:g} um: at or below = tip-to-tip (red rings)",
+    )
     ax.set_xlabel("rigid tooth centre angle, deg")
     ax.set_ylabel("min clearance to a facing flexspline tip, um")
     ax.set_title(title, fontsize=10, pad=16)

@@ -7,11 +7,24 @@ import re
 
 import numpy as np
 
-from wgcad.errors import GeometryError
 from wgcad.atomic import atomic_write
+from wgcad.errors import GeometryError
 
-__all__ = ["wire_from_path", "wire_from_polygon", "bspline_wire", "circle_wire", "prism", "revolve_profile", "fuse", "cut", "drill",
-           "write_step", "read_step", "solid_props", "step_text"]
+__all__ = [
+    "wire_from_path",
+    "wire_from_polygon",
+    "bspline_wire",
+    "circle_wire",
+    "prism",
+    "revolve_profile",
+    "fuse",
+    "cut",
+    "drill",
+    "write_step",
+    "read_step",
+    "solid_props",
+    "step_text",
+]
 
 #: Fixed FILE_NAME time stamp, so the same design gives byte-identical STEP files.
 FIXED_STAMP = "2000-01-01T00:00:00"
@@ -77,10 +90,10 @@ def wire_from_polygon(points):
 
 def bspline_wire(points):
     """A closed wire of one smooth periodic B-spline interpolating ``points (n, 2)`` (closing point implicit)."""
-    from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeEdge
     from OCP.BRep import BRep_Builder
-    from OCP.GeomAPI import GeomAPI_Interpolate
+    from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeEdge
     from OCP.collections import HArray1_gp_Pnt as TColgp_HArray1OfPnt
+    from OCP.GeomAPI import GeomAPI_Interpolate
     from OCP.TopoDS import TopoDS_Wire
 
     pts = np.asarray(points, dtype=float)
@@ -200,7 +213,9 @@ def drill(solid, holes, z0: float, z1: float):
     bld = BRep_Builder()
     bld.MakeCompound(comp)
     for cx, cy, d in holes:
-        cyl = BRepPrimAPI_MakeCylinder(gp_Ax2(_pnt(cx, cy, z0 - 1.0), gp_Dir(0, 0, 1)), d / 2.0, (z1 - z0) + 2.0).Shape()
+        cyl = BRepPrimAPI_MakeCylinder(
+            gp_Ax2(_pnt(cx, cy, z0 - 1.0), gp_Dir(0, 0, 1)), d / 2.0, (z1 - z0) + 2.0
+        ).Shape()
         bld.Add(comp, cyl)
     return cut(solid, comp)
 
@@ -301,5 +316,9 @@ def solid_props(shape) -> dict:
         k = str(BRepAdaptor_Surface(TopoDS.Face(ex.Current())).GetType()).split(".")[-1]
         kinds[k] = kinds.get(k, 0) + 1
         ex.Next()
-    return {"valid": bool(BRepCheck_Analyzer(shape).IsValid()), "volume": float(props.Mass()),
-            "bounds": ((x0, y0, z0), (x1, y1, z1)), "faces": kinds}
+    return {
+        "valid": bool(BRepCheck_Analyzer(shape).IsValid()),
+        "volume": float(props.Mass()),
+        "bounds": ((x0, y0, z0), (x1, y1, z1)),
+        "faces": kinds,
+    }

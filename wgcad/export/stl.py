@@ -11,8 +11,8 @@ import shapely
 import trimesh
 from trimesh.exchange.stl import export_stl
 
-from wgcad.errors import GeometryError
 from wgcad.atomic import atomic_write
+from wgcad.errors import GeometryError
 from wgcad.export.rings import clean_outline
 
 __all__ = ["ring_solid", "stl_bytes", "write_stl"]

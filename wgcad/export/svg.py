@@ -7,8 +7,8 @@ from xml.sax.saxutils import escape
 
 import numpy as np
 
-from wgcad.export.arcs import bulge_centres
 from wgcad.atomic import atomic_write
+from wgcad.export.arcs import bulge_centres
 
 __all__ = ["svg_text", "write_svg"]
 
@@ -52,17 +52,23 @@ def svg_text(layers, title: str) -> str:
     w, h = hi - lo
     flip = lambda y: lo[1] + hi[1] - y  # noqa: E731  (mirror y so the drawing is not upside down)
     stroke = max(0.02, 0.0008 * float(max(w, h)))
-    out = [f'<svg xmlns="http://www.w3.org/2000/svg" width="{_f(w)}mm" height="{_f(h)}mm" '
-           f'viewBox="{_f(lo[0])} {_f(lo[1])} {_f(w)} {_f(h)}">', f"<title>{escape(title)}</title>",
-           f'<rect x="{_f(lo[0])}" y="{_f(lo[1])}" width="{_f(w)}" height="{_f(h)}" fill="white"/>']
+    out = [
+        f'<svg xmlns="http://www.w3.org/2000/svg" width="{_f(w)}mm" height="{_f(h)}mm" '
+        f'viewBox="{_f(lo[0])} {_f(lo[1])} {_f(w)} {_f(h)}">',
+        f"<title>{escape(title)}</title>",
+        f'<rect x="{_f(lo[0])}" y="{_f(lo[1])}" width="{_f(w)}" height="{_f(h)}" fill="white"/>',
+    ]
     for layer in layers:
         col = ACI.get(layer.color, "#000000")
         out.append(f'<g id="{escape(layer.name)}" fill="none" stroke="{col}" stroke-width="{_f(stroke)}">')
         out += [f'<path d="{_poly(o, flip)}"/>' for o in layer.outlines]
         out += [f'<path d="{_path(v, b, flip)}"/>' for v, b in layer.paths]
         out += [f'<circle cx="{_f(cx)}" cy="{_f(flip(cy))}" r="{_f(r)}"/>' for cx, cy, r in layer.circles]
-        out += [f'<text x="{_f(x)}" y="{_f(flip(y))}" font-size="{_f(hh)}" font-family="monospace" fill="{col}" '
-                f'stroke="none">{escape(t)}</text>' for x, y, hh, t in layer.texts]
+        out += [
+            f'<text x="{_f(x)}" y="{_f(flip(y))}" font-size="{_f(hh)}" font-family="monospace" fill="{col}" '
+            f'stroke="none">{escape(t)}</text>'
+            for x, y, hh, t in layer.texts
+        ]
         out.append("</g>")
     out.append("</svg>\n")
     return "\n".join(out)

@@ -6,7 +6,8 @@ import math
 
 import numpy as np
 
-from .mpl import png_bytes, pyplot as _plt
+from .mpl import png_bytes
+from .mpl import pyplot as _plt
 
 __all__ = ["sweep_pngs", "histograms_png", "sensitivity_png", "surface_png"]
 
@@ -46,7 +47,9 @@ def histograms_png(spec, cols: dict, summ: dict) -> bytes:
                 hi = max(hi, *(x for x in lim if x is not None))
             if hi == lo:
                 hi, lo = hi + 0.5, lo - 0.5
-            ax.hist(v, bins=min(60, max(10, int(np.sqrt(v.size)))), range=(lo, hi), color="0.45", edgecolor="white", lw=0.3)
+            ax.hist(
+                v, bins=min(60, max(10, int(np.sqrt(v.size)))), range=(lo, hi), color="0.45", edgecolor="white", lw=0.3
+            )
         _limit_lines(ax, lim)
         title = f
         if lim is not None and summ["limits"].get(f, {}).get("fraction") is not None:
@@ -79,7 +82,10 @@ def sensitivity_png(spec, cols: dict, summ: dict) -> bytes:
     ok = cols["status"] == "ok"
     by_fail = any(r["failure"] is not None for r in rows)
     if by_fail:
-        fig_name = min(summ["limits"], key=lambda k: summ["limits"][k]["fraction"] if summ["limits"][k]["fraction"] is not None else 1.0)
+        fig_name = min(
+            summ["limits"],
+            key=lambda k: summ["limits"][k]["fraction"] if summ["limits"][k]["fraction"] is not None else 1.0,
+        )
     else:
         fig_name = next(iter(spec.limits or spec.record))
 
@@ -145,10 +151,19 @@ def surface_png(spec, summ: dict) -> bytes:
     shape = tuple(g["shape"])
     names, values = g["parameters"], g["values"]
     text_axis = [any(isinstance(v, str) for v in vs) for vs in values]
-    items = [(f, np.asarray(g["surfaces"][f]["mean"], float), np.asarray(g["surfaces"][f]["min"], float),
-              np.asarray(g["surfaces"][f]["max"], float)) for f in figs]
+    items = [
+        (
+            f,
+            np.asarray(g["surfaces"][f]["mean"], float),
+            np.asarray(g["surfaces"][f]["min"], float),
+            np.asarray(g["surfaces"][f]["max"], float),
+        )
+        for f in figs
+    ]
     if g["yield"]:
-        yv = np.asarray([np.nan if y["fraction"] is None else 100 * y["fraction"] for y in g["yield"]], float).reshape(shape)
+        yv = np.asarray([np.nan if y["fraction"] is None else 100 * y["fraction"] for y in g["yield"]], float).reshape(
+            shape
+        )
         items.append(("yield %", yv, yv, yv))
     for k, (f, mean, lo, hi) in enumerate(items):
         ax = axes[k // ncol][k % ncol]
@@ -156,8 +171,15 @@ def surface_png(spec, summ: dict) -> bytes:
             xs = np.arange(shape[0]) if text_axis[0] else np.asarray(values[0], float)
             if f == "yield %":
                 ci = np.asarray([y["ci"] for y in g["yield"]], float) * 100.0
-                ax.errorbar(xs, mean, yerr=[mean - ci[:, 0], ci[:, 1] - mean], fmt="o-", color="k", capsize=3,
-                            label=f"yield, {100 * summ['confidence']:.0f} % interval")
+                ax.errorbar(
+                    xs,
+                    mean,
+                    yerr=[mean - ci[:, 0], ci[:, 1] - mean],
+                    fmt="o-",
+                    color="k",
+                    capsize=3,
+                    label=f"yield, {100 * summ['confidence']:.0f} % interval",
+                )
                 ax.set_ylim(-3, 103)
             else:
                 ax.plot(xs, mean, "o-", color="k", label="mean over the draws")
@@ -175,13 +197,26 @@ def surface_png(spec, summ: dict) -> bytes:
             with np.errstate(invalid="ignore"):
                 m = np.nanmean(m, axis=2) if m.shape[2] > 1 else m[:, :, 0]
             is_yield = f == "yield %"
-            im = ax.imshow(m.T, origin="lower", aspect="auto", cmap="RdYlGn" if is_yield else "viridis",
-                           vmin=0.0 if is_yield else None, vmax=100.0 if is_yield else None)
+            im = ax.imshow(
+                m.T,
+                origin="lower",
+                aspect="auto",
+                cmap="RdYlGn" if is_yield else "viridis",
+                vmin=0.0 if is_yield else None,
+                vmax=100.0 if is_yield else None,
+            )
             for i in range(m.shape[0]):
                 for j in range(m.shape[1]):
                     if np.isfinite(m[i, j]):
-                        ax.text(i, j, f"{m[i, j]:.3g}", ha="center", va="center", fontsize=7,
-                                color="black" if is_yield or m[i, j] >= np.nanmean(m) else "white")
+                        ax.text(
+                            i,
+                            j,
+                            f"{m[i, j]:.3g}",
+                            ha="center",
+                            va="center",
+                            fontsize=7,
+                            color="black" if is_yield or m[i, j] >= np.nanmean(m) else "white",
+                        )
             ax.set_xticks(range(shape[0]), [str(v) for v in values[0]], fontsize=8)
             ax.set_yticks(range(shape[1]), [str(v) for v in values[1]], fontsize=8)
             ax.set_xlabel(names[0])

@@ -9,8 +9,8 @@ from xml.etree import ElementTree as ET
 
 import numpy as np
 
-from wgcad.errors import InputFileError
 from wgcad.atomic import atomic_write
+from wgcad.errors import InputFileError
 
 __all__ = ["threemf_bytes", "write_3mf", "read_3mf"]
 
@@ -34,8 +34,11 @@ ZIP_TIME = (1980, 1, 1, 0, 0, 0)
 
 
 def _model_xml(meshes: dict) -> str:
-    out = [f'<?xml version="1.0" encoding="UTF-8"?>\n<model unit="millimeter" xml:lang="en-US" xmlns="{NS}">',
-           '<metadata name="Application">wgcad</metadata>', "<resources>"]
+    out = [
+        f'<?xml version="1.0" encoding="UTF-8"?>\n<model unit="millimeter" xml:lang="en-US" xmlns="{NS}">',
+        '<metadata name="Application">wgcad</metadata>',
+        "<resources>",
+    ]
     for k, (name, mesh) in enumerate(meshes.items(), start=1):
         v = np.asarray(mesh.vertices, dtype=np.float64)
         f = np.asarray(mesh.faces, dtype=np.int64)
@@ -55,7 +58,11 @@ def threemf_bytes(meshes: dict) -> bytes:
     """The 3MF package of named meshes ``{name: trimesh.Trimesh}`` (mm), one object and one build item each."""
     buf = io.BytesIO()
     with zipfile.ZipFile(buf, "w", zipfile.ZIP_DEFLATED) as z:
-        for name, text in (("[Content_Types].xml", CONTENT_TYPES), ("_rels/.rels", RELS), ("3D/3dmodel.model", _model_xml(meshes))):
+        for name, text in (
+            ("[Content_Types].xml", CONTENT_TYPES),
+            ("_rels/.rels", RELS),
+            ("3D/3dmodel.model", _model_xml(meshes)),
+        ):
             info = zipfile.ZipInfo(name, date_time=ZIP_TIME)
             info.compress_type = zipfile.ZIP_DEFLATED
             z.writestr(info, text.encode("utf-8"))

@@ -35,9 +35,7 @@ __all__ = [
 # registry
 
 
-LAWS: dict[str, type[Law]] = {
-    cls.name: cls for cls in (Harmonic, Disc, FourForce, Ellipse, ExternalRing)
-}
+LAWS: dict[str, type[Law]] = {cls.name: cls for cls in (Harmonic, Disc, FourForce, Ellipse, ExternalRing)}
 
 
 def make_law(name, *, w0, r_m, n_waves=2, beta=None, offset=0.0) -> Law:
@@ -90,4 +88,3 @@ def make_law(name, *, w0, r_m, n_waves=2, beta=None, offset=0.0) -> Law:
     if name == "ellipse":
         return Ellipse(w0, r_m, off)
     return LAWS[name](w0, r_m, beta)
-

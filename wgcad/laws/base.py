@@ -94,9 +94,7 @@ def _check_w0_rm(w0, r_m) -> tuple[float, float]:
         raise DesignError("flexspline.rim_thickness", f"neutral-line radius r_m must be > 0 mm, got {r_m:g}")
     w0 = _real(w0, "generator.w0_coef", "W0 = w0_coef * module")
     if w0 <= 0.0:
-        raise DesignError(
-            "generator.w0_coef", f"W0 = w0_coef * module must be > 0 mm, got {w0:g} mm"
-        )
+        raise DesignError("generator.w0_coef", f"W0 = w0_coef * module must be > 0 mm, got {w0:g} mm")
     if w0 >= r_m / _W0_MAX_DIVISOR:
         raise DesignError(
             "generator.w0_coef",
@@ -112,9 +110,7 @@ def _check_beta(beta, law: str) -> float:
         raise DesignError("generator.beta_deg", f"is required by law '{law}'")
     beta = _real(beta, "generator.beta_deg", "beta")
     if not 0.0 < beta < _HALF_PI:
-        raise DesignError(
-            "generator.beta_deg", f"must be in (0, 90) degrees, got {math.degrees(beta):.10g}"
-        )
+        raise DesignError("generator.beta_deg", f"must be in (0, 90) degrees, got {math.degrees(beta):.10g}")
     return beta
 
 
@@ -173,7 +169,7 @@ class Law(abc.ABC):
     #: ellipse does not, its shape changes with the amplitude
     linear_in_w0: ClassVar[bool] = True
 
-    def with_w0(self, w0: float) -> "Law":
+    def with_w0(self, w0: float) -> Law:
         """The same law with another amplitude W0 (mm), e.g. for coning."""
         return replace(self, w0=w0)
 
@@ -200,5 +196,3 @@ class _TwoWaveLaw(Law):
         sgn = np.where(red < 0.0, -1.0, 1.0)
         w, dw, d2w, v, dv, th, dth = self._quarter(psi)
         return RimState(phi, w, sgn * dw, d2w, sgn * v, dv, sgn * th, dth)
-
-

@@ -2,10 +2,10 @@
 
 from __future__ import annotations
 
-
 import numpy as np
 
 from wgcad.errors import DesignError
+
 from .base import _real
 
 __all__ = ["coned_w0"]
@@ -46,9 +46,7 @@ def coned_w0(w0, z, *, length, z_h):
     """
     w0 = _real(w0, "generator.w0_coef", "W0 = w0_coef * module")
     if w0 <= 0.0:
-        raise DesignError(
-            "generator.w0_coef", f"W0 = w0_coef * module must be > 0 mm, got {w0:g} mm"
-        )
+        raise DesignError("generator.w0_coef", f"W0 = w0_coef * module must be > 0 mm, got {w0:g} mm")
     length = _real(length, "generator.cone_length", "length")
     z_h = _real(z_h, "generator.generator_z", "z_h")
     if length <= 0.0:

@@ -10,7 +10,8 @@ import numpy as np
 
 from wgcad.constants import NEWTON_TOL
 from wgcad.errors import DesignError, GeometryError
-from .base import _HALF_PI, _TwoWaveLaw, _check_w0_rm, _real
+
+from .base import _HALF_PI, _check_w0_rm, _real, _TwoWaveLaw
 
 __all__ = ["Ellipse", "ellipe", "ellipeinc"]
 
@@ -115,8 +116,15 @@ class Ellipse(_TwoWaveLaw):
                 "(it must exceed 4 x the semi-major axis)",
             )
         m = _solve_ellipe(quarter / a)
-        for k, val in (("w0", w0), ("r_m", r_m), ("offset", d), ("a", a),
-                       ("b", a * math.sqrt(1.0 - m)), ("_m", m), ("_E", float(ellipe(m)))):
+        for k, val in (
+            ("w0", w0),
+            ("r_m", r_m),
+            ("offset", d),
+            ("a", a),
+            ("b", a * math.sqrt(1.0 - m)),
+            ("_m", m),
+            ("_E", float(ellipe(m))),
+        ):
             object.__setattr__(self, k, val)
 
     def _arc(self, t):
@@ -160,5 +168,3 @@ class Ellipse(_TwoWaveLaw):
         dv = -2.0 * r * np.sin(0.5 * theta) ** 2 - w  # r_m (cos(theta) - 1) - w
         d2w = dv - r * np.cos(theta) * dtheta
         return w, dw, d2w, v, dv, theta, dtheta
-
-

@@ -9,6 +9,7 @@ from typing import ClassVar
 import numpy as np
 
 from wgcad.errors import DesignError
+
 from .base import Law, RimState, _check_w0_rm
 
 __all__ = ["Harmonic"]
@@ -67,5 +68,3 @@ class Harmonic(Law):
             theta=(w0 / r) * (n - 1.0 / n) * s,
             dtheta=(w0 / r) * (n * n - 1.0) * c,
         )
-
-

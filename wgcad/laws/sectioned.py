@@ -9,7 +9,8 @@ from typing import ClassVar
 import numpy as np
 
 from wgcad.errors import DesignError
-from .base import _HALF_PI, RimState, _TwoWaveLaw, _check_beta, _check_w0_rm
+
+from .base import _HALF_PI, RimState, _check_beta, _check_w0_rm, _TwoWaveLaw
 
 __all__ = ["Disc", "ExternalRing", "FourForce"]
 
@@ -37,7 +38,6 @@ def _ff_band_edge() -> float:
 #: are mirror images by a quarter turn) and |D| >= 0.258.
 _FF_BETA_LO = _ff_band_edge()
 _FF_BETA_HI = _HALF_PI - _FF_BETA_LO
-
 
 
 # --------------------------------------------------------------------------
@@ -106,8 +106,7 @@ class _DiscShape(_SectionedLaw):
         A = _HALF_PI - sb * cb - beta
         B = -2.0 * sb + (4.0 * beta / math.pi) * sb + (4.0 / math.pi) * cb
         C = (4.0 / math.pi) * (beta * sb + cb)  # = B + 2 sin(beta)
-        for k, val in (("w0", w0), ("r_m", r_m), ("beta", beta), ("_A", A), ("_B", B),
-                       ("_C", C), ("_K", w0 / (A - B))):
+        for k, val in (("w0", w0), ("r_m", r_m), ("beta", beta), ("_A", A), ("_B", B), ("_C", C), ("_K", w0 / (A - B))):
             object.__setattr__(self, k, val)
 
     def _sections(self, phi):
@@ -138,7 +137,6 @@ class _DiscShape(_SectionedLaw):
             (K / r) * (C - 2.0 * s),
         )
         return sec1, sec2
-
 
 
 @dataclass(frozen=True)
@@ -272,5 +270,3 @@ class FourForce(_SectionedLaw):
             return (w, dw, d2w, v, -w, (v - dw) / r, (-w - d2w) / r)
 
         return full(w1, dw1, d2w1, v1), full(w2, dw2, d2w2, v2)
-
-

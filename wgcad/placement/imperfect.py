@@ -86,21 +86,29 @@ class Imperfections:
     flex_install: float = 0.0
 
     @classmethod
-    def from_spec(cls, spec) -> "Imperfections":
+    def from_spec(cls, spec) -> Imperfections:
         """From the design table (um, deg) to mm, rad."""
         s = spec
         return cls(
-            1e-3 * s.flex_runout_um, radians(s.flex_runout_phase_deg),
-            1e-3 * s.rigid_runout_um, radians(s.rigid_runout_phase_deg),
-            1e-3 * s.flex_eccentricity_um, radians(s.flex_eccentricity_phase_deg),
-            1e-3 * s.rigid_eccentricity_um, radians(s.rigid_eccentricity_phase_deg),
-            1e-3 * s.cam_offset_cam_um, radians(s.cam_offset_cam_phase_deg),
-            1e-3 * s.cam_offset_flex_um, radians(s.cam_offset_flex_phase_deg),
-            1e-3 * s.cam_offset_fixed_um, radians(s.cam_offset_fixed_phase_deg),
-            radians(s.rigid_install_angle_deg), radians(s.flex_install_angle_deg),
+            1e-3 * s.flex_runout_um,
+            radians(s.flex_runout_phase_deg),
+            1e-3 * s.rigid_runout_um,
+            radians(s.rigid_runout_phase_deg),
+            1e-3 * s.flex_eccentricity_um,
+            radians(s.flex_eccentricity_phase_deg),
+            1e-3 * s.rigid_eccentricity_um,
+            radians(s.rigid_eccentricity_phase_deg),
+            1e-3 * s.cam_offset_cam_um,
+            radians(s.cam_offset_cam_phase_deg),
+            1e-3 * s.cam_offset_flex_um,
+            radians(s.cam_offset_flex_phase_deg),
+            1e-3 * s.cam_offset_fixed_um,
+            radians(s.cam_offset_fixed_phase_deg),
+            radians(s.rigid_install_angle_deg),
+            radians(s.flex_install_angle_deg),
         )
 
-    def replace(self, **changes) -> "Imperfections":
+    def replace(self, **changes) -> Imperfections:
         from dataclasses import replace
 
         return replace(self, **changes)
@@ -137,9 +145,13 @@ def shortcuts(imp: Imperfections) -> dict:
         # without them a generator turn later every tooth meets what its neighbour met (the perfect
         # teeth are alike), so one turn holds every state
         "one_generator_turn": bool(not flex_borne),
-        "why": ("no errors" if perfect else
-                "only the cam-borne offset: constant in the generator frame" if cam_only else
-                "gear run-out/eccentricity or a flexspline-borne/stationary cam offset: the full cycle is needed"),
+        "why": (
+            "no errors"
+            if perfect
+            else "only the cam-borne offset: constant in the generator frame"
+            if cam_only
+            else "gear run-out/eccentricity or a flexspline-borne/stationary cam offset: the full cycle is needed"
+        ),
     }
 
 
@@ -194,9 +206,11 @@ def cam_offset(imp: Imperfections, phi_h, phi_g, parts=("cam", "flex", "fixed"))
     phi_g = np.asarray(phi_g, dtype=float)
     x = np.zeros(np.broadcast(phi_h, phi_g).shape)
     y = np.zeros_like(x)
-    for name, amp, ang in (("cam", imp.cam_cam, imp.cam_cam_phase + phi_h),
-                           ("flex", imp.cam_flex, imp.cam_flex_phase + phi_g),
-                           ("fixed", imp.cam_fixed, imp.cam_fixed_phase + 0.0 * phi_h)):
+    for name, amp, ang in (
+        ("cam", imp.cam_cam, imp.cam_cam_phase + phi_h),
+        ("flex", imp.cam_flex, imp.cam_flex_phase + phi_g),
+        ("fixed", imp.cam_fixed, imp.cam_fixed_phase + 0.0 * phi_h),
+    ):
         if name in parts and amp != 0.0:
             x = x + amp * np.cos(ang)
             y = y + amp * np.sin(ang)

@@ -7,8 +7,8 @@ from math import pi
 import numpy as np
 
 from .. import constants
-from ..laws import Law
 from ..kinematics import flex_rotation
+from ..laws import Law
 
 __all__ = [
     "tooth_angles",
@@ -157,7 +157,9 @@ def place_points_first_order(local: np.ndarray, law: Law, phi, r_m: float, centr
     return np.stack([x * c - y * s, x * s + y * c], axis=-1)
 
 
-def place_flex_teeth(drive, phi_h: float, local: np.ndarray | None = None, teeth=None, z: float | None = None) -> np.ndarray:
+def place_flex_teeth(
+    drive, phi_h: float, local: np.ndarray | None = None, teeth=None, z: float | None = None
+) -> np.ndarray:
     """Deformed flexspline teeth in the rigid-gear frame at generator angle ``phi_h``.
 
     Parameters

@@ -196,9 +196,14 @@ def make_gear(sp: ToothSpec, tol: float = constants.CHORD_TOL) -> Gear:
     r = sp.module * sp.z / 2.0
     r_a, r_f = _radii(sp)
     if sp.internal and not r_a < r_f:
-        raise DesignError(f"{f}.tip_radius", f"tip radius {r_a:.4f} mm must be inside the root radius {r_f:.4f} mm for internal teeth")
+        raise DesignError(
+            f"{f}.tip_radius", f"tip radius {r_a:.4f} mm must be inside the root radius {r_f:.4f} mm for internal teeth"
+        )
     if not sp.internal and not r_a > r_f:
-        raise DesignError(f"{f}.tip_radius", f"tip radius {r_a:.4f} mm must be outside the root radius {r_f:.4f} mm for external teeth")
+        raise DesignError(
+            f"{f}.tip_radius",
+            f"tip radius {r_a:.4f} mm must be outside the root radius {r_f:.4f} mm for external teeth",
+        )
     if r_f <= 0 or r_a <= 0:
         raise DesignError(f"{f}.root_radius", f"radii must be positive (tip {r_a:.4f} mm, root {r_f:.4f} mm)")
     # the field that sets the tip and how to blunt it: cycloidal teeth have no shift, c* truncates them (docs/models.md 2.2)
@@ -325,11 +330,16 @@ def _involute_half_period(sp: ToothSpec, r, r_a, r_f, tol, tip_field):
         # undercut by a standard rack: x < h_a* - z sin^2(alpha)/2
         x_min = sp.addendum_coef - sp.z * np.sin(sp.alpha) ** 2 / 2.0
         if sp.shift < x_min - 1e-12:
-            raise DesignError(f"{f}.shift", f"undercut: shift {sp.shift:g} is below the minimum {x_min:.4f} = h_a* - z sin^2(alpha)/2 for rack generation")
+            raise DesignError(
+                f"{f}.shift",
+                f"undercut: shift {sp.shift:g} is below the minimum {x_min:.4f} = h_a* - z sin^2(alpha)/2 for rack generation",
+            )
         psi_a = float(iv.half_angle_at(base, r_b, r_a)) if r_a >= r_b else base
         tip_thk = 2.0 * r_a * psi_a
         if r_a <= r_b:
-            raise DesignError(tip_field, f"tip radius {r_a:.4f} mm is inside the base circle {r_b:.4f} mm: no involute flank")
+            raise DesignError(
+                tip_field, f"tip radius {r_a:.4f} mm is inside the base circle {r_b:.4f} mm: no involute flank"
+            )
         t_a = np.sqrt((r_a / r_b) ** 2 - 1.0)
         flank = lambda t: iv.involute_flank(base, r_b, t)  # noqa: E731
         tip = arc_points((0.0, 0.0), r_a, 0.0, psi_a, tol)
@@ -361,7 +371,9 @@ def _involute_half_period(sp: ToothSpec, r, r_a, r_f, tol, tip_field):
                 hp += [pc.involute(base, r_b, t_a, 0.0), pc.line(fl[-2], fl[-1])]
             root0 = float(np.arctan2(fl[-1, 1], fl[-1, 0]))
             if root0 >= gamma2:
-                raise DesignError(f"{f}.root_radius", "teeth overlap at the root circle: the space closes before the root")
+                raise DesignError(
+                    f"{f}.root_radius", "teeth overlap at the root circle: the space closes before the root"
+                )
             pieces = [tip, fl[1:]]
         root = arc_points((0.0, 0.0), r_f, root0, gamma2, tol)
         hp.append(pc.arc((0.0, 0.0), r_f, root0, gamma2))
@@ -369,7 +381,10 @@ def _involute_half_period(sp: ToothSpec, r, r_a, r_f, tol, tip_field):
     # internal gear: work on the space (centred on angle 0 in its own frame),
     # then map to the tooth frame by a -> gamma/2 - a
     if r_a <= r_b:
-        raise DesignError(tip_field, f"tip radius {r_a:.4f} mm of the internal teeth is inside the base circle {r_b:.4f} mm: no involute flank")
+        raise DesignError(
+            tip_field,
+            f"tip radius {r_a:.4f} mm of the internal teeth is inside the base circle {r_b:.4f} mm: no involute flank",
+        )
     sig_a = float(iv.half_angle_at(base, r_b, r_a))
     tip_thk = 2.0 * r_a * (gamma2 - sig_a)
     t_a = np.sqrt((r_a / r_b) ** 2 - 1.0)
@@ -419,8 +434,11 @@ def _cycloid_half_period(sp: ToothSpec, r, r_a, r_f, tol, tip_field, fix):
     for name, where, val in (("tip", tip_field, r_a), ("root", f"{f}.root_radius", r_f)):
         a, b = reach[name]
         if not a - 1e-12 <= val <= b + 1e-12:
-            raise DesignError(where, f"{name} radius {val:.4f} mm must lie in [{a:.4f}, {b:.4f}] mm, between the pitch "
-                                     "circle and the cycloid's reach (pitch radius +- m/2)")
+            raise DesignError(
+                where,
+                f"{name} radius {val:.4f} mm must lie in [{a:.4f}, {b:.4f}] mm, between the pitch "
+                "circle and the cycloid's reach (pitch radius +- m/2)",
+            )
     curve_a = cy.epicycloid if add_epi else cy.hypocycloid
     curve_d = cy.hypocycloid if add_epi else cy.epicycloid
     phi_a = float(cy.roll_angle_at_radius(r, rho, r_a, add_epi))
@@ -439,8 +457,10 @@ def _cycloid_half_period(sp: ToothSpec, r, r_a, r_f, tol, tip_field, fix):
     if root0 > gamma2 * (1 + 1e-9):
         raise DesignError(f"{f}.thinning", "negative thinning closes the space at the root")
     root = arc_points((0.0, 0.0), r_f, root0, gamma2, tol)
-    hp = [pc.arc((0.0, 0.0), r_a, 0.0, psi_a),
-          pc.cycloid("epicycloid" if add_epi else "hypocycloid", r, rho, phi_a, 0.0, rot=q, flip=-1.0),
-          pc.cycloid("hypocycloid" if add_epi else "epicycloid", r, rho, 0.0, phi_f, rot=q),
-          pc.arc((0.0, 0.0), r_f, root0, gamma2)]
+    hp = [
+        pc.arc((0.0, 0.0), r_a, 0.0, psi_a),
+        pc.cycloid("epicycloid" if add_epi else "hypocycloid", r, rho, phi_a, 0.0, rot=q, flip=-1.0),
+        pc.cycloid("hypocycloid" if add_epi else "epicycloid", r, rho, 0.0, phi_f, rot=q),
+        pc.arc((0.0, 0.0), r_f, root0, gamma2),
+    ]
     return _join(tip, a_pts[1:], d_pts[1:], root[1:]), tip_thk, None, hp

@@ -169,8 +169,13 @@ def _span(gear: Gear) -> dict | None:
             return {"k": None, "note": "no number of teeth puts the jaws on the flanks"}
         k0 = min(near, key=lambda k: abs(contact(k)[1] - mid))
     w, rc = contact(k0)
-    return {"k": k0, "w_k_mm": w, "contact_diameter_mm": 2.0 * rc, "k_rule": rule,
-            "method": "closed form (involute)" if closed else "numerical (sampled cycloidal outline)"}
+    return {
+        "k": k0,
+        "w_k_mm": w,
+        "contact_diameter_mm": 2.0 * rc,
+        "k_rule": rule,
+        "method": "closed form (involute)" if closed else "numerical (sampled cycloidal outline)",
+    }
 
 
 # ----------------------------------------------------------------------------- pins
@@ -301,7 +306,9 @@ def _pins(gear: Gear, d_pin: float | None) -> dict:
     proud, clear = fits(d_pin)
     out = {
         "pin_diameter_mm": d_pin,
-        "pin_diameter_source": "design" if chosen else "contact nearest mid-flank with the pin standing out of the teeth, 1 um steps",
+        "pin_diameter_source": "design"
+        if chosen
+        else "contact nearest mid-flank with the pin standing out of the teeth, 1 um steps",
         "between_pins_mm" if sp.internal else "over_pins_mm": res["dimension_mm"],
         "pin_centre_diameter_mm": 2.0 * R_m,
         "pin_stands_out_of_the_teeth": bool(proud),
@@ -348,7 +355,10 @@ def workshop_figures(gear: Gear, measure_diameter: float | None = None, pin_diam
     if lo <= mid_r <= hi:
         out["mid_depth"] = thickness_at(gear, mid_r)
     else:  # mid-depth in the fillet: the middle of the flank instead
-        out["mid_depth"] = {**thickness_at(gear, 0.5 * (lo + hi)), "note": "mid-depth lies on the fillet: middle of the flank"}
+        out["mid_depth"] = {
+            **thickness_at(gear, 0.5 * (lo + hi)),
+            "note": "mid-depth lies on the fillet: middle of the flank",
+        }
     if measure_diameter is not None:
         out["at_chosen_diameter"] = thickness_at(gear, 0.5 * measure_diameter)
     out["span"] = _span(gear)

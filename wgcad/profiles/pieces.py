@@ -126,11 +126,11 @@ class Piece:
         return float(abs(h) * np.dot(w, np.hypot(d[:, 0], d[:, 1])))
 
     # -- transforms ----------------------------------------------------------------
-    def reversed(self) -> "Piece":
+    def reversed(self) -> Piece:
         """The same curve run the other way."""
         return Piece(self.kind, self.t1, self.t0, self.params, self.rot, self.flip)
 
-    def mirrored(self) -> "Piece":
+    def mirrored(self) -> Piece:
         """Mirror image about the x axis (``y -> -y``), same direction of travel along the image."""
         if self.kind == "arc":
             cx, cy, R = self.params
@@ -141,7 +141,7 @@ class Piece:
         # diag(1,-1) R(a) = R(-a) diag(1,-1)
         return Piece(self.kind, self.t0, self.t1, self.params, -self.rot, -self.flip)
 
-    def rotated(self, angle: float) -> "Piece":
+    def rotated(self, angle: float) -> Piece:
         """Turned by ``angle`` (rad, counter-clockwise) about the origin."""
         if self.kind == "arc":
             cx, cy, R = self.params

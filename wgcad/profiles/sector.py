@@ -90,9 +90,17 @@ def sector_layout(spec: SectorsSpec, z_flex: int, z_rigid: int) -> SectorLayout:
         bounds.append(a)
     c = np.concatenate(centres)
     nxt = np.append(c[1:], c[0] + 2.0 * pi)
-    out = SectorLayout(c, np.concatenate(sector), np.concatenate(index), np.concatenate(coupling),
-                       np.concatenate(pitch), np.concatenate(delta), np.array(bounds), tuple(spec.kinds),
-                       0.5 * (c + nxt))
+    out = SectorLayout(
+        c,
+        np.concatenate(sector),
+        np.concatenate(index),
+        np.concatenate(coupling),
+        np.concatenate(pitch),
+        np.concatenate(delta),
+        np.array(bounds),
+        tuple(spec.kinds),
+        0.5 * (c + nxt),
+    )
     for name in ("centres", "sector", "index", "coupling", "pitch", "delta", "bounds", "spaces"):
         getattr(out, name).setflags(write=False)
     return out
@@ -203,8 +211,10 @@ def sectored_outline(layout: SectorLayout, teeth: TeethByHeight, heights: np.nda
     r_f = teeth.full.r_f
     m = teeth.base.module
     keep = np.nonzero(np.asarray(heights) >= MIN_HEIGHT_COEF * m)[0]
-    cores = [(layout.centres[i], _core_band(teeth.gear(heights[i]), teeth.tol) if band else _core(teeth.gear(heights[i])))
-             for i in keep]
+    cores = [
+        (layout.centres[i], _core_band(teeth.gear(heights[i]), teeth.tol) if band else _core(teeth.gear(heights[i])))
+        for i in keep
+    ]
     pieces = []
     for j, (c, core) in enumerate(cores):
         pts = rotate(core, c)
@@ -215,8 +225,15 @@ def sectored_outline(layout: SectorLayout, teeth: TeethByHeight, heights: np.nda
         if j == len(cores) - 1:
             a1 += 2.0 * pi
         if not a1 > a0:
-            raise DesignError("sectors.pitch_z", f"teeth at {np.rad2deg(c):.3f} and {np.rad2deg(c_next):.3f} deg overlap at the root circle")
-        arc = band_points(pc.arc((0.0, 0.0), r_f, a0, a1), teeth.tol) if band else arc_points((0.0, 0.0), r_f, a0, a1, teeth.tol)
+            raise DesignError(
+                "sectors.pitch_z",
+                f"teeth at {np.rad2deg(c):.3f} and {np.rad2deg(c_next):.3f} deg overlap at the root circle",
+            )
+        arc = (
+            band_points(pc.arc((0.0, 0.0), r_f, a0, a1), teeth.tol)
+            if band
+            else arc_points((0.0, 0.0), r_f, a0, a1, teeth.tol)
+        )
         pieces.append(arc[1:-1])
     out = np.concatenate(pieces)
     keep_pt = np.ones(len(out), dtype=bool)
@@ -226,7 +243,9 @@ def sectored_outline(layout: SectorLayout, teeth: TeethByHeight, heights: np.nda
     return out
 
 
-def sectored_gear_outline(layout: SectorLayout, teeth: TeethByHeight, coupling_heights: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+def sectored_gear_outline(
+    layout: SectorLayout, teeth: TeethByHeight, coupling_heights: np.ndarray
+) -> tuple[np.ndarray, np.ndarray]:
     """Heights of every tooth (coupling teeth from ``coupling_heights`` per sector position, the rest full) and the outline.
 
     Returns

@@ -30,11 +30,13 @@ def worst_json(f) -> dict:
     }
     if "rigid_tooth" in f.details:
         out["rigid_tooth"] = int(f.details["rigid_tooth"])
-    out.update({
-        "overlap_area_um2": round(1e6 * f.details["overlap_area"], 4),
-        "polygon_clearance_um": None if f.polygon_value is None else round(1e3 * f.polygon_value, 4),
-        "method": f.method,
-    })
+    out.update(
+        {
+            "overlap_area_um2": round(1e6 * f.details["overlap_area"], 4),
+            "polygon_clearance_um": None if f.polygon_value is None else round(1e3 * f.polygon_value, 4),
+            "method": f.method,
+        }
+    )
     return out
 
 
@@ -55,27 +57,44 @@ def entry_json(gap, crossing, pinch, side: str) -> dict:
         "crossing_edge": crossing.details.get("edge"),
     }
     if np.isfinite(pinch.value):
-        out.update({
-            "pinch_um": round(1e3 * pinch.value, 4),
-            "pinch_tooth_angle_deg": _deg(pinch.tooth_angle),
-            "pinch_section_z_mm": _z(pinch.section_z),
-            "pinch_location": pinch.location,
-            "pinch_edge": pinch.details.get("edge"),
-        })
+        out.update(
+            {
+                "pinch_um": round(1e3 * pinch.value, 4),
+                "pinch_tooth_angle_deg": _deg(pinch.tooth_angle),
+                "pinch_section_z_mm": _z(pinch.section_z),
+                "pinch_location": pinch.location,
+                "pinch_edge": pinch.details.get("edge"),
+            }
+        )
     else:
-        out.update({"pinch_um": None, "pinch_tooth_angle_deg": None, "pinch_section_z_mm": None,
-                    "pinch_location": None, "pinch_edge": None})
-    out["tip_to_tip_risk"] = bool(gap.details.get("tip_to_tip_risk", False) or pinch.details.get("tip_to_tip_risk", False))
+        out.update(
+            {
+                "pinch_um": None,
+                "pinch_tooth_angle_deg": None,
+                "pinch_section_z_mm": None,
+                "pinch_location": None,
+                "pinch_edge": None,
+            }
+        )
+    out["tip_to_tip_risk"] = bool(
+        gap.details.get("tip_to_tip_risk", False) or pinch.details.get("tip_to_tip_risk", False)
+    )
     if "passages" in gap.details and isinstance(gap.details["passages"], list):
-        out["sections"] = [{
-            "section_z_mm": _z(p["section_z"]),
-            "entry_gap_um": round(1e3 * p["delta"], 4) if np.isfinite(p["delta"]) else None,
-            "tooth_angle_deg": _deg(p["delta_phi"]) if np.isfinite(p["delta"]) else None,
-            "edge": p["edge"] or None, "kind": p["kind"] or None,
-            "crossing_tooth_angle_deg": _deg(p["crossing"]) if np.isfinite(p["crossing"]) else None,
-            "crossing_working_um": round(1e3 * p["crossing_gaps"][0], 4) if np.isfinite(p["crossing"]) else None,
-            "crossing_non_working_um": round(1e3 * p["crossing_gaps"][1], 4) if np.isfinite(p["crossing"]) else None,
-        } for p in gap.details["passages"]]
+        out["sections"] = [
+            {
+                "section_z_mm": _z(p["section_z"]),
+                "entry_gap_um": round(1e3 * p["delta"], 4) if np.isfinite(p["delta"]) else None,
+                "tooth_angle_deg": _deg(p["delta_phi"]) if np.isfinite(p["delta"]) else None,
+                "edge": p["edge"] or None,
+                "kind": p["kind"] or None,
+                "crossing_tooth_angle_deg": _deg(p["crossing"]) if np.isfinite(p["crossing"]) else None,
+                "crossing_working_um": round(1e3 * p["crossing_gaps"][0], 4) if np.isfinite(p["crossing"]) else None,
+                "crossing_non_working_um": round(1e3 * p["crossing_gaps"][1], 4)
+                if np.isfinite(p["crossing"])
+                else None,
+            }
+            for p in gap.details["passages"]
+        ]
     if gap.details.get("note"):
         out["note"] = gap.details["note"]
     if crossing.tooth is not None:  # an imperfect drive: the passage the figures happen in
@@ -136,8 +155,10 @@ def audit_summary(name: str, res: dict) -> str:
     lines = [f"{name}: clearance audit ({st['engine']} engine)"]
     lines.append(f"  minimum clearance: {res['min_clearance_um']:.3f} um, {_spot(w)}")
     if res["interference"]:
-        lines.append(f"  INTERFERENCE: penetration {-res['min_clearance_um']:.3f} um deeper than the tolerance "
-                     f"{res['interference_tol_um']:g} um (overlap area {w['overlap_area_um2']:.1f} um^2)")
+        lines.append(
+            f"  INTERFERENCE: penetration {-res['min_clearance_um']:.3f} um deeper than the tolerance "
+            f"{res['interference_tol_um']:g} um (overlap area {w['overlap_area_um2']:.1f} um^2)"
+        )
     elif res["min_clearance_um"] < res["interference_tol_um"]:
         lines.append(f"  contact within the tolerance ({res['interference_tol_um']:g} um): no interference")
     else:
@@ -147,59 +168,95 @@ def audit_summary(name: str, res: dict) -> str:
         sh = st["shortcuts_that_hold"]
         held = [k.replace("_", " ") for k, v in sh.items() if v and k != "one_generator_turn"]
         turns = st.get("generator_turns", 1.0)
-        cyc = (f"{turns:g} generator turn{'s' if turns != 1 else ''} of the {st['full_cycle_turns']}-turn cycle swept"
-               if st.get("full_cycle_turns") else "")
+        cyc = (
+            f"{turns:g} generator turn{'s' if turns != 1 else ''} of the {st['full_cycle_turns']}-turn cycle swept"
+            if st.get("full_cycle_turns")
+            else ""
+        )
         if sh.get("one_generator_turn") and cyc:
             cyc += " (no flexspline-borne errors: one turn holds every state)"
-        lines.append("  imperfect parts ([imperfections]): every tooth posed with its errors" + (f", {cyc}" if cyc else "")
-                     + "; shortcuts that still hold: " + (", ".join(held) if held else "none") + " (none used)")
+        lines.append(
+            "  imperfect parts ([imperfections]): every tooth posed with its errors"
+            + (f", {cyc}" if cyc else "")
+            + "; shortcuts that still hold: "
+            + (", ".join(held) if held else "none")
+            + " (none used)"
+        )
     if e.get("note"):
         pass  # not computed (imperfect parts): the caller's NOT CHECKED lines say so
     elif res["entry_gap_um"] is not None:
         sec = "" if e["section_z_mm"] is None else f", section z = {e['section_z_mm']:g} mm"
-        what = ("the pinch where the tips pass each other" if e["kind"] == "pinch" else "at the tip crossing (no pinch: the smallest gap of the entry)")
-        lines.append(f"  entry gap Delta [S1]: {res['entry_gap_um']:.3f} um by the {e['edge']} edge ({e['location']}) at tooth angle "
-                     f"{e['tooth_angle_deg']:+.3f} deg{sec}, {what}"
-                     + ("  TIP-TO-TIP RISK" if e["tip_to_tip_risk"] else ""))
+        what = (
+            "the pinch where the tips pass each other"
+            if e["kind"] == "pinch"
+            else "at the tip crossing (no pinch: the smallest gap of the entry)"
+        )
+        lines.append(
+            f"  entry gap Delta [S1]: {res['entry_gap_um']:.3f} um by the {e['edge']} edge ({e['location']}) at tooth angle "
+            f"{e['tooth_angle_deg']:+.3f} deg{sec}, {what}" + ("  TIP-TO-TIP RISK" if e["tip_to_tip_risk"] else "")
+        )
         csec = "" if e["crossing_section_z_mm"] is None else f", section z = {e['crossing_section_z_mm']:g} mm"
-        lines.append(f"  tip crossing: {e['crossing_um']:.3f} um by the {e['crossing_edge']} edge at tooth angle "
-                     f"{e['crossing_tooth_angle_deg']:+.3f} deg{csec} (flexspline tip circle meeting the rigid tip circle)"
-                     + (f"; tooth {e['tooth']} at generator angle {e['generator_angle_deg']:.3f} deg, the smallest of "
-                        f"{e['passages']} passages (they spread over {e['spread_um']:.3f} um)" if "tooth" in e else ""))
+        lines.append(
+            f"  tip crossing: {e['crossing_um']:.3f} um by the {e['crossing_edge']} edge at tooth angle "
+            f"{e['crossing_tooth_angle_deg']:+.3f} deg{csec} (flexspline tip circle meeting the rigid tip circle)"
+            + (
+                f"; tooth {e['tooth']} at generator angle {e['generator_angle_deg']:.3f} deg, the smallest of "
+                f"{e['passages']} passages (they spread over {e['spread_um']:.3f} um)"
+                if "tooth" in e
+                else ""
+            )
+        )
         if e["pinch_um"] is None:
-            lines.append("  entry pinch: none (after the crossing the gaps never dip and rise again before the flanks engage)")
+            lines.append(
+                "  entry pinch: none (after the crossing the gaps never dip and rise again before the flanks engage)"
+            )
         else:
             psec = "" if e["pinch_section_z_mm"] is None else f", section z = {e['pinch_section_z_mm']:g} mm"
-            lines.append(f"  entry pinch: {e['pinch_um']:.3f} um by the {e['pinch_edge']} edge at tooth angle "
-                         f"{e['pinch_tooth_angle_deg']:+.3f} deg{psec}, {e['pinch_location']}"
-                         + (f"; tooth {e['pinch_tooth']} at generator angle {e['pinch_generator_angle_deg']:.3f} deg"
-                            if "pinch_tooth" in e else ""))
+            lines.append(
+                f"  entry pinch: {e['pinch_um']:.3f} um by the {e['pinch_edge']} edge at tooth angle "
+                f"{e['pinch_tooth_angle_deg']:+.3f} deg{psec}, {e['pinch_location']}"
+                + (
+                    f"; tooth {e['pinch_tooth']} at generator angle {e['pinch_generator_angle_deg']:.3f} deg"
+                    if "pinch_tooth" in e
+                    else ""
+                )
+            )
     else:
         lines.append("  entry gap: none (the tips never cross the rigid tip circle)")
     b = res["backlash_at"]
     if res["backlash_arcmin"] is None:
         if res.get("backlash_unbounded"):
-            lines.append(f"  backlash: unbounded (no flexspline tooth engages at generator angle {b['generator_angle_deg']:g} deg)")
+            lines.append(
+                f"  backlash: unbounded (no flexspline tooth engages at generator angle {b['generator_angle_deg']:g} deg)"
+            )
         elif res["interference"]:
             lines.append(f"  backlash: none, teeth interfere at generator angle {b['generator_angle_deg']:g} deg")
         else:
             lines.append(f"  backlash: none (the teeth touch at generator angle {b['generator_angle_deg']:g} deg)")
     else:
-        lines.append(f"  backlash: {res['backlash_arcmin']:.4f} arcmin = {res['backlash_um_at_pitch']:.2f} um at the rigid pitch circle "
-                     f"(generator angle {b['generator_angle_deg']:g} deg)")
+        lines.append(
+            f"  backlash: {res['backlash_arcmin']:.4f} arcmin = {res['backlash_um_at_pitch']:.2f} um at the rigid pitch circle "
+            f"(generator angle {b['generator_angle_deg']:g} deg)"
+        )
     if st.get("refined"):
-        lines.append(f"  figures refined on the exact tooth curves (to {st['refine_tol_um']:g} um either side; "
-                     f"outlines at {st['chord_tol_um']:g} um chords find where)")
+        lines.append(
+            f"  figures refined on the exact tooth curves (to {st['refine_tol_um']:g} um either side; "
+            f"outlines at {st['chord_tol_um']:g} um chords find where)"
+        )
     else:
         lines.append(f"  polygon figures: within 2 x {st['chord_tol_um']:g} um of the exact curves' (either side)")
     if st.get("face_ends_checked") is False:
         lines.append(f"  WARNING: coned flexspline, sections {st['sections_z_mm']} mm: the face ends were not checked")
     c = res["counts"]
     if "perfect_evaluated" in c:
-        lines.append(f"  computed {c['evaluated']} of {c['samples']} tooth samples on polygons, {c.get('refined', 0)} on the exact curves "
-                     f"({c['culled']} ruled out by the perfect drive's bounds less the errors' reach, {c['perfect_evaluated']} "
-                     f"perfect-drive tooth angles evaluated for them) in {res['elapsed_s']:.3f} s")
+        lines.append(
+            f"  computed {c['evaluated']} of {c['samples']} tooth samples on polygons, {c.get('refined', 0)} on the exact curves "
+            f"({c['culled']} ruled out by the perfect drive's bounds less the errors' reach, {c['perfect_evaluated']} "
+            f"perfect-drive tooth angles evaluated for them) in {res['elapsed_s']:.3f} s"
+        )
     else:
-        lines.append(f"  computed {c['evaluated']} of {c['samples']} tooth samples on polygons, {c.get('refined', 0)} on the exact curves "
-                     f"({c['unique_tooth_angles']} distinct tooth angles, {c['culled']} culled by radius) in {res['elapsed_s']:.3f} s")
+        lines.append(
+            f"  computed {c['evaluated']} of {c['samples']} tooth samples on polygons, {c.get('refined', 0)} on the exact curves "
+            f"({c['unique_tooth_angles']} distinct tooth angles, {c['culled']} culled by radius) in {res['elapsed_s']:.3f} s"
+        )
     return "\n".join(lines)

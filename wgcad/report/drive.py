@@ -7,8 +7,8 @@ from math import pi
 import numpy as np
 
 from .. import __version__
-from ..kinematics import gear_ratios
 from ..errors import DesignError
+from ..kinematics import gear_ratios
 from ..placement import place_points, place_points_first_order, tooth_angles
 from ..profiles import cycloid as cy
 from ..profiles import measure
@@ -54,18 +54,24 @@ def workshop(gear, gs=None) -> dict:
     if dm is not None:
         lo, hi = measure.flank_zone(gear)
         if not 2 * lo <= dm <= 2 * hi:
-            raise DesignError(f"{which}.measure_diameter", f"{dm:g} mm is off the flanks, which run from "
-                                                           f"{2 * lo:.4f} to {2 * hi:.4f} mm in diameter")
+            raise DesignError(
+                f"{which}.measure_diameter",
+                f"{dm:g} mm is off the flanks, which run from {2 * lo:.4f} to {2 * hi:.4f} mm in diameter",
+            )
     try:
         w = measure.workshop_figures(gear, dm, dp)
     except ArithmeticError:
         if dp is None:
             raise
-        raise DesignError(f"{which}.pin_diameter", f"a pin of {dp:g} mm does not touch both flanks of a space") from None
+        raise DesignError(
+            f"{which}.pin_diameter", f"a pin of {dp:g} mm does not touch both flanks of a space"
+        ) from None
     p = w["pins"]
     if dp is not None and not (p["pin_stands_out_of_the_teeth"] and p["pin_clear_of_the_root"]):
         why = "does not stand out of the teeth" if not p["pin_stands_out_of_the_teeth"] else "touches the root"
-        raise DesignError(f"{which}.pin_diameter", f"a pin of {dp:g} mm {why}; choose another (or omit it for the default)")
+        raise DesignError(
+            f"{which}.pin_diameter", f"a pin of {dp:g} mm {why}; choose another (or omit it for the default)"
+        )
     return _rounded(w)
 
 
@@ -152,9 +158,11 @@ def drive_report(drive) -> dict:
         "design": d.name,
         "source": des.source,
         "chord_tol_um": _r(drive.tol * 1e3, 6),
-        "outline_error": ("undeformed gears (DXF layers FLEXSPLINE, RIGID and the STL solids): a symmetric band, "
-                          "within chord_tol_um of the exact curves on either side; deformed-state DXFs: chords "
-                          "through points of the exact curves, so within chord_tol_um on the concave side only"),
+        "outline_error": (
+            "undeformed gears (DXF layers FLEXSPLINE, RIGID and the STL solids): a symmetric band, "
+            "within chord_tol_um of the exact curves on either side; deformed-state DXFs: chords "
+            "through points of the exact curves, so within chord_tol_um on the concave side only"
+        ),
         "drive": {
             "module_mm": d.module,
             "z_flex": d.z_flex,
@@ -201,22 +209,33 @@ def format_summary(rep: dict) -> str:
     def row(label, fv, bv):
         lines.append(f"  {label:38s}{fmt(fv):>20s}{fmt(bv):>20s}")
 
-    for label, key in (("pitch radius, mm", "pitch_radius_mm"), ("tip radius, mm", "tip_radius_mm"),
-                       ("root radius, mm", "root_radius_mm"), ("base radius, mm", "base_radius_mm"),
-                       ("rim radius, mm", "rim_radius_mm"), ("tip thickness, mm", "tip_thickness_mm"),
-                       ("outline vertices", "outline_vertices")):
+    for label, key in (
+        ("pitch radius, mm", "pitch_radius_mm"),
+        ("tip radius, mm", "tip_radius_mm"),
+        ("root radius, mm", "root_radius_mm"),
+        ("base radius, mm", "base_radius_mm"),
+        ("rim radius, mm", "rim_radius_mm"),
+        ("tip thickness, mm", "tip_thickness_mm"),
+        ("outline vertices", "outline_vertices"),
+    ):
         row(label, f.get(key), b.get(key))
     if "cycloid_rack_vs_exact_um" in f:
         row("rack vs exact cycloid, um", f.get("cycloid_rack_vs_exact_um"), b.get("cycloid_rack_vs_exact_um"))
     # the pitch-circle figures only where the pitch circle crosses the teeth: outside them they are
     # figures of the extended flanks (one of them negative), not something to measure
     if f["pitch_circle_within_teeth"] or b["pitch_circle_within_teeth"]:
-        for label, key in (("tooth thickness @pitch, mm", "tooth_thickness_pitch_mm"), ("space width @pitch, mm", "space_width_pitch_mm")):
+        for label, key in (
+            ("tooth thickness @pitch, mm", "tooth_thickness_pitch_mm"),
+            ("space width @pitch, mm", "space_width_pitch_mm"),
+        ):
             row(label, *(g[key] if g["pitch_circle_within_teeth"] else None for g in (f, b)))
     wf, wb = f["workshop"], b["workshop"]
     lines += ["", "  workshop measurements (undeformed gears)"]
-    row("flanks between diameters, mm", f"{wf['flank_from_diameter_mm']:.3f}-{wf['flank_to_diameter_mm']:.3f}",
-        f"{wb['flank_from_diameter_mm']:.3f}-{wb['flank_to_diameter_mm']:.3f}")
+    row(
+        "flanks between diameters, mm",
+        f"{wf['flank_from_diameter_mm']:.3f}-{wf['flank_to_diameter_mm']:.3f}",
+        f"{wb['flank_from_diameter_mm']:.3f}-{wb['flank_to_diameter_mm']:.3f}",
+    )
     row("mid-depth diameter, mm", wf["mid_depth"]["diameter_mm"], wb["mid_depth"]["diameter_mm"])
     row("  thickness there: arc, mm", wf["mid_depth"]["arc_mm"], wb["mid_depth"]["arc_mm"])
     row("  chordal thickness, mm", wf["mid_depth"]["chordal_mm"], wb["mid_depth"]["chordal_mm"])
@@ -236,17 +255,27 @@ def format_summary(rep: dict) -> str:
 
     row("span W_k over k teeth, mm", span(wf), span(wb))
     row("pin (ball) diameter, mm", wf["pins"]["pin_diameter_mm"], wb["pins"]["pin_diameter_mm"])
-    row("dimension over / between pins, mm", *(w["pins"].get("over_pins_mm", w["pins"].get("between_pins_mm")) for w in (wf, wb)))
+    row(
+        "dimension over / between pins, mm",
+        *(w["pins"].get("over_pins_mm", w["pins"].get("between_pins_mm")) for w in (wf, wb)),
+    )
     row("smallest concave radius, mm", wf["smallest_concave_radius_mm"], wb["smallest_concave_radius_mm"])
-    methods = sorted({w["span"]["method"] for w in (wf, wb) if w["span"] and w["span"].get("method")} | {w["pins"]["method"] for w in (wf, wb)})
-    lines.append(f"  (span and pins: {'; '.join(methods)}; thicknesses and concave radii: closed form;"
-                 " external teeth over pins, internal between pins)")
+    methods = sorted(
+        {w["span"]["method"] for w in (wf, wb) if w["span"] and w["span"].get("method")}
+        | {w["pins"]["method"] for w in (wf, wb)}
+    )
+    lines.append(
+        f"  (span and pins: {'; '.join(methods)}; thicknesses and concave radii: closed form;"
+        " external teeth over pins, internal between pins)"
+    )
     if any(w["smallest_concave_radius_mm"] == 0.0 for w in (wf, wb)):
         lines.append("  (a concave radius of 0: sharp root corner, or the cycloid's curvature at the pitch point)")
     outside = [key for key, g in (("flexspline", f), ("rigid", b)) if not g["pitch_circle_within_teeth"]]
     if outside:
-        lines.append(f"  ({' and '.join(outside)}: the pitch circle lies outside the teeth, so no thickness is given there; "
-                     "report.json keeps the virtual values of the extended flanks)")
+        lines.append(
+            f"  ({' and '.join(outside)}: the pitch circle lies outside the teeth, so no thickness is given there; "
+            "report.json keeps the virtual values of the extended flanks)"
+        )
     lines += [
         "",
         f"  depth of engagement on the major axis: {m['depth_of_engagement_mm']:.4f} mm (w = {m['w_major_mm']:.4f} mm)",

@@ -4,15 +4,21 @@ from __future__ import annotations
 
 import time
 from dataclasses import dataclass, field
-from math import pi
 
 import numpy as np
 
 from ..profiles.sector import MIN_HEIGHT_COEF, SectorLayout, TeethByHeight
 from .scene import DEFAULT_CULL, DEFAULT_STEP_DEG, SectoredScene, sweep_angles
 
-__all__ = ["ClosedFormHeights", "SimulatedHeights", "closed_form_heights", "simulated_heights", "assigned_angles", "register_angles",
-           "listed_heights"]
+__all__ = [
+    "ClosedFormHeights",
+    "SimulatedHeights",
+    "closed_form_heights",
+    "simulated_heights",
+    "assigned_angles",
+    "register_angles",
+    "listed_heights",
+]
 
 
 @dataclass(frozen=True)
@@ -109,8 +115,9 @@ def register_angles(scene: SectoredScene, step_deg: float = DEFAULT_STEP_DEG, cu
     return phi_h, phi
 
 
-def closed_form_heights(drive, layout: SectorLayout, teeth: TeethByHeight, assign: str = "register",
-                        step_deg: float = DEFAULT_STEP_DEG) -> ClosedFormHeights:
+def closed_form_heights(
+    drive, layout: SectorLayout, teeth: TeethByHeight, assign: str = "register", step_deg: float = DEFAULT_STEP_DEG
+) -> ClosedFormHeights:
     """The closed-form heights of docs/models.md 2.3 with every parameter explicit.
 
     ``assign`` chooses the generator angle of each tooth: ``"register"``
@@ -142,16 +149,19 @@ def closed_form_heights(drive, layout: SectorLayout, teeth: TeethByHeight, assig
         phi_h, phi = register_angles(SectoredScene(drive, layout, teeth, h), step_deg)
         h, w = formula(phi)
         iterations = 1
-        rule = (f"smallest |phi| (from the nearer wave end) over a {step_deg:g} deg sweep of half a turn with the motion "
-                "law at which a flexspline tip land faces the tooth's tip land (out of register)")
+        rule = (
+            f"smallest |phi| (from the nearer wave end) over a {step_deg:g} deg sweep of half a turn with the motion "
+            "law at which a flexspline tip land faces the tooth's tip land (out of register)"
+        )
     else:
         raise ValueError(f"assign must be 'register' or 'boundary', got {assign!r}")
     g = drive.design.generator
     beta = float(np.deg2rad(g.beta_deg)) if g.beta_deg is not None else float("nan")
     for a in (h, phi_h, phi, w):
         a.setflags(write=False)
-    return ClosedFormHeights(h, phi_h, phi, w, r_fix, r_cr, h_s, float(drive.law.w0), beta, H, rule,
-                             time.perf_counter() - t0, iterations)
+    return ClosedFormHeights(
+        h, phi_h, phi, w, r_fix, r_cr, h_s, float(drive.law.w0), beta, H, rule, time.perf_counter() - t0, iterations
+    )
 
 
 @dataclass(frozen=True)
@@ -183,8 +193,15 @@ class SimulatedHeights:
     elapsed_s: float = 0.0
 
 
-def simulated_heights(drive, layout: SectorLayout, teeth: TeethByHeight, tip_clearance: float,
-                      step_deg: float = DEFAULT_STEP_DEG, tol: float = 1e-4, cull: float = DEFAULT_CULL) -> SimulatedHeights:
+def simulated_heights(
+    drive,
+    layout: SectorLayout,
+    teeth: TeethByHeight,
+    tip_clearance: float,
+    step_deg: float = DEFAULT_STEP_DEG,
+    tol: float = 1e-4,
+    cull: float = DEFAULT_CULL,
+) -> SimulatedHeights:
     """Largest height of every rigid tooth (coupling teeth, and any transmission tooth found at risk) that keeps
     ``tip_clearance`` (mm) to the flexspline tips that face it.
 
@@ -266,10 +283,22 @@ def simulated_heights(drive, layout: SectorLayout, teeth: TeethByHeight, tip_cle
     teeth_at_risk = bad
     for a in (heights, worst_phi_h, worst_phi, unreachable):
         a.setflags(write=False)
-    return SimulatedHeights(heights, tip_clearance, worst_phi_h, worst_phi, unreachable, step_deg, tol,
-                            {"pairs_swept": int(n_all), "pairs_at_risk": int(len(pairs)), "pair_evaluations": int(evals),
-                             "teeth_lowered": int(len(teeth_at_risk))},
-                            time.perf_counter() - t0)
+    return SimulatedHeights(
+        heights,
+        tip_clearance,
+        worst_phi_h,
+        worst_phi,
+        unreachable,
+        step_deg,
+        tol,
+        {
+            "pairs_swept": int(n_all),
+            "pairs_at_risk": int(len(pairs)),
+            "pair_evaluations": int(evals),
+            "teeth_lowered": int(len(teeth_at_risk)),
+        },
+        time.perf_counter() - t0,
+    )
 
 
 def listed_heights(layout: SectorLayout, heights_mm, full: float) -> np.ndarray:
@@ -285,7 +314,9 @@ def listed_heights(layout: SectorLayout, heights_mm, full: float) -> np.ndarray:
     hm = np.asarray(heights_mm, dtype=float)
     for i, h in enumerate(hm):
         if h > full + 1e-12:
-            raise DesignError(f"sectors.heights_mm[{i}]", f"{h:g} mm exceeds the full tooth height {full:.4f} mm (rigid root to tip)")
+            raise DesignError(
+                f"sectors.heights_mm[{i}]", f"{h:g} mm exceeds the full tooth height {full:.4f} mm (rigid root to tip)"
+            )
     out = np.full(layout.n_teeth, full)
     out[layout.coupling] = hm[layout.index[layout.coupling]]
     out.setflags(write=False)

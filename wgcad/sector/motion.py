@@ -92,7 +92,9 @@ class MotionLaw:
             if out and out[-1].kind == p.kind:
                 q = out[-1]
                 step = q.output_step + p.output_step
-                out[-1] = Phase(p.kind, q.start, p.end, step, float("inf") if p.kind == "dwell" else (p.end - q.start) / step)
+                out[-1] = Phase(
+                    p.kind, q.start, p.end, step, float("inf") if p.kind == "dwell" else (p.end - q.start) / step
+                )
             else:
                 out.append(p)
         return out

@@ -33,7 +33,15 @@ from ..profiles.sampling import polar
 from ..profiles.sector import SectorLayout, TeethByHeight
 from .motion import MotionLaw, motion_law
 
-__all__ = ["SectoredScene", "SweepPairs", "SectoredAudit", "sectored_audit", "sweep_angles", "DEFAULT_STEP_DEG", "DEFAULT_CULL"]
+__all__ = [
+    "SectoredScene",
+    "SweepPairs",
+    "SectoredAudit",
+    "sectored_audit",
+    "sweep_angles",
+    "DEFAULT_STEP_DEG",
+    "DEFAULT_CULL",
+]
 
 #: generator-angle step of the sweeps, deg: a flexspline tip moves radially by
 #: at most |w'| ~ W0 per rad, 1.4 um per 0.1 deg at W0 = 0.8 mm
@@ -121,7 +129,7 @@ class SectoredScene:
         A, z = phi.shape
         return rot.reshape(A, z), shift.reshape(A, z, 2), phi
 
-    def pairs(self, phi_h: np.ndarray, cull: float = DEFAULT_CULL, teeth=None) -> "SweepPairs":
+    def pairs(self, phi_h: np.ndarray, cull: float = DEFAULT_CULL, teeth=None) -> SweepPairs:
         """Flexspline-rigid tooth pairs worth measuring over the generator angles ``phi_h``.
 
         Each flexspline tooth is paired with the two rigid teeth that bracket
@@ -166,10 +174,11 @@ class SectoredScene:
         # angle from the nearer wave end (the law repeats every 2 pi / waves)
         per = 2.0 * pi / self.drive.design.drive.waves
         phi = (phi + 0.5 * per) % per - 0.5 * per
-        return SweepPairs(phi_h=phi_h, angle=ai[rows], flex=ki[rows], rigid=ri, rot=rot[rows], shift=shift[rows],
-                          phi=phi[rows])
+        return SweepPairs(
+            phi_h=phi_h, angle=ai[rows], flex=ki[rows], rigid=ri, rot=rot[rows], shift=shift[rows], phi=phi[rows]
+        )
 
-    def facing(self, pairs: "SweepPairs", psi=None) -> np.ndarray:
+    def facing(self, pairs: SweepPairs, psi=None) -> np.ndarray:
         """Whether each pair's flexspline tip land faces the rigid tooth's tip land (overlapping angular extents), ``(P,)`` bool.
 
         The rigid tip land is the full-height tooth's (``psi`` overrides it,
@@ -186,7 +195,7 @@ class SectoredScene:
         ps = self.psi_full if psi is None else psi
         return (hi >= -ps) & (lo <= ps)
 
-    def clearance(self, pairs: "SweepPairs", heights=None) -> np.ndarray:
+    def clearance(self, pairs: SweepPairs, heights=None) -> np.ndarray:
         """Signed clearance of every pair (mm, negative = penetration depth), grouped per rigid tooth template.
 
         ``heights`` (``(P,)``) measures each pair against a rigid tooth of that
@@ -224,8 +233,10 @@ class SweepPairs:
     shift: np.ndarray
     phi: np.ndarray
 
-    def take(self, sel) -> "SweepPairs":
-        return SweepPairs(self.phi_h, self.angle[sel], self.flex[sel], self.rigid[sel], self.rot[sel], self.shift[sel], self.phi[sel])
+    def take(self, sel) -> SweepPairs:
+        return SweepPairs(
+            self.phi_h, self.angle[sel], self.flex[sel], self.rigid[sel], self.rot[sel], self.shift[sel], self.phi[sel]
+        )
 
     def __len__(self) -> int:
         return len(self.rigid)
@@ -262,12 +273,16 @@ class SectoredAudit:
             "tip_to_tip": self.has_tip_to_tip,
             "tip_to_tip_teeth": len(self.tip_to_tip),
             "tip_to_tip_at": self.tip_to_tip,
-            "min_tip_clearance_um": round(1e3 * self.min_tip_clearance, 4) if np.isfinite(self.min_tip_clearance) else None,
+            "min_tip_clearance_um": round(1e3 * self.min_tip_clearance, 4)
+            if np.isfinite(self.min_tip_clearance)
+            else None,
             "worst_tip": self.worst_tip,
             "min_clearance_um": round(1e3 * self.min_clearance, 4),
             "worst": self.worst,
             "flank_interference": bool(self.flank_interference),
-            "min_flank_clearance_um": round(1e3 * self.min_flank_clearance, 4) if np.isfinite(self.min_flank_clearance) else None,
+            "min_flank_clearance_um": round(1e3 * self.min_flank_clearance, 4)
+            if np.isfinite(self.min_flank_clearance)
+            else None,
             "interference_tol_um": round(1e3 * self.interference_tol, 4),
             "counts": self.counts,
             "settings": self.settings,
@@ -293,8 +308,12 @@ def _where(scene: SectoredScene, pairs: SweepPairs, n: int, c: float) -> dict:
     }
 
 
-def sectored_audit(scene: SectoredScene, step_deg: float = DEFAULT_STEP_DEG, cull: float = DEFAULT_CULL,
-                   interference_tol: float = constants.INTERFERENCE_TOL) -> SectoredAudit:
+def sectored_audit(
+    scene: SectoredScene,
+    step_deg: float = DEFAULT_STEP_DEG,
+    cull: float = DEFAULT_CULL,
+    interference_tol: float = constants.INTERFERENCE_TOL,
+) -> SectoredAudit:
     """Sweep the generator over the cycle (half a turn: identical waves) and report tip-to-tip and flank findings.
 
     A pair meets *tip-to-tip* when its tip lands face each other
@@ -334,8 +353,13 @@ def sectored_audit(scene: SectoredScene, step_deg: float = DEFAULT_STEP_DEG, cul
         min_flank_clearance=min_flank,
         interference_tol=interference_tol,
         counts={"generator_angles": int(len(angles)), "pairs_measured": int(len(c)), "facing_pairs": int(face.sum())},
-        settings={"step_deg": step_deg, "sweep": "half turn, every tooth (identical waves)", "cull_um": 1e3 * cull,
-                  "mesh_period": False, "mirror": False},
+        settings={
+            "step_deg": step_deg,
+            "sweep": "half turn, every tooth (identical waves)",
+            "cull_um": 1e3 * cull,
+            "mesh_period": False,
+            "mirror": False,
+        },
         elapsed_s=time.perf_counter() - t0,
         per_tooth_tip=tip_min,
     )

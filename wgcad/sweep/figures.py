@@ -34,8 +34,11 @@ FIGURES = {
     "ke_pp_arcsec": ("ke", "largest kinematic error (peak to peak over one flexspline revolution), no load"),
     "lost_motion_min_arcsec": ("ke", "smallest lost motion over the revolution (negative: the teeth interfere)"),
     "lost_motion_max_arcsec": ("ke", "largest lost motion over the revolution"),
-    "ke_deep_overlap_fraction": ("ke", "share of the angles whose first contact overlaps so deeply (turns back > 300 "
-                                       "arcsec to separate) that the linear error model is not to be trusted there"),
+    "ke_deep_overlap_fraction": (
+        "ke",
+        "share of the angles whose first contact overlaps so deeply (turns back > 300 "
+        "arcsec to separate) that the linear error model is not to be trusted there",
+    ),
     "min_clearance_um": ("audit", "smallest clearance of the perfect drive, no load (negative: interference)"),
     "entry_gap_um": ("audit", "entry gap of the perfect drive, no load"),
     "backlash_arcmin": ("audit", "backlash of the perfect drive (NaN where the teeth touch or interfere)"),
@@ -65,8 +68,11 @@ def parse_figure(name: str) -> tuple[str, str, float | None]:
         base, t = m.group(1), float(m.group(2))
         if base not in LOADED:
             near = difflib.get_close_matches(base, LOADED, n=1)
-            raise DesignError("figures.record", f"'{name}': no loaded figure '{base}'"
-                              + (f"; did you mean '{near[0]}@{m.group(2)}Nm'?" if near else f"; loaded figures: {', '.join(LOADED)}"))
+            raise DesignError(
+                "figures.record",
+                f"'{name}': no loaded figure '{base}'"
+                + (f"; did you mean '{near[0]}@{m.group(2)}Nm'?" if near else f"; loaded figures: {', '.join(LOADED)}"),
+            )
         if not 0.0 <= t <= 1e7:
             raise DesignError("figures.record", f"'{name}': torque must be in [0, 1e7] N m")
         return "load", base, t
@@ -74,8 +80,15 @@ def parse_figure(name: str) -> tuple[str, str, float | None]:
         raise DesignError("figures.record", f"'{name}': a loaded figure reads NAME@TORQUENm, e.g. entry_gap_um@500Nm")
     if name not in FIGURES:
         near = difflib.get_close_matches(name, list(FIGURES) + [f"{k}@500Nm" for k in LOADED], n=1)
-        raise DesignError("figures.record", f"unknown figure '{name}'" + (f"; did you mean '{near[0]}'?" if near else
-                          f"; figures: {', '.join(FIGURES)}, and NAME@TNm for {', '.join(LOADED)}"))
+        raise DesignError(
+            "figures.record",
+            f"unknown figure '{name}'"
+            + (
+                f"; did you mean '{near[0]}'?"
+                if near
+                else f"; figures: {', '.join(FIGURES)}, and NAME@TNm for {', '.join(LOADED)}"
+            ),
+        )
     return FIGURES[name][0], name, None
 
 
@@ -91,14 +104,23 @@ def check_figures(spec, base_design) -> None:
         raise DesignError("figures.record", "a figure is named twice (the same torque written two ways)")
     models = {parse_figure(r)[0] for r in spec.record}
     if "ke" in models and base_design.drive.fixed != "rigid":
-        raise DesignError("figures.record", "the KE figures model a fixed rigid gear (docs/models.md 6.2); the base design has drive.fixed = flexspline")
+        raise DesignError(
+            "figures.record",
+            "the KE figures model a fixed rigid gear (docs/models.md 6.2); the base design has drive.fixed = flexspline",
+        )
     if "load" in models and base_design.bearing.balls is None:
-        raise DesignError("figures.record", "figures under load need the elastic model's [bearing] table in the base design (bearing.balls is missing)")
+        raise DesignError(
+            "figures.record",
+            "figures under load need the elastic model's [bearing] table in the base design (bearing.balls is missing)",
+        )
     for p in spec.parameters:
         if p.table == "sectors":
             raise DesignError(f"parameters.{p.name}", "no sweep figure models the sectored rigid gear")
         seen = [m for m in models if p.table in MODELS[m]]
         if not seen:
             who = ", ".join(sorted(m for m in MODELS if p.table in MODELS[m])) or "none"
-            raise DesignError(f"parameters.{p.name}", f"no recorded figure depends on [{p.table}] (models that see it: {who}); "
-                              "record a figure of one of them or drop the parameter")
+            raise DesignError(
+                f"parameters.{p.name}",
+                f"no recorded figure depends on [{p.table}] (models that see it: {who}); "
+                "record a figure of one of them or drop the parameter",
+            )

@@ -39,6 +39,7 @@ class ClusterError(WgcadError, RuntimeError):
 
     exit_code = 4
 
+
 #: Dask's share of a task's time the grain aims below
 OVERHEAD_SHARE = 0.02
 #: longest task aimed at, s: what a killed run loses per worker, and the progress bar's step
@@ -87,12 +88,28 @@ def local_cluster(workers: int):
     """A Dask LocalCluster of ``workers`` single-threaded processes on loopback, no dashboard."""
     from distributed import LocalCluster
 
-    return LocalCluster(n_workers=workers, threads_per_worker=1, processes=True, host="127.0.0.1",
-                        dashboard_address=None, silence_logs=40)
+    return LocalCluster(
+        n_workers=workers,
+        threads_per_worker=1,
+        processes=True,
+        host="127.0.0.1",
+        dashboard_address=None,
+        silence_logs=40,
+    )
 
 
-def run_sweep(spec, out, *, client=None, scheduler: str | None = None, workers: int | None = None, batch: int | None = None,
-              progress=None, max_chunks: int | None = None, fmt: str | None = None) -> RunInfo:
+def run_sweep(
+    spec,
+    out,
+    *,
+    client=None,
+    scheduler: str | None = None,
+    workers: int | None = None,
+    batch: int | None = None,
+    progress=None,
+    max_chunks: int | None = None,
+    fmt: str | None = None,
+) -> RunInfo:
     """Compute every sample of ``spec`` not yet stored in ``out``.
 
     Parameters
@@ -199,8 +216,10 @@ def run_sweep(spec, out, *, client=None, scheduler: str | None = None, workers: 
                 try:
                     res = f.result()
                 except Exception as e:  # noqa: BLE001 - KilledWorker, lost scheduler, CommClosedError...
-                    raise ClusterError(f"a Dask task failed ({type(e).__name__}: {' '.join(str(e).split())[:200]}); "
-                                       f"{info.chunks_written} chunks stored this run are kept: run again to resume") from e
+                    raise ClusterError(
+                        f"a Dask task failed ({type(e).__name__}: {' '.join(str(e).split())[:200]}); "
+                        f"{info.chunks_written} chunks stored this run are kept: run again to resume"
+                    ) from e
                 if stored(res):
                     info.stopped_early = info.computed + info.skipped < spec.total
                     break
@@ -230,5 +249,12 @@ def _timed_batch(payload, start, stop):
         else:
             for k, v in r["columns"].items():
                 cols[k].extend(v)
-    return {"columns": cols, "start": start, "stop": stop, "compute_s": time.perf_counter() - t0, "cpu_s": time.process_time() - c0,
-            "sample_s": ts, "built": 0}
+    return {
+        "columns": cols,
+        "start": start,
+        "stop": stop,
+        "compute_s": time.perf_counter() - t0,
+        "cpu_s": time.process_time() - c0,
+        "sample_s": ts,
+        "built": 0,
+    }

@@ -48,7 +48,7 @@ def sample_values(payload: dict, i: int) -> dict:
 
             u = next(zi)
             # inverse CDF of the uniform variate (u = 0 has probability 2^-53: nudged inside)
-            out[p.name] = float(p.a + p.b * ndtri(min(max(u, 2.0 ** -54), 1.0 - 2.0 ** -54)))
+            out[p.name] = float(p.a + p.b * ndtri(min(max(u, 2.0**-54), 1.0 - 2.0**-54)))
     return out
 
 

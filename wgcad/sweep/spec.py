@@ -52,8 +52,11 @@ _SWEEP_KEYS = ("name", "design", "samples", "seed", "batch")
 _FIG_KEYS = ("record", "audit_step_deg", "audit_sections", "load_sections", "ke_per_mesh", "ke_table")
 #: ``figures.ke_table``: one KE contact table per worker for the sweep's largest amplitudes, or one per sample
 KE_TABLES = ("shared", "per_sample")
-_PARAM_KEYS = {"normal": ("distribution", "mean", "sd"), "uniform": ("distribution", "lo", "hi"),
-               "grid": ("distribution", "values", "grid")}
+_PARAM_KEYS = {
+    "normal": ("distribution", "mean", "sd"),
+    "uniform": ("distribution", "lo", "hi"),
+    "grid": ("distribution", "values", "grid"),
+}
 
 
 @dataclass(frozen=True)
@@ -132,18 +135,32 @@ class SweepSpec:
 
     def fingerprint(self) -> str:
         """Hash of everything that decides the samples and their results (not the limits, not the batch size)."""
-        doc = {"design": self.design_data, "parameters": [p.__dict__ for p in self.parameters],
-               "record": list(self.record), "samples": self.samples, "seed": self.seed,
-               "settings": [self.audit_step_deg, self.audit_sections, self.load_sections, self.ke_per_mesh, self.ke_table]}
+        doc = {
+            "design": self.design_data,
+            "parameters": [p.__dict__ for p in self.parameters],
+            "record": list(self.record),
+            "samples": self.samples,
+            "seed": self.seed,
+            "settings": [self.audit_step_deg, self.audit_sections, self.load_sections, self.ke_per_mesh, self.ke_table],
+        }
         return hashlib.sha256(json.dumps(doc, sort_keys=True, default=str).encode()).hexdigest()[:16]
 
     def payload(self) -> dict:
         """What a task needs, small and picklable (the design as data: remote workers need not see the file)."""
-        return {"design": self.design_data, "parameters": self.parameters, "record": self.record,
-                "samples": self.samples, "seed": self.seed, "grid_shape": tuple(len(p.values) for p in self.grid),
-                "audit_step_deg": self.audit_step_deg, "audit_sections": self.audit_sections,
-                "load_sections": self.load_sections, "ke_per_mesh": self.ke_per_mesh, "ke_table": self.ke_table,
-                "fingerprint": self.fingerprint()}
+        return {
+            "design": self.design_data,
+            "parameters": self.parameters,
+            "record": self.record,
+            "samples": self.samples,
+            "seed": self.seed,
+            "grid_shape": tuple(len(p.values) for p in self.grid),
+            "audit_step_deg": self.audit_step_deg,
+            "audit_sections": self.audit_sections,
+            "load_sections": self.load_sections,
+            "ke_per_mesh": self.ke_per_mesh,
+            "ke_table": self.ke_table,
+            "fingerprint": self.fingerprint(),
+        }
 
 
 def _unknown(where: str, keys, known) -> None:
@@ -184,14 +201,19 @@ def _parameter(name: str, table: str, key: str, d) -> Parameter:
     types = _field_types()
     if table not in types:
         near = difflib.get_close_matches(table, types, n=1)
-        raise DesignError(where, "unknown design table" + (f"; did you mean '{near[0]}'?" if near else f"; tables: {', '.join(types)}"))
+        raise DesignError(
+            where,
+            "unknown design table" + (f"; did you mean '{near[0]}'?" if near else f"; tables: {', '.join(types)}"),
+        )
     if key not in types[table]:
         near = difflib.get_close_matches(key, types[table], n=1)
         raise DesignError(where, f"not a key of [{table}]" + (f"; did you mean '{table}.{near[0]}'?" if near else ""))
     if table == "drive" and key == "name":
         raise DesignError(where, "the drive's name cannot be swept")
     if not isinstance(d, dict):
-        raise DesignError(where, f"must be a table with distribution = normal/uniform or grid = [...], got {type(d).__name__}")
+        raise DesignError(
+            where, f"must be a table with distribution = normal/uniform or grid = [...], got {type(d).__name__}"
+        )
     base, choices = types[table][key]
     kind = d.get("distribution", "grid" if ("grid" in d or "values" in d) else None)
     if kind not in DISTRIBUTIONS:
@@ -210,7 +232,7 @@ def _parameter(name: str, table: str, key: str, d) -> Parameter:
                 if not isinstance(v, str) or (choices and v not in choices):
                     raise DesignError(w, f"must be one of {', '.join(choices or ())}; got {v!r}")
             elif base is int:
-                v = _whole(w, v, -10**9, 10**9)
+                v = _whole(w, v, -(10**9), 10**9)
             else:
                 v = _number(w, v)
             out.append(v)
@@ -218,7 +240,10 @@ def _parameter(name: str, table: str, key: str, d) -> Parameter:
             raise DesignError(f"{where}.grid", "values repeat; each grid value once")
         return Parameter(name, table, key, "grid", values=tuple(out))
     if base is not float:
-        raise DesignError(where, f"{'a whole-number' if base is int else 'a text'} key: give it a grid of values, not a {kind} distribution")
+        raise DesignError(
+            where,
+            f"{'a whole-number' if base is int else 'a text'} key: give it a grid of values, not a {kind} distribution",
+        )
     if kind == "normal":
         for k in ("mean", "sd"):
             if k not in d:
@@ -246,7 +271,9 @@ def _parameters(data) -> tuple:
             out.append(_parameter(top, table, key, v))
             continue
         if not isinstance(v, dict) or not v or not all(isinstance(x, dict) for x in v.values()):
-            raise DesignError(f"parameters.{top}", "expected [parameters.TABLE.KEY] tables, e.g. [parameters.generator.w0_coef]")
+            raise DesignError(
+                f"parameters.{top}", "expected [parameters.TABLE.KEY] tables, e.g. [parameters.generator.w0_coef]"
+            )
         for key, d in v.items():
             out.append(_parameter(f"{top}.{key}", top, key, d))
     if len(out) > 64:
@@ -254,7 +281,9 @@ def _parameters(data) -> tuple:
     return tuple(out)
 
 
-def parse_spec(data: dict, source: str = "<memory>", base_dir: Path | None = None, design_data: dict | None = None) -> SweepSpec:
+def parse_spec(
+    data: dict, source: str = "<memory>", base_dir: Path | None = None, design_data: dict | None = None
+) -> SweepSpec:
     """Build and validate a :class:`SweepSpec` from a TOML dict.
 
     ``design_data`` (the base design as a TOML dict) is read from ``sweep.design``
@@ -304,20 +333,24 @@ def parse_spec(data: dict, source: str = "<memory>", base_dir: Path | None = Non
     samples = sw.get("samples", 1000 if has_random else 1)
     samples = _whole("sweep.samples", samples, 1, MAX_SAMPLES)
     if not has_random and samples != 1:
-        raise DesignError("sweep.samples", f"no parameter has a distribution, so every grid point has one sample; got {samples}")
+        raise DesignError(
+            "sweep.samples", f"no parameter has a distribution, so every grid point has one sample; got {samples}"
+        )
     npts = 1
     for p in params:
         if not p.random:
             npts *= len(p.values)
     if npts * samples > MAX_SAMPLES:
-        raise DesignError("sweep.samples", f"{npts} grid points x {samples} samples = {npts * samples} exceeds {MAX_SAMPLES}")
+        raise DesignError(
+            "sweep.samples", f"{npts} grid points x {samples} samples = {npts * samples} exceeds {MAX_SAMPLES}"
+        )
     fig = data.get("figures")
     if not isinstance(fig, dict):
         raise DesignError("figures", "table [figures] is required (record = [...])")
     _unknown("figures", fig, _FIG_KEYS)
     rec = fig.get("record")
     if not isinstance(rec, list) or not rec or not all(isinstance(r, str) for r in rec):
-        raise DesignError("figures.record", "must be a non-empty list of figure names, e.g. [\"ke_pp_arcsec\"]")
+        raise DesignError("figures.record", 'must be a non-empty list of figure names, e.g. ["ke_pp_arcsec"]')
     if len(set(rec)) != len(rec):
         raise DesignError("figures.record", "a figure is named twice")
     step = _number("figures.audit_step_deg", fig.get("audit_step_deg", 0.5))
@@ -327,11 +360,22 @@ def parse_spec(data: dict, source: str = "<memory>", base_dir: Path | None = Non
     if kt not in KE_TABLES:
         raise DesignError("figures.ke_table", f"must be one of {', '.join(KE_TABLES)}; got {kt!r}")
     spec = SweepSpec(
-        name=name, design_path=dpath, design_data=design_data, parameters=params, record=tuple(rec), samples=samples,
-        seed=seed, limits={}, batch=batch, audit_step_deg=step,
+        name=name,
+        design_path=dpath,
+        design_data=design_data,
+        parameters=params,
+        record=tuple(rec),
+        samples=samples,
+        seed=seed,
+        limits={},
+        batch=batch,
+        audit_step_deg=step,
         audit_sections=_whole("figures.audit_sections", fig.get("audit_sections", 3), 1, 50),
         load_sections=_whole("figures.load_sections", fig.get("load_sections", 3), 1, 20),
-        ke_per_mesh=_whole("figures.ke_per_mesh", fig.get("ke_per_mesh", 16), 1, 512), ke_table=kt, source=source)
+        ke_per_mesh=_whole("figures.ke_per_mesh", fig.get("ke_per_mesh", 16), 1, 512),
+        ke_table=kt,
+        source=source,
+    )
     check_figures(spec, base)
     lim = data.get("limits", {})
     if not isinstance(lim, dict):
@@ -341,7 +385,9 @@ def parse_spec(data: dict, source: str = "<memory>", base_dir: Path | None = Non
         where = f"limits.{k}"
         if k not in spec.record:
             near = difflib.get_close_matches(k, spec.record, n=1)
-            raise DesignError(where, "not a recorded figure (figures.record)" + (f"; did you mean '{near[0]}'?" if near else ""))
+            raise DesignError(
+                where, "not a recorded figure (figures.record)" + (f"; did you mean '{near[0]}'?" if near else "")
+            )
         if not isinstance(v, dict) or not v:
             raise DesignError(where, "must be { min = ... } and/or { max = ... }")
         _unknown(where, v, ("min", "max"))
@@ -371,4 +417,3 @@ def load_spec(path) -> SweepSpec:
     except InputFileError as e:  # the reader speaks of design files
         raise InputFileError(str(e).replace("design file", "sweep spec file")) from None
     return parse_spec(parse_toml(text, p, "a sweep spec"), source=str(p), base_dir=p.parent)
-

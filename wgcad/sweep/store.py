@@ -59,7 +59,7 @@ class Store:
         self.name = name
 
     # -- the folder ----------------------------------------------------------
-    def open(self) -> "Store":
+    def open(self) -> Store:
         """Create the folder (or check that it holds this spec's results) and write ``sweep.json``."""
         from ..atomic import atomic_write, ensure_writable_dir, remove_stale_temps
 
@@ -70,15 +70,23 @@ class Store:
             except (OSError, ValueError) as e:
                 raise OutputError(f"{meta}: unreadable sweep record ({e}); choose another --out") from None
             if old.get("fingerprint") != self.fingerprint:
-                raise OutputError(f"{self.folder}: holds the results of another sweep spec (fingerprint {old.get('fingerprint')}, "
-                                  f"this spec {self.fingerprint}); choose another --out or remove the folder")
+                raise OutputError(
+                    f"{self.folder}: holds the results of another sweep spec (fingerprint {old.get('fingerprint')}, "
+                    f"this spec {self.fingerprint}); choose another --out or remove the folder"
+                )
             if old.get("format") != self.fmt:
                 raise OutputError(f"{self.folder}: its chunks are {old.get('format')}, this run would write {self.fmt}")
         elif self.folder.exists() and any(self.folder.iterdir()):
             raise OutputError(f"{self.folder}: not empty and not a sweep folder (no sweep.json); choose another --out")
         ensure_writable_dir(self.chunks)
         remove_stale_temps(self.chunks)  # temporaries of a killed run
-        doc = {"fingerprint": self.fingerprint, "name": self.name, "columns": self.columns, "total": self.total, "format": self.fmt}
+        doc = {
+            "fingerprint": self.fingerprint,
+            "name": self.name,
+            "columns": self.columns,
+            "total": self.total,
+            "format": self.fmt,
+        }
         atomic_write(meta, (json.dumps(doc, indent=2) + "\n").encode())
         return self
 
@@ -139,7 +147,12 @@ class Store:
         n = len(columns[self.columns[0]])
         for i in range(n):
             # repr of a float round-trips exactly: a CSV sweep is as bit-exact as a Parquet one
-            w.writerow([repr(float(columns[c][i])) if isinstance(columns[c][i], float) else columns[c][i] for c in self.columns])
+            w.writerow(
+                [
+                    repr(float(columns[c][i])) if isinstance(columns[c][i], float) else columns[c][i]
+                    for c in self.columns
+                ]
+            )
         return s.getvalue().encode()
 
     # -- reading -------------------------------------------------------------

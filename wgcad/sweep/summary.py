@@ -90,8 +90,16 @@ def _stats(v: np.ndarray) -> dict:
     if f.size == 0:
         return {"n": 0}
     q = np.quantile(f, [0.01, 0.5, 0.99])
-    return {"n": int(f.size), "mean": float(f.mean()), "sd": float(f.std(ddof=1)) if f.size > 1 else 0.0,
-            "min": float(f.min()), "p01": float(q[0]), "median": float(q[1]), "p99": float(q[2]), "max": float(f.max())}
+    return {
+        "n": int(f.size),
+        "mean": float(f.mean()),
+        "sd": float(f.std(ddof=1)) if f.size > 1 else 0.0,
+        "min": float(f.min()),
+        "p01": float(q[0]),
+        "median": float(q[1]),
+        "p99": float(q[2]),
+        "max": float(f.max()),
+    }
 
 
 def summarize(spec, cols: dict, conf: float = 0.95) -> dict:
@@ -99,41 +107,75 @@ def summarize(spec, cols: dict, conf: float = 0.95) -> dict:
     n = len(cols["sample"])
     st = cols["status"]
     ok = st == "ok"
-    counts = {"total": spec.total, "done": n, "ok": int(ok.sum()), "refused": int((st == "refused").sum()),
-              "failed": int((st == "failed").sum()), "error": int((st == "error").sum())}
+    counts = {
+        "total": spec.total,
+        "done": n,
+        "ok": int(ok.sum()),
+        "refused": int((st == "refused").sum()),
+        "failed": int((st == "failed").sum()),
+        "error": int((st == "error").sum()),
+    }
     reasons = collections.Counter(r for r, s in zip(cols["reason"], st) if s != "ok")
-    out = {"name": spec.name, "design": spec.design_path, "seed": spec.seed, "counts": counts,
-           "reasons": [{"reason": r, "samples": c} for r, c in reasons.most_common(8)],
-           "figures": {f: _stats(cols[f][ok]) for f in spec.record}, "limits": {}, "yield": None,
-           "sensitivity": [], "grid": None, "confidence": conf}
+    out = {
+        "name": spec.name,
+        "design": spec.design_path,
+        "seed": spec.seed,
+        "counts": counts,
+        "reasons": [{"reason": r, "samples": c} for r, c in reasons.most_common(8)],
+        "figures": {f: _stats(cols[f][ok]) for f in spec.record},
+        "limits": {},
+        "yield": None,
+        "sensitivity": [],
+        "grid": None,
+        "confidence": conf,
+    }
     fail = None
     if spec.limits:
         pas = passes(cols, spec.limits)
         k, m = int(pas[ok].sum()), int(ok.sum())
         for name, (lo, hi) in spec.limits.items():
             v = cols[name][ok]
-            inside = np.isfinite(v) & (v >= (lo if lo is not None else -np.inf)) & (v <= (hi if hi is not None else np.inf))
-            out["limits"][name] = {"min": lo, "max": hi, "pass": int(inside.sum()), "of": m,
-                                   "fraction": float(inside.mean()) if m else None}
+            inside = (
+                np.isfinite(v) & (v >= (lo if lo is not None else -np.inf)) & (v <= (hi if hi is not None else np.inf))
+            )
+            out["limits"][name] = {
+                "min": lo,
+                "max": hi,
+                "pass": int(inside.sum()),
+                "of": m,
+                "fraction": float(inside.mean()) if m else None,
+            }
         lo_, hi_ = clopper_pearson(k, m, conf)
-        out["yield"] = {"pass": k, "of": m, "fraction": k / m if m else None, "ci": [lo_, hi_], "method": "Clopper-Pearson",
-                        "wilson": list(wilson(k, m, conf)),
-                        "counting_refused_as_failures": k / n if n else None}
+        out["yield"] = {
+            "pass": k,
+            "of": m,
+            "fraction": k / m if m else None,
+            "ci": [lo_, hi_],
+            "method": "Clopper-Pearson",
+            "wilson": list(wilson(k, m, conf)),
+            "counting_refused_as_failures": k / n if n else None,
+        }
         fail = (~pas[ok]).astype(float)
     rand = [p for p in spec.parameters if p.random]
     if rand and ok.sum() >= 3:
         for p in rand:
             x = np.asarray(cols[p.name][ok], dtype=float)
-            row = {"parameter": p.name, "phase": p.phase,
-                   "failure": _assoc(p, x, fail) if fail is not None and 0 < fail.sum() < len(fail) else None,
-                   "figures": {}}
-            for f in (spec.limits or spec.record):
+            row = {
+                "parameter": p.name,
+                "phase": p.phase,
+                "failure": _assoc(p, x, fail) if fail is not None and 0 < fail.sum() < len(fail) else None,
+                "figures": {},
+            }
+            for f in spec.limits or spec.record:
                 y = cols[f][ok]
                 good = np.isfinite(y)
                 row["figures"][f] = _assoc(p, x[good], y[good]) if good.sum() >= 3 else None
             out["sensitivity"].append(row)
-        key = (lambda r: -abs(r["failure"] or 0.0)) if fail is not None else \
-            (lambda r: -max([abs(v) for v in r["figures"].values() if v is not None] or [0.0]))
+        key = (
+            (lambda r: -abs(r["failure"] or 0.0))
+            if fail is not None
+            else (lambda r: -max([abs(v) for v in r["figures"].values() if v is not None] or [0.0]))
+        )
         out["sensitivity"].sort(key=key)
     grid = [p for p in spec.parameters if not p.random]
     if grid:
@@ -153,7 +195,11 @@ def summarize(spec, cols: dict, conf: float = 0.95) -> dict:
             np.minimum.at(lo, gp[sel], v[sel])
             np.maximum.at(hi, gp[sel], v[sel])
             lo[~has], hi[~has] = np.nan, np.nan
-            surf[f] = {"mean": mean.reshape(shape).tolist(), "min": lo.reshape(shape).tolist(), "max": hi.reshape(shape).tolist()}
+            surf[f] = {
+                "mean": mean.reshape(shape).tolist(),
+                "min": lo.reshape(shape).tolist(),
+                "max": hi.reshape(shape).tolist(),
+            }
         ylds = None
         if spec.limits:
             pas = passes(cols, spec.limits)
@@ -162,9 +208,16 @@ def summarize(spec, cols: dict, conf: float = 0.95) -> dict:
             k_all = np.bincount(gp[ok & pas], minlength=G)
             for g in range(G):
                 k, m = int(k_all[g]), int(m_all[g])
-                ylds.append({"pass": k, "of": m, "fraction": k / m if m else None, "ci": list(clopper_pearson(k, m, conf))})
-        out["grid"] = {"parameters": [p.name for p in grid], "values": [list(p.values) for p in grid], "shape": list(shape),
-                       "surfaces": surf, "yield": ylds}
+                ylds.append(
+                    {"pass": k, "of": m, "fraction": k / m if m else None, "ci": list(clopper_pearson(k, m, conf))}
+                )
+        out["grid"] = {
+            "parameters": [p.name for p in grid],
+            "values": [list(p.values) for p in grid],
+            "shape": list(shape),
+            "surfaces": surf,
+            "yield": ylds,
+        }
     return out
 
 
@@ -175,36 +228,64 @@ def _fmt(x, nd=3) -> str:
 def format_summary(s: dict, info=None) -> str:
     """The summary for people, a few lines."""
     c = s["counts"]
-    lines = [f"{s['name']}: {c['done']} of {c['total']} samples stored ({c['ok']} computed, {c['refused']} refused by the rules, "
-             f"{c['failed']} failed in a model" + (f", {c['error']} ERRORS (a bug: please report)" if c["error"] else "") + ")"]
+    lines = [
+        f"{s['name']}: {c['done']} of {c['total']} samples stored ({c['ok']} computed, {c['refused']} refused by the rules, "
+        f"{c['failed']} failed in a model"
+        + (f", {c['error']} ERRORS (a bug: please report)" if c["error"] else "")
+        + ")"
+    ]
     if info is not None:
-        lines.append(f"  this run: {info.computed} samples computed, {info.skipped} already stored; {info.executor}; "
-                     f"{info.batch} samples per task" + (f" (measured: {1e3 * info.sample_s:.0f} ms per sample, Dask round trip "
-                                                         f"{1e3 * info.overhead_s:.1f} ms)" if info.sample_s else "")
-                     + f"; {info.wall_s:.1f} s" + (" - STOPPED EARLY" if info.stopped_early else ""))
+        lines.append(
+            f"  this run: {info.computed} samples computed, {info.skipped} already stored; {info.executor}; "
+            f"{info.batch} samples per task"
+            + (
+                f" (measured: {1e3 * info.sample_s:.0f} ms per sample, Dask round trip {1e3 * info.overhead_s:.1f} ms)"
+                if info.sample_s
+                else ""
+            )
+            + f"; {info.wall_s:.1f} s"
+            + (" - STOPPED EARLY" if info.stopped_early else "")
+        )
     for r in s["reasons"][:4]:
         lines.append(f"  not computed ({r['samples']}): {r['reason']}")
     for f, st in s["figures"].items():
         if st.get("n"):
-            lines.append(f"  {f}: mean {_fmt(st['mean'], 4)}, sd {_fmt(st['sd'])}, 1 %..99 % {_fmt(st['p01'], 4)} .. {_fmt(st['p99'], 4)}, "
-                         f"range {_fmt(st['min'], 4)} .. {_fmt(st['max'], 4)}")
+            lines.append(
+                f"  {f}: mean {_fmt(st['mean'], 4)}, sd {_fmt(st['sd'])}, 1 %..99 % {_fmt(st['p01'], 4)} .. {_fmt(st['p99'], 4)}, "
+                f"range {_fmt(st['min'], 4)} .. {_fmt(st['max'], 4)}"
+            )
         else:
             lines.append(f"  {f}: no value")
     y = s["yield"]
     if y is not None and y["of"]:
-        lims = ", ".join(f"{k} " + " and ".join(x for x in ((f">= {v['min']:g}" if v["min"] is not None else ""),
-                                                           (f"<= {v['max']:g}" if v["max"] is not None else "")) if x)
-                         for k, v in s["limits"].items())
-        lines.append(f"  YIELD {100 * y['fraction']:.2f} % ({y['pass']} of the {y['of']} samples whose every model held), "
-                     f"{100 * s['confidence']:.0f} % interval {100 * y['ci'][0]:.2f} .. {100 * y['ci'][1]:.2f} % "
-                     f"(Clopper-Pearson); limits: {lims}")
+        lims = ", ".join(
+            f"{k} "
+            + " and ".join(
+                x
+                for x in (
+                    (f">= {v['min']:g}" if v["min"] is not None else ""),
+                    (f"<= {v['max']:g}" if v["max"] is not None else ""),
+                )
+                if x
+            )
+            for k, v in s["limits"].items()
+        )
+        lines.append(
+            f"  YIELD {100 * y['fraction']:.2f} % ({y['pass']} of the {y['of']} samples whose every model held), "
+            f"{100 * s['confidence']:.0f} % interval {100 * y['ci'][0]:.2f} .. {100 * y['ci'][1]:.2f} % "
+            f"(Clopper-Pearson); limits: {lims}"
+        )
         if c["refused"] or c["failed"] or c["error"]:
-            lines.append(f"  counting refused, failed and error samples as failures: {100 * y['counting_refused_as_failures']:.2f} %")
+            lines.append(
+                f"  counting refused, failed and error samples as failures: {100 * y['counting_refused_as_failures']:.2f} %"
+            )
     elif y is not None:
         lines.append(f"  YIELD not defined: no sample's models held ({c['done']} stored: see the reasons above)")
     if s["sensitivity"]:
         top = [r for r in s["sensitivity"] if r["failure"] is not None][:5]
         if top:
-            lines.append("  parameters driving failures (rank correlation with failing): "
-                         + ", ".join(f"{r['parameter']} {r['failure']:+.2f}" for r in top))
+            lines.append(
+                "  parameters driving failures (rank correlation with failing): "
+                + ", ".join(f"{r['parameter']} {r['failure']:+.2f}" for r in top)
+            )
     return "\n".join(lines)

@@ -109,7 +109,12 @@ def noop(x=None):
 
 def columns_of(payload: dict) -> list[str]:
     """Result columns in order: index, grid index, draw, parameters, figures, status, reason."""
-    return ["sample", "grid_point", "draw"] + [p.name for p in payload["parameters"]] + list(payload["record"]) + ["status", "reason"]
+    return (
+        ["sample", "grid_point", "draw"]
+        + [p.name for p in payload["parameters"]]
+        + list(payload["record"])
+        + ["status", "reason"]
+    )
 
 
 def _geometry_key(data: dict) -> str:
@@ -131,8 +136,8 @@ def _drive(data, design):
 
 def _ke(payload, data, design, drive) -> dict:
     from ..accuracy import ke as K
-    from ..placement.imperfect import Imperfections
     from ..design.imperfections import ImperfectionsSpec
+    from ..placement.imperfect import Imperfections
 
     imp = Imperfections.from_spec(design.imperfections)
     # the table is built for the sweep's largest amplitudes (module docstring of sampling) and the
@@ -151,12 +156,18 @@ def _ke(payload, data, design, drive) -> dict:
     res = K.kinematic_error(drive, imp, table=tab)
     if res.deep_overlap_fraction > 0:
         # the figure exists only where its model holds (docs/models.md 6.2): this sample's is not recorded
-        raise ModelError(f"KE outside the linear error model: at {100 * res.deep_overlap_fraction:.1f} % of the angles the "
-                         f"first contact overlaps so deeply (turning back > {K.DEEP_OVERLAP * _AS:.0f} arcsec) that the "
-                         "model does not hold; more side clearance or smaller errors, or the elastic model (load figures)")
+        raise ModelError(
+            f"KE outside the linear error model: at {100 * res.deep_overlap_fraction:.1f} % of the angles the "
+            f"first contact overlaps so deeply (turning back > {K.DEEP_OVERLAP * _AS:.0f} arcsec) that the "
+            "model does not hold; more side clearance or smaller errors, or the elastic model (load figures)"
+        )
     lm = res.lost_motion
-    return {"ke_pp_arcsec": res.ke_pp * _AS, "lost_motion_min_arcsec": float(lm.min()) * _AS,
-            "lost_motion_max_arcsec": float(lm.max()) * _AS, "ke_deep_overlap_fraction": float(res.deep_overlap_fraction)}
+    return {
+        "ke_pp_arcsec": res.ke_pp * _AS,
+        "lost_motion_min_arcsec": float(lm.min()) * _AS,
+        "lost_motion_max_arcsec": float(lm.max()) * _AS,
+        "ke_deep_overlap_fraction": float(res.deep_overlap_fraction),
+    }
 
 
 def _audit(payload, data, drive) -> dict:
@@ -172,14 +183,19 @@ def _audit_run(payload, drive) -> dict:
     bw = drive.design.drive.face_width
     secs = np.unique(np.concatenate([drive.sections(payload["audit_sections"]), [0.0, bw]]))  # as wgcad audit
     r = audit(drive, AuditSettings(angles=np.deg2rad(np.arange(n) * (360.0 / n)), sections=secs))
-    return {"min_clearance_um": 1e3 * r.min_clearance, "entry_gap_um": 1e3 * r.entry_gap,
-            "backlash_arcmin": float(np.rad2deg(r.backlash) * 60.0) if np.isfinite(r.backlash) else math.nan}
+    return {
+        "min_clearance_um": 1e3 * r.min_clearance,
+        "entry_gap_um": 1e3 * r.entry_gap,
+        "backlash_arcmin": float(np.rad2deg(r.backlash) * 60.0) if np.isfinite(r.backlash) else math.nan,
+    }
 
 
 def _load(payload, data, design, drive, torques) -> dict:
     # the load model sees the geometry and [material], [bearing], [load]: not [imperfections]
-    key = _h([data.get(k) for k in ("drive", "tooth", "flexspline", "rigid", "generator", "material", "bearing", "load")]
-             + [payload["load_sections"], sorted(torques)])
+    key = _h(
+        [data.get(k) for k in ("drive", "tooth", "flexspline", "rigid", "generator", "material", "bearing", "load")]
+        + [payload["load_sections"], sorted(torques)]
+    )
     return dict(_cached("load", key, lambda: _load_run(payload, data, design, drive, torques)))
 
 
@@ -193,7 +209,14 @@ def _load_run(payload, data, design, drive, torques) -> dict:
     res = torque_sweep(model, sorted(torques), ld.cam_offset_um, ld.cam_offset_deg)
     out = {}
     for lv in res["levels"]:
-        for name in ("entry_gap_um", "teeth_in_contact", "min_clearance_um", "wind_up_arcmin", "largest_tooth_force_n", "max_ball_load_n"):
+        for name in (
+            "entry_gap_um",
+            "teeth_in_contact",
+            "min_clearance_um",
+            "wind_up_arcmin",
+            "largest_tooth_force_n",
+            "max_ball_load_n",
+        ):
             v = lv[name]
             out[f"{name}@{lv['torque_nm']:g}Nm"] = math.nan if v is None else float(v)
     return out
@@ -261,5 +284,11 @@ def run_batch(payload: dict, start: int, stop: int) -> dict:
     b0 = _STATS["built"]
     rows = [run_sample(payload, i) for i in range(start, stop)]
     cols = {c: [r.get(c) for r in rows] for c in columns_of(payload)}
-    return {"columns": cols, "start": start, "stop": stop, "compute_s": time.perf_counter() - t0,
-            "cpu_s": time.process_time() - c0, "built": _STATS["built"] - b0}
+    return {
+        "columns": cols,
+        "start": start,
+        "stop": stop,
+        "compute_s": time.perf_counter() - t0,
+        "cpu_s": time.process_time() - c0,
+        "built": _STATS["built"] - b0,
+    }

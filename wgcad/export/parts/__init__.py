@@ -35,7 +35,11 @@ def build_parts(drive, sizes, style: str = "arcs", tol: float | None = None, gen
     from . import assembly, bodies
 
     tol = drive.tol if tol is None else tol
-    out = [bodies.flexspline(drive, sizes, style, tol), bodies.plug(drive, sizes, tol), bodies.rigid(drive, sizes, style, tol)]
+    out = [
+        bodies.flexspline(drive, sizes, style, tol),
+        bodies.plug(drive, sizes, tol),
+        bodies.rigid(drive, sizes, style, tol),
+    ]
     for deg in generator_angles_deg:
         out.append(assembly.deformed_assembly(drive, sizes, deg, tol))
     return out

@@ -66,7 +66,9 @@ def deformed_assembly(drive, sizes, generator_angle_deg: float, tol: float) -> P
         law = drive.law_at(zc) if drive.coned else drive.law
         rim = _rot(_rot(deformed_curve(law, drive.r_m, drive.flex_rim_radius - drive.r_m, ph), phi_h), frame)
         if not shapely.LinearRing(outline).is_simple:
-            raise GeometryError(f"deformed flexspline outline at {generator_angle_deg:g} deg, z = {zc:.3f} mm is not simple")
+            raise GeometryError(
+                f"deformed flexspline outline at {generator_angle_deg:g} deg, z = {zc:.3f} mm is not simple"
+            )
         outer, hole = (rim, outline) if drive.external else (outline, rim)
         slices.append((outer, hole, z0, z1))
         vol += (_area(outer) - _area(hole)) * (z1 - z0)

@@ -106,9 +106,18 @@ def flexspline(drive, sizes, style: str, tol: float) -> Part:
         n = n_segments(r_rim + ts, tol)
         return to_trimesh(ring + (revolve_m(rz, n) - holes_m(holes, L - td, L, tol)))
 
-    info.update({"kind": "cup flexspline", "cup_length_mm": L, "shell_thickness_mm": ts, "diaphragm_thickness_mm": td,
-                 "hub_bore_diameter_mm": 2 * r_bore, "bolt_circle_diameter_mm": sizes.cup_bolt_circle_diameter,
-                 "bolt_count": sizes.cup_bolt_count, "bolt_hole_diameter_mm": sizes.cup_bolt_hole_diameter})
+    info.update(
+        {
+            "kind": "cup flexspline",
+            "cup_length_mm": L,
+            "shell_thickness_mm": ts,
+            "diaphragm_thickness_mm": td,
+            "hub_bore_diameter_mm": 2 * r_bore,
+            "bolt_circle_diameter_mm": sizes.cup_bolt_circle_diameter,
+            "bolt_count": sizes.cup_bolt_count,
+            "bolt_hole_diameter_mm": sizes.cup_bolt_hole_diameter,
+        }
+    )
     return Part("flexspline", layers, solid, mesh, vol, ((-tip_r, -tip_r, 0.0), (tip_r, tip_r, L)), info)
 
 
@@ -166,26 +175,46 @@ def plug(drive, sizes, tol: float) -> Part:
     z0, z1 = po["z_mm"] - 0.5 * width, po["z_mm"] + 0.5 * width
     rho = _min_curvature_radius(po["neutral"])
     if not drive.external and -off >= rho:
-        raise DesignError("parts.bearing_thickness", f"the bearing ({sizes.bearing_thickness:g} mm) does not fit the plug: its seat lies "
-                          f"{-off:.3f} mm inside the neutral line, beyond the line's smallest radius of curvature {rho:.3f} mm")
+        raise DesignError(
+            "parts.bearing_thickness",
+            f"the bearing ({sizes.bearing_thickness:g} mm) does not fit the plug: its seat lies "
+            f"{-off:.3f} mm inside the neutral line, beyond the line's smallest radius of curvature {rho:.3f} mm",
+        )
     if not shapely.LinearRing(outline).is_simple:
-        raise DesignError("parts.bearing_thickness", f"the bearing ({sizes.bearing_thickness:g} mm) does not fit the plug: its outline crosses itself")
+        raise DesignError(
+            "parts.bearing_thickness",
+            f"the bearing ({sizes.bearing_thickness:g} mm) does not fit the plug: its outline crosses itself",
+        )
     radii = np.hypot(*outline.T)
-    info = {"bearing_thickness_mm": sizes.bearing_thickness, "bearing_width_mm": width, "seat_offset_from_neutral_mm": off,
-            "generator_section_z_mm": po["z_mm"], "neutral_min_curvature_radius_mm": rho,
-            "plug_major_diameter_mm": 2 * float(radii.max()), "plug_minor_diameter_mm": 2 * float(radii.min())}
+    info = {
+        "bearing_thickness_mm": sizes.bearing_thickness,
+        "bearing_width_mm": width,
+        "seat_offset_from_neutral_mm": off,
+        "generator_section_z_mm": po["z_mm"],
+        "neutral_min_curvature_radius_mm": rho,
+        "plug_major_diameter_mm": 2 * float(radii.max()),
+        "plug_minor_diameter_mm": 2 * float(radii.min()),
+    }
     area = abs(shapely.Polygon(outline).area)
     perim = float(np.sum(np.hypot(*(np.roll(outline, -1, axis=0) - outline).T)))
     if not drive.external:
-        bore_d = sizes.plug_bore_diameter if sizes.plug_bore_diameter is not None else round(0.4 * 2 * float(radii.min()), 1)
+        bore_d = (
+            sizes.plug_bore_diameter if sizes.plug_bore_diameter is not None else round(0.4 * 2 * float(radii.min()), 1)
+        )
         if 0.5 * bore_d >= 0.9 * float(radii.min()):
-            raise DesignError("parts.plug_bore_diameter", f"{bore_d:g} mm does not fit the plug (smallest plug diameter {2 * radii.min():.3f} mm, "
-                              f"wall at least a tenth of its radius)")
+            raise DesignError(
+                "parts.plug_bore_diameter",
+                f"{bore_d:g} mm does not fit the plug (smallest plug diameter {2 * radii.min():.3f} mm, "
+                f"wall at least a tenth of its radius)",
+            )
         r_b = 0.5 * bore_d
         vol = (area - PI * r_b**2) * width
         info["plug_bore_diameter_mm"] = bore_d
-        layers = [DxfLayer("PLUG", outlines=(outline,), color=2), DxfLayer("PLUG_BORE", circles=((0.0, 0.0, r_b),), color=2),
-                  DxfLayer("NEUTRAL_LINE", outlines=(po["neutral"],), color=3)]
+        layers = [
+            DxfLayer("PLUG", outlines=(outline,), color=2),
+            DxfLayer("PLUG_BORE", circles=((0.0, 0.0, r_b),), color=2),
+            DxfLayer("NEUTRAL_LINE", outlines=(po["neutral"],), color=3),
+        ]
         name = "plug"
 
         def solid():
@@ -199,8 +228,10 @@ def plug(drive, sizes, tol: float) -> Part:
         R_out = float(radii.max()) + max(2.0, sizes.bearing_thickness)
         vol = (PI * R_out**2 - area) * width
         info["ring_outer_diameter_mm"] = 2 * R_out
-        layers = [DxfLayer("GENERATOR_RING", outlines=(outline,), circles=((0.0, 0.0, R_out),), color=2),
-                  DxfLayer("NEUTRAL_LINE", outlines=(po["neutral"],), color=3)]
+        layers = [
+            DxfLayer("GENERATOR_RING", outlines=(outline,), circles=((0.0, 0.0, R_out),), color=2),
+            DxfLayer("NEUTRAL_LINE", outlines=(po["neutral"],), color=3),
+        ]
         name = "generator_ring"
 
         def solid():
@@ -227,19 +258,32 @@ def rigid(drive, sizes, style: str, tol: float) -> Part:
     area = abs(path_area(path))
     R = drive.rigid_rim_radius
     dh = sizes.flange_bolt_hole_diameter
-    holes = bolt_circle(sizes.flange_bolt_circle_diameter, sizes.flange_bolt_count, dh, phase=PI / sizes.flange_bolt_count)
+    holes = bolt_circle(
+        sizes.flange_bolt_circle_diameter, sizes.flange_bolt_count, dh, phase=PI / sizes.flange_bolt_count
+    )
     hole_circles = tuple((x, y, 0.5 * h) for x, y, h in holes)
     hole_area = len(holes) * PI * (0.5 * dh) ** 2
     tf = sizes.flange_thickness
-    info = {"bolt_circle_diameter_mm": sizes.flange_bolt_circle_diameter, "bolt_count": sizes.flange_bolt_count, "bolt_hole_diameter_mm": dh}
+    info = {
+        "bolt_circle_diameter_mm": sizes.flange_bolt_circle_diameter,
+        "bolt_count": sizes.flange_bolt_count,
+        "bolt_hole_diameter_mm": dh,
+    }
     if not drive.external:
         Rf = 0.5 * sizes.flange_outer_diameter
         tip_r = Rf
         vol = (PI * R * R - area) * (bw - tf) + (PI * Rf * Rf - area - hole_area) * tf
         gl, data, _ = data_layer("rigid", g, tol, 1.15 * Rf, Rf, max(0.5, round(0.02 * 2 * R, 1)))
-        layers = [_teeth_layer("RIGID", g, path, style, 1, band), DxfLayer("RIGID_OUTER", circles=((0.0, 0.0, R),), color=1),
-                  DxfLayer("FLANGE", circles=((0.0, 0.0, Rf),), color=1), DxfLayer("FLANGE_BOLT_HOLES", circles=hole_circles, color=3), gl]
-        info.update({"kind": "rigid gear with mounting flange", "flange_outer_diameter_mm": 2 * Rf, "flange_thickness_mm": tf})
+        layers = [
+            _teeth_layer("RIGID", g, path, style, 1, band),
+            DxfLayer("RIGID_OUTER", circles=((0.0, 0.0, R),), color=1),
+            DxfLayer("FLANGE", circles=((0.0, 0.0, Rf),), color=1),
+            DxfLayer("FLANGE_BOLT_HOLES", circles=hole_circles, color=3),
+            gl,
+        ]
+        info.update(
+            {"kind": "rigid gear with mounting flange", "flange_outer_diameter_mm": 2 * Rf, "flange_thickness_mm": tf}
+        )
 
         def solid():
             # the whole gear at flange size, then the flange's excess cut away below it: a fuse of two
@@ -251,7 +295,9 @@ def rigid(drive, sizes, style: str, tol: float) -> Part:
             return S.cut(body, S.prism(S.circle_wire(Rf + 1.0), [S.circle_wire(R)], bw - tf + 1.0, -1.0))
 
         def mesh():
-            plate = prism_m(circle_points(Rf, tol), [band] + [circle_points(0.5 * h, tol, x, y) for x, y, h in holes], bw - tf, bw)
+            plate = prism_m(
+                circle_points(Rf, tol), [band] + [circle_points(0.5 * h, tol, x, y) for x, y, h in holes], bw - tf, bw
+            )
             if tf >= bw:
                 return to_trimesh(plate)
             return to_trimesh(prism_m(circle_points(R, tol), [band], 0.0, bw - tf) + plate)
@@ -259,15 +305,27 @@ def rigid(drive, sizes, style: str, tol: float) -> Part:
         tip_r = float(np.hypot(*g.outline.T).max())
         vol = (area - PI * R * R - hole_area) * bw
         gl, data, _ = data_layer("rigid", g, tol, 1.15 * tip_r, tip_r, max(0.5, round(0.02 * 2 * tip_r, 1)))
-        layers = [_teeth_layer("RIGID", g, path, style, 1, band), DxfLayer("RIGID_BORE", circles=((0.0, 0.0, R),), color=1),
-                  DxfLayer("BOLT_HOLES", circles=hole_circles, color=3), gl]
+        layers = [
+            _teeth_layer("RIGID", g, path, style, 1, band),
+            DxfLayer("RIGID_BORE", circles=((0.0, 0.0, R),), color=1),
+            DxfLayer("BOLT_HOLES", circles=hole_circles, color=3),
+            gl,
+        ]
         info["kind"] = "rigid gear (external teeth) with bolted hub"
 
         def solid():
-            return S.prism(S.wire_from_path(path.vertices, path.bulges),
-                           [S.circle_wire(R)] + [S.circle_wire(0.5 * h, x, y) for x, y, h in holes], bw)
+            return S.prism(
+                S.wire_from_path(path.vertices, path.bulges),
+                [S.circle_wire(R)] + [S.circle_wire(0.5 * h, x, y) for x, y, h in holes],
+                bw,
+            )
 
         def mesh():
-            return to_trimesh(prism_m(band, [circle_points(R, tol)] + [circle_points(0.5 * h, tol, x, y) for x, y, h in holes], 0.0, bw))
+            return to_trimesh(
+                prism_m(
+                    band, [circle_points(R, tol)] + [circle_points(0.5 * h, tol, x, y) for x, y, h in holes], 0.0, bw
+                )
+            )
+
     info["gear_data"] = data
     return Part("rigid", layers, solid, mesh, vol, ((-tip_r, -tip_r, 0.0), (tip_r, tip_r, bw)), info)

@@ -73,5 +73,11 @@ def to_trimesh(m):
 
 def bolt_circle(diameter: float, count: int, hole: float, phase: float = 0.0) -> list:
     """``[(cx, cy, hole)]`` of ``count`` holes evenly on a bolt circle, the first at angle ``phase``."""
-    return [(0.5 * diameter * math.cos(phase + 2 * math.pi * k / count), 0.5 * diameter * math.sin(phase + 2 * math.pi * k / count), hole)
-            for k in range(count)]
+    return [
+        (
+            0.5 * diameter * math.cos(phase + 2 * math.pi * k / count),
+            0.5 * diameter * math.sin(phase + 2 * math.pi * k / count),
+            hole,
+        )
+        for k in range(count)
+    ]
