@@ -11,7 +11,6 @@ import pytest
 
 from wgcad.atomic import atomic_batch
 from wgcad.errors import InputFileError, OutputError
-from wgcad.export import EXPORTERS
 from wgcad.export.dxf import DxfLayer, audit_dxf, build_dxf, clean_outline, read_dxf, write_dxf
 
 # DXF stores coordinates as decimal text; ezdxf writes Python's shortest
@@ -171,12 +170,11 @@ def test_write_is_atomic(tmp_path):
     assert sorted(p.name for p in tmp_path.iterdir()) == ["file"]
 
 
-def test_registry_and_batch(tmp_path):
-    assert EXPORTERS["dxf"] is write_dxf
+def test_batch_writes_both_files(tmp_path):
     layers = [DxfLayer("a", outlines=(star(1000),))]
     with atomic_batch() as batch:
-        EXPORTERS["dxf"](batch.temp_path(tmp_path / "one.dxf"), layers)
-        EXPORTERS["dxf"](batch.temp_path(tmp_path / "two.dxf"), layers)
+        write_dxf(batch.temp_path(tmp_path / "one.dxf"), layers)
+        write_dxf(batch.temp_path(tmp_path / "two.dxf"), layers)
     assert sorted(p.name for p in tmp_path.iterdir()) == ["one.dxf", "two.dxf"]
     assert max_error(read_dxf(tmp_path / "two.dxf")["a"]["outlines"][0], layers[0].outlines[0]) == 0.0
 

@@ -1,4 +1,4 @@
-"""File exporters (DXF outlines and arcs, STL, 3MF, STEP, SVG; the part set in parts/), atomic writes, and a registry keyed by file extension.
+"""File exporters (DXF outlines and arcs, STL, 3MF, STEP, SVG; the part set in parts/) and the pictures; the atomic writes they use live in :mod:`wgcad.atomic`.
 
 The DXF and STL modules import ezdxf, trimesh and manifold3d (together ~2 s
 on a cold start), so they are loaded on first use of a name that needs them
@@ -18,7 +18,6 @@ from wgcad.atomic import (
 )
 
 __all__ = [
-    "EXPORTERS",
     "atomic_batch",
     "atomic_write",
     "atomic_writer",
@@ -48,18 +47,7 @@ _LAZY = {
 
 
 def __getattr__(name):
-    if name == "EXPORTERS":
-        from wgcad.export.dxf import write_dxf
-        from wgcad.export.step import write_step
-        from wgcad.export.stl import write_stl
-        from wgcad.export.threemf import write_3mf
-
-        #: Exporters keyed by file extension (no dot): ``EXPORTERS[ext](path, obj)``
-        #: writes ``obj`` (a sequence of DxfLayer for "dxf", a trimesh.Trimesh
-        #: for "stl", ``{name: OCP shape}`` for "step", ``{name: trimesh}``
-        #: for "3mf") to ``path`` atomically.
-        value = {"dxf": write_dxf, "stl": write_stl, "step": write_step, "3mf": write_3mf}
-    elif name in _LAZY:
+    if name in _LAZY:
         value = getattr(importlib.import_module(_LAZY[name]), name)
     else:
         raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

@@ -52,7 +52,7 @@ import numpy as np
 
 from . import cycloid as cy
 from . import involute as iv
-from .gear import Gear, _involute_base_angle, make_gear, rotate
+from .gear import Gear, _involute_base_angle, rotate
 
 __all__ = [
     "flank_zone",
@@ -66,10 +66,6 @@ __all__ = [
     "concave_radii",
     "workshop_figures",
 ]
-
-
-def _sgn_outward(gear: Gear) -> float:
-    return -1.0 if gear.spec.internal else 1.0
 
 
 def flank_zone(gear: Gear) -> tuple[float, float]:
@@ -368,11 +364,6 @@ def workshop_figures(gear: Gear, measure_diameter: float | None = None, pin_diam
     out["smallest_concave_radius_mm"] = min(radii.values())
     out["thickness_method"] = "closed form"
     return out
-
-
-def fine_copy(gear: Gear, tol: float) -> Gear:
-    """The same gear sampled at another chord tolerance (for numerical checks)."""
-    return make_gear(gear.spec, tol)
 
 
 def _brentq(*args, **kwargs):

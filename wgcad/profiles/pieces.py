@@ -98,22 +98,6 @@ class Piece:
         """Second derivatives ``d2P/dt2``, ``(n, 2)``."""
         return self._eval(np.atleast_1d(np.asarray(t, dtype=float)), 2)
 
-    def jet(self, t) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """``(point, deriv, deriv2)`` at ``t``, each ``(n, 2)``, in one evaluation."""
-        t = np.atleast_1d(np.asarray(t, dtype=float))
-        k = self.kind
-        if k in ("arc", "line"):
-            return self._eval(t, 0), self._eval(t, 1), self._eval(t, 2)
-        if k == "involute":
-            out = _involute(self.params, t, -1)
-        else:
-            out = _cycloid(self.params, t, -1, 1.0 if k == "epicycloid" else -1.0)
-        if self.flip < 0:
-            out = [o * np.array([1.0, -1.0]) for o in out]
-        if self.rot:
-            out = [_rot(o, self.rot) for o in out]
-        return tuple(out)
-
     def length(self, n: int = 64) -> float:
         """Arc length (Gauss-Legendre on ``n`` nodes; exact for arcs and lines), mm."""
         if self.kind == "arc":

@@ -49,10 +49,6 @@ def _pappus(rz) -> float:
     return 2.0 * PI * abs(float(val))
 
 
-def _surface_bound(perimeters_mm, height_mm) -> float:
-    return float(np.sum(perimeters_mm)) * height_mm
-
-
 def flexspline(drive, sizes, style: str, tol: float) -> Part:
     """The cup flexspline (internal deformation) or the internally toothed flexible ring (external)."""
     from wgcad.export import step as S
