@@ -16,7 +16,8 @@ ROOT = Path(__file__).resolve().parent.parent / "wgcad"
 #: ground first; a unit is a top-level module or package of wgcad
 FLOORS = [
     {"errors", "constants"},
-    {"atomic", "design"},
+    {"numbers", "userfiles", "atomic"},
+    {"design"},
     {"laws"},
     {"kinematics"},
     {"profiles"},

@@ -219,3 +219,63 @@ def test_workers_undo_the_nannys_malloc_tuning():
     if faults["plain"] < 40 * 100:
         pytest.skip(f"this allocator does not fault in every array anew ({faults['plain']} faults): nothing to undo")
     assert faults["fix"] < 0.1 * faults["plain"], faults
+
+
+def _summary_only(spec, out):
+    """What `wgcad sweep --summary-only` reads: every chunk, checked against the spec."""
+    from wgcad.sweep.sampling import chunk_check
+
+    pl = spec.payload()
+    return Store(out, pl["fingerprint"], columns_of(pl), spec.total).open().read(check=chunk_check(pl))
+
+
+@pytest.fixture()
+def folder(tmp_path):
+    out = tmp_path / "o"
+    run_sweep(_spec(), out, workers=0, batch=4)  # chunks [0, 4), [4, 8), [8, 12)
+    return out
+
+
+def test_a_truncated_chunk_is_named(folder):
+    p = sorted((folder / "chunks").iterdir())[1]
+    p.write_bytes(p.read_bytes()[:100])
+    with pytest.raises(OutputError, match=f"{p.name}: damaged chunk"):
+        _summary_only(_spec(), folder)
+
+
+def test_a_folder_named_like_a_chunk_is_named(folder):
+    (folder / "chunks" / "chunk-000000012-000000013.parquet").mkdir()
+    with pytest.raises(OutputError, match="outside this sweep|not a regular file"):
+        _summary_only(_spec(), folder)
+    (folder / "chunks" / "chunk-000000012-000000013.parquet").rmdir()
+    (folder / "chunks" / "chunk-000000002-000000003.parquet").mkdir()
+    with pytest.raises(OutputError, match="not a regular file"):
+        _summary_only(_spec(), folder)
+
+
+def test_an_overlapping_chunk_is_refused_not_counted_twice(folder):
+    # before, "12 of 6 samples stored" entered the yield and its interval
+    src = folder / "chunks" / "chunk-000000004-000000008.parquet"
+    dup = folder / "chunks" / "chunk-000000004-000000006.parquet"
+    import pyarrow.parquet as pq
+
+    pq.write_table(pq.read_table(src).slice(0, 2), dup)
+    with pytest.raises(OutputError, match="hold the same samples"):
+        _summary_only(_spec(), folder)
+    with pytest.raises(OutputError, match="hold the same samples"):
+        run_sweep(_spec(), folder, workers=0)  # a resume refuses it too
+
+
+def test_a_chunk_of_another_spec_is_refused(folder, tmp_path):
+    other = tmp_path / "other"
+    run_sweep(_spec(seed=6), other, workers=0, batch=4)
+    name = "chunk-000000004-000000008.parquet"
+    (folder / "chunks" / name).write_bytes((other / "chunks" / name).read_bytes())
+    with pytest.raises(OutputError, match="another spec"):
+        _summary_only(_spec(), folder)
+
+
+def test_a_sweep_record_that_is_not_an_object_is_refused(folder, capsys):
+    (folder / "sweep.json").write_text("[]")
+    with pytest.raises(OutputError, match="not a sweep record"):
+        _summary_only(_spec(), folder)

@@ -8,7 +8,9 @@ from pathlib import Path
 
 import numpy as np
 
-from .errors import InputFileError
+from .errors import DesignError, InputFileError
+from .numbers import read_float, read_int
+from .userfiles import read_user_text
 
 __all__ = ["FORMAT", "Drift", "baseline_figures", "make_baseline", "load_baseline", "compare", "format_drifts"]
 
@@ -76,21 +78,58 @@ def make_baseline(design_source: str, settings: dict, drive, audit_json: dict) -
     }
 
 
+#: largest baseline file read, bytes: a baseline holds about a dozen figures (~2 kB)
+MAX_BASELINE_BYTES = 1 << 20
+
+
 def load_baseline(path) -> dict:
-    """Read a baseline file; :class:`InputFileError` on anything that is not one."""
+    """Read and check a baseline file: its settings and every figure are validated before use.
+
+    Raises
+    ------
+    InputFileError
+        Anything that is not a regular file of at most :data:`MAX_BASELINE_BYTES` holding a wgcad
+        baseline: one line naming the part that is wrong.
+    """
     p = Path(path)
+    text = read_user_text(p, "baseline file", MAX_BASELINE_BYTES, "JSON")
     try:
-        doc = json.loads(p.read_text())
-    except FileNotFoundError:
-        raise InputFileError(f"{p}: baseline file not found") from None
-    except (OSError, ValueError) as e:
+        doc = json.loads(text, parse_constant=_no_constant)
+    except ValueError as e:
         raise InputFileError(f"{p}: not a readable JSON baseline ({e})") from None
     if not isinstance(doc, dict) or doc.get("wgcad_baseline") != FORMAT or not isinstance(doc.get("figures"), dict):
         raise InputFileError(f"{p}: not a wgcad baseline (format {FORMAT})")
+    st = doc.get("settings")
+    if not isinstance(st, dict):
+        raise InputFileError(f"{p}: settings must be a JSON object, got {type(st).__name__}")
     for key in ("step_deg", "sections", "chord_tol_um", "interference_tol_um"):
-        if key not in doc.get("settings", {}):
+        if key not in st:
             raise InputFileError(f"{p}: settings.{key} is missing")
+        try:
+            st[key] = (
+                read_int(f"settings.{key}", st[key]) if key == "sections" else read_float(f"settings.{key}", st[key])
+            )
+        except DesignError as e:
+            raise InputFileError(f"{p}: {e}") from None
+    for key, fig in doc["figures"].items():
+        where = f"figures.{key}"
+        if not isinstance(fig, dict) or "value" not in fig:
+            raise InputFileError(f"{p}: {where} must be an object with a value")
+        v = fig["value"]
+        try:
+            if v is not None and not isinstance(v, bool):
+                fig["value"] = read_float(f"{where}.value", v)
+            tol = read_float(f"{where}.tol", fig.get("tol", 0.0))
+        except DesignError as e:
+            raise InputFileError(f"{p}: {e}") from None
+        if tol < 0:
+            raise InputFileError(f"{p}: {where}.tol must be >= 0, got {tol:g}")
+        fig["tol"] = tol
     return doc
+
+
+def _no_constant(name: str):
+    raise ValueError(f"{name} is not a number a baseline may hold")
 
 
 def compare(baseline: dict, current: dict) -> list[Drift]:

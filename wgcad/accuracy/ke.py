@@ -50,7 +50,7 @@ from math import pi
 import numpy as np
 
 from ..clearance.closing import closing_direct
-from ..errors import DesignError
+from ..errors import DesignError, ModelError
 from ..kinematics import gear_ratios
 from ..placement.imperfect import Imperfections
 from .ke_table import DEFAULT_N, ContactTable, LanePlan, _harmonics, _lanes, contact_table, lane_minimum
@@ -152,6 +152,7 @@ def kinematic_error(
     if tab.cam_cam != (imp.cam_cam, imp.cam_cam_phase):
         raise DesignError("imperfections.cam_offset_cam_um", "the contact table was built for another cam-borne offset")
     I = _record(tab) if samples is None else int(samples)
+    _require_contacts(tab)
     lw, ln = _lanes(tab, tab.side_w, imp), _lanes(tab, -tab.side_w, imp)
     dw, dn = np.empty(I), np.empty(I)
     deep = np.zeros(I, dtype=bool)
@@ -162,6 +163,12 @@ def kinematic_error(
             g = tab.sides[side]["g"]
             out[a : a + len(i)], e = lane_minimum(tab, lanes, g, co[side], i)
             deep[a : a + len(i)] |= (e >= 0) & (g[np.maximum(e, 0)] < -DEEP_OVERLAP)
+    if not (np.all(np.isfinite(dw)) and np.all(np.isfinite(dn))):
+        free = int(np.count_nonzero(~(np.isfinite(dw) & np.isfinite(dn))))
+        raise ModelError(
+            f"the flexspline turns freely at {free} of {I} generator angles (no tooth within reach of a rigid tooth "
+            "on one side): the output is not driven there and has no KE; check the tooth heights and W0 (wgcad audit)"
+        )
     theta, lm = _theta(tab, dw, dn)
     phi_h = tab.sigma * np.arange(I) * 2 * pi / (tab.z_b * tab.N)
     eng = "single-flank (backlash)" if lm.min() >= 0 else "double-flank (interference)" if lm.max() < 0 else "mixed"
@@ -179,6 +186,17 @@ def kinematic_error(
     )
 
 
+def _require_contacts(tab: ContactTable) -> None:
+    """Refuse a drive whose teeth never come within reach of each other (:class:`~wgcad.errors.ModelError`)."""
+    for side in (tab.side_w, -tab.side_w):
+        if not len(tab.sides[side]["g"]):
+            which = "working" if side == tab.side_w else "non-working"
+            raise ModelError(
+                f"no tooth of the flexspline comes within reach of a rigid tooth on its {which} side at any generator "
+                "angle: the output is not driven and has no KE; check the tooth heights, the shifts and W0 (wgcad audit)"
+            )
+
+
 def install_angle_scan(tab: ContactTable, imp: Imperfections, angles, lever: str = "rigid") -> np.ndarray:
     """Largest KE (rad) for each installation angle (rad) of the rigid gear (``lever="rigid"``) or the flexspline."""
     if lever not in ("rigid", "flex"):
@@ -186,6 +204,7 @@ def install_angle_scan(tab: ContactTable, imp: Imperfections, angles, lever: str
     ang = np.atleast_1d(np.asarray(angles, dtype=float))
     ca, sa = np.cos(ang), np.sin(ang)
     I = _record(tab)
+    _require_contacts(tab)
     lw, ln = _lanes(tab, tab.side_w, imp), _lanes(tab, -tab.side_w, imp)  # the bounds hold for every angle
     hi = np.full(len(ang), -np.inf)
     lo = np.full(len(ang), np.inf)

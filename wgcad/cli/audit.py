@@ -128,7 +128,7 @@ def cmd_audit(args) -> int:
 
         drifts = compare(base, baseline_figures(drive, res))
         res["baseline"] = {"path": str(args.baseline), "drifts": [d.__dict__ for d in drifts]}
-    res_text = json.dumps(res, indent=2) + "\n"
+    res_text = json.dumps(res, allow_nan=False, indent=2) + "\n"
     base_text = None
     if args.write_baseline:
         from ..regression import make_baseline
@@ -143,7 +143,7 @@ def cmd_audit(args) -> int:
             drive,
             res,
         )
-        base_text = json.dumps(doc, indent=2) + "\n"
+        base_text = json.dumps(doc, allow_nan=False, indent=2) + "\n"
     files = [(args.json, res_text), (args.write_baseline, base_text)]
     if any(p and p != STDOUT for p, _ in files) or args.plot:
         from ..atomic import atomic_batch

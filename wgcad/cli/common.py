@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import argparse
 import contextlib
+import math
 import os
 import signal
 import sys
@@ -157,6 +158,32 @@ def positive_float(lo: float, hi: float, unit: str):
             raise argparse.ArgumentTypeError(f"'{text}' is not a number") from None
         if not lo < val <= hi:
             raise argparse.ArgumentTypeError(f"must be in ({lo:g}, {hi:g}] {unit}, got {val:g}")
+        return val
+
+    return conv
+
+
+def key_float(table: str, key: str):
+    """An argparse type for a flag that sets design key ``[table] key``: the key's own bounds and unit
+    (:mod:`wgcad.design.rules`), so a flag and its key accept the same values. The schema is read only when the
+    flag is given (``wgcad --help`` stays light)."""
+
+    def conv(text: str) -> float:
+        from dataclasses import fields
+
+        from ..design.rules import key_meta
+        from ..design.schema import _TABLES as TABLES
+
+        meta = key_meta(next(f for f in fields(TABLES[table]) if f.name == key))
+        lo, hi, unit = float(meta["lo"]), float(meta["hi"]), meta.get("unit") or ""
+        try:
+            val = float(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"'{text}' is not a number") from None
+        if not (math.isfinite(val) and lo <= val <= hi):
+            raise argparse.ArgumentTypeError(
+                f"must be in [{lo:g}, {hi:g}] {unit} (as the key [{table}] {key}), got {val:g}"
+            )
         return val
 
     return conv

@@ -263,7 +263,9 @@ def cmd_generate(args) -> int:
         report_path = out / report_name(stem)
         rep["files"] = [p.name for p in files] + [report_path.name]
         # no timings in the report: the same design must give byte-identical files
-        Path(batch.temp_path(report_path)).write_text(json.dumps(rep, indent=2, sort_keys=False) + "\n")
+        Path(batch.temp_path(report_path)).write_text(
+            json.dumps(rep, allow_nan=False, indent=2, sort_keys=False) + "\n"
+        )
         files.append(report_path)
         # the previous run's files for this design that this run does not write again go with the commit
         stale, kept = manifest.stale_files(p.name for p in files)
@@ -275,7 +277,7 @@ def cmd_generate(args) -> int:
     for name in kept:
         print(f"wgcad: warning: kept {out / name}: an earlier run wrote it, but it was changed since", file=sys.stderr)
     if args.json:
-        write_stdout(json.dumps(rep, indent=2) + "\n")
+        write_stdout(json.dumps(rep, allow_nan=False, indent=2) + "\n")
     elif not args.quiet:
         removed = f", removed {len(stale)} of the previous run's files" if stale else ""
         write_stdout(

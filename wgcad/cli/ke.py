@@ -111,7 +111,7 @@ def cmd_ke(args) -> int:
         )
     with atomic_batch() as batch:
         if args.json:
-            Path(batch.temp_path(Path(args.json))).write_text(json.dumps(out, indent=2))
+            Path(batch.temp_path(Path(args.json))).write_text(json.dumps(out, allow_nan=False, indent=2))
         if args.plot:
             from ..export.ke_figures import flank_png, install_png, ke_png
 

@@ -7,7 +7,7 @@ import sys
 from pathlib import Path
 
 from ..errors import DesignError
-from .common import EXIT_INTERFERENCE, EXIT_OK, Progress
+from .common import EXIT_INTERFERENCE, EXIT_OK, Progress, key_float
 
 __all__ = ["register_args", "run_load", "torque_levels", "RATED", "RATED_STEPS"]
 
@@ -52,13 +52,13 @@ def register_args(a) -> None:
     )
     g.add_argument(
         "--cam-offset-um",
-        type=float,
+        type=key_float("load", "cam_offset_um"),
         default=None,
         help="cam axis offset e_h, um (default: [load] of the design, else 0)",
     )
     g.add_argument(
         "--cam-offset-deg",
-        type=float,
+        type=key_float("load", "cam_offset_deg"),
         default=None,
         help="direction of e_h from the major axis, deg (default: [load], else 0)",
     )
@@ -196,7 +196,7 @@ def run_load(args) -> int:
         res["compare"] = compare
     with atomic_batch() as batch:
         if args.json:
-            Path(batch.temp_path(args.json)).write_text(json.dumps(res, indent=2) + "\n")
+            Path(batch.temp_path(args.json)).write_text(json.dumps(res, allow_nan=False, indent=2) + "\n")
         if args.plot:
             from ..export.load_figures import entry_gap_png, force_distribution_png
 

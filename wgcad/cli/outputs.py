@@ -174,4 +174,4 @@ class Manifest:
             for final, temp in written
         ]
         doc = {"written_by": "wgcad generate", "design": self.stem, "source": self.source, "files": files}
-        return json.dumps(doc, indent=1) + "\n"
+        return json.dumps(doc, allow_nan=False, indent=1) + "\n"

@@ -114,10 +114,10 @@ def cmd_parts(args) -> int:
                 if p.name.startswith("assembly"):
                     write_3mf(target(f"{stem}_{p.name}.3mf"), {f"{p.name}_{k}": m for k, m in p.info["meshes"].items()})
         report["files"] = [f.name for f in files] + ["parts.json"]
-        Path(target("parts.json")).write_text(json.dumps(report, indent=2) + "\n")
+        Path(target("parts.json")).write_text(json.dumps(report, allow_nan=False, indent=2) + "\n")
         files.pop()
     if args.json:
-        print(json.dumps(report, indent=2))
+        print(json.dumps(report, allow_nan=False, indent=2))
     elif not args.quiet:
         print(f"{design.drive.name}: {len(parts)} parts ({', '.join(p.name for p in parts)})")
         for k in sizes.derived:

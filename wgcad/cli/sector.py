@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from .common import EPILOG, EXIT_INTERFERENCE, EXIT_OK, _UsageError, out_dir, positive_float
+from .common import EPILOG, EXIT_INTERFERENCE, EXIT_OK, _UsageError, add_memory_flag, out_dir, positive_float
 
 __all__ = ["register", "cmd_sector", "run_sector"]
 
@@ -172,8 +172,13 @@ def cmd_sector(args) -> int:
 
     from ..atomic import atomic_batch, ensure_writable_dir
     from ..design import load_design
+    from ..design.budget import check_sector_budget
+    from ..sector.scene import DEFAULT_STEP_DEG
 
     design = load_design(args.design)
+    check_sector_budget(
+        design.drive.z_flex, DEFAULT_STEP_DEG if args.step_deg is None else args.step_deg, args.max_memory_mb
+    )
     out = out_dir(args, args.design)
     ensure_writable_dir(out)
     res = run_sector(design, args.heights, args.assign, args.step_deg, args.tip_clearance_um)
@@ -308,9 +313,11 @@ def cmd_sector(args) -> int:
         write_dxf(batch.temp_path(out / f"{stem}_sector_rigid.dxf"), layers)
         if mesh is not None:
             write_stl(batch.temp_path(out / f"{stem}_sector_rigid.stl"), mesh)
-        Path(batch.temp_path(out / f"{stem}_sector.json")).write_text(json.dumps(summ, indent=2) + "\n")
+        Path(batch.temp_path(out / f"{stem}_sector.json")).write_text(
+            json.dumps(summ, allow_nan=False, indent=2) + "\n"
+        )
     if args.json:
-        print(json.dumps(summ, indent=2))
+        print(json.dumps(summ, allow_nan=False, indent=2))
     else:
         _print_summary(name, res, summ, out)
     return EXIT_INTERFERENCE if res["audit_built"].has_tip_to_tip else EXIT_OK
@@ -408,4 +415,5 @@ def register(sub) -> None:
     )
     s.add_argument("--no-stl", action="store_true", help="skip the STL solid")
     s.add_argument("--json", action="store_true", help="print the summary as JSON")
+    add_memory_flag(s)
     s.set_defaults(func=cmd_sector)

@@ -63,13 +63,17 @@ def cmd_sweep(args) -> int:
     if args.summary_only:
         store.open()
     bar.set(1.0, "summary")
-    cols = store.read()
+    from ..sweep.sampling import chunk_check
+
+    cols = store.read(check=chunk_check(payload))
     summ = summarize(spec, cols)
     if info is not None:
         summ["run"] = {k: v for k, v in info.__dict__.items()}
     summ["results"] = {"folder": str(out), "format": store.fmt, "chunks": len(store.done_ranges())}
     with atomic_batch() as batch:
-        Path(batch.temp_path(out / "summary.json")).write_text(json.dumps(summ, indent=2, default=str) + "\n")
+        Path(batch.temp_path(out / "summary.json")).write_text(
+            json.dumps(summ, allow_nan=False, indent=2, default=str) + "\n"
+        )
         if not args.no_plots and len(cols["sample"]):
             from ..export.sweep_figures import sweep_pngs
 

@@ -18,7 +18,15 @@ from math import ceil, sqrt
 from .. import constants
 from ..errors import DesignError
 
-__all__ = ["DEFAULT_MAX_MEMORY_MB", "RunEstimate", "outline_vertices_per_tooth", "estimate_run", "check_budget"]
+__all__ = [
+    "DEFAULT_MAX_MEMORY_MB",
+    "RunEstimate",
+    "outline_vertices_per_tooth",
+    "estimate_run",
+    "check_budget",
+    "estimate_sector_mb",
+    "check_sector_budget",
+]
 
 #: Memory a run may use by default, MB. The bundled templates need 0.1-0.2 GB
 #: for ``generate`` and a default ``audit``; 2 GB fits beside other work on a
@@ -146,6 +154,33 @@ def estimate_run(
             + batch * p * _PER_BATCH_VERTEX_B
         )
     return RunEstimate(verts, int(n_out), int(samples), mem / 1e6)
+
+
+# `wgcad sector`: its sweeps hold every (generator angle, flexspline tooth) pair of half a turn at once.
+# Measured peak RSS of `wgcad sector templates/d4_sectored.toml --no-stl` (84 teeth, /usr/bin/time -f %M):
+# 466 MB at 0.1 deg, 886 MB at 0.05, 2146 MB at 0.02, 4248 MB at 0.01: 45 MB plus 2.78 kB per pair;
+# the estimate takes 20 % more per pair
+_SECTOR_BASE_MB = 45.0
+_SECTOR_PER_PAIR_B = 1.2 * 2.78e3
+
+
+def estimate_sector_mb(z_flex: int, step_deg: float) -> float:
+    """Memory (MB) of ``wgcad sector`` at generator-angle step ``step_deg`` for ``z_flex`` flexspline teeth."""
+    angles = round(180.0 / step_deg)
+    return _SECTOR_BASE_MB + _SECTOR_PER_PAIR_B * angles * z_flex / 1e6
+
+
+def check_sector_budget(z_flex: int, step_deg: float, max_memory_mb: float | None = DEFAULT_MAX_MEMORY_MB) -> float:
+    """Refuse a sector run whose estimated memory exceeds ``max_memory_mb`` (one line naming --step-deg)."""
+    mb = estimate_sector_mb(z_flex, step_deg)
+    if max_memory_mb is not None and mb > max_memory_mb:
+        raise DesignError(
+            "--step-deg",
+            f"a step of {step_deg:g} deg needs about {mb:.0f} MB ({round(180.0 / step_deg)} generator angles x "
+            f"{z_flex} teeth held at once), more than the budget of {max_memory_mb:g} MB; coarsen --step-deg or "
+            "raise --max-memory-mb",
+        )
+    return mb
 
 
 def check_budget(

@@ -9,6 +9,7 @@ from dataclasses import dataclass, fields
 from pathlib import Path
 
 from ..errors import DesignError, InputFileError
+from ..numbers import read_float
 
 __all__ = ["PartsSpec", "PartSizes", "parse_parts", "load_parts", "part_sizes", "MAX_PART_MM", "MAX_BOLTS", "PARTS_DOC"]
 
@@ -92,14 +93,9 @@ def parse_parts(data) -> PartsSpec:
             if isinstance(value, bool) or not isinstance(value, int) or not 1 <= value <= MAX_BOLTS:
                 raise DesignError(where, f"must be a whole number 1..{MAX_BOLTS}, got {value!r}")
         else:
-            if (
-                isinstance(value, bool)
-                or not isinstance(value, (int, float))
-                or not math.isfinite(value)
-                or not 0 < value <= MAX_PART_MM
-            ):
+            value = read_float(where, value)
+            if not 0 < value <= MAX_PART_MM:
                 raise DesignError(where, f"must be a positive number of mm up to {MAX_PART_MM:g}, got {value!r}")
-            value = float(value)
         kw[key] = value
     return PartsSpec(**kw)
 

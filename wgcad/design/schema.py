@@ -8,6 +8,7 @@ import typing
 from dataclasses import MISSING, dataclass, fields, replace
 
 from ..errors import DesignError
+from ..numbers import read_float, read_int
 from .imperfections import ImperfectionsSpec, validate_imperfections
 from .load import BearingSpec, LoadSpec, MaterialSpec, validate_load_tables
 from .rules import Rel, check_bounds, show
@@ -345,16 +346,9 @@ def _coerce(table: str, key: str, value, tp):
     base, optional = _base_type(tp)
     where = f"{table}.{key}"
     if base is float:
-        if isinstance(value, bool) or not isinstance(value, (int, float)):
-            raise DesignError(where, f"must be a number, got {type(value).__name__} {show(value)}")
-        value = float(value)
-        if not math.isfinite(value):
-            raise DesignError(where, f"must be finite, got {value}")
-        return value
+        return read_float(where, value)
     if base is int:
-        if isinstance(value, bool) or not isinstance(value, int):
-            raise DesignError(where, f"must be a whole number, got {type(value).__name__} {show(value)}")
-        return value
+        return read_int(where, value)
     if base is str:
         if not isinstance(value, str):
             raise DesignError(where, f"must be a string, got {type(value).__name__} {show(value)}")

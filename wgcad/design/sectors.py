@@ -3,10 +3,10 @@
 from __future__ import annotations
 
 import difflib
-import math
 from dataclasses import dataclass, fields
 
 from ..errors import DesignError
+from ..numbers import read_float, read_int
 from .rules import key as _key
 
 __all__ = ["SectorsSpec", "KINDS", "HEIGHT_MODES", "validate_sectors", "sector_pitch_z"]
@@ -142,15 +142,9 @@ class SectorsSpec:
 def _scalar(table, key, value, tp):
     where = f"{table}.{key}"
     if tp is float:
-        if isinstance(value, bool) or not isinstance(value, (int, float)):
-            raise DesignError(where, f"must be a number, got {type(value).__name__} {value!r}")
-        if not math.isfinite(value):
-            raise DesignError(where, f"must be finite, got {value}")
-        return float(value)
+        return read_float(where, value)
     if tp is int:
-        if isinstance(value, bool) or not isinstance(value, int):
-            raise DesignError(where, f"must be a whole number, got {type(value).__name__} {value!r}")
-        return value
+        return read_int(where, value)
     if not isinstance(value, str):
         raise DesignError(where, f"must be a string, got {type(value).__name__} {value!r}")
     return value

@@ -190,7 +190,15 @@ def torque_sweep(
         "cam_offset_deg": cam_offset_deg,
         "model": {
             "ring_ei_n_mm2": {k: round(v, 1) for k, v in model.ei_parts.items()},
-            "cup_torsional_stiffness_nm_per_rad": round(model.cup_stiffness * 1e-3, 1),
+            # a cup without a length (no coning) is taken as rigid in torsion: no finite figure to give
+            "cup_torsional_stiffness_nm_per_rad": (
+                round(model.cup_stiffness * 1e-3, 1) if np.isfinite(model.cup_stiffness) else None
+            ),
+            "cup_torsional_stiffness_note": (
+                None
+                if np.isfinite(model.cup_stiffness)
+                else "rigid: the design gives no cup length (generator.cone_length)"
+            ),
             "bearing_clearance_um": round(1e3 * model.bearing.clearance, 3),
             "mounted": mounted_summary(model, states[0].cam_offset if states else np.zeros(2)),
             "sections_z_mm": [float(z) for z in model.zs],

@@ -15,7 +15,7 @@ import copy
 
 import numpy as np
 
-__all__ = ["split_index", "sample_values", "sample_design_data", "envelope_amplitudes_um"]
+__all__ = ["split_index", "sample_values", "sample_design_data", "envelope_amplitudes_um", "chunk_check"]
 
 
 def split_index(i: int, samples: int, grid_shape: tuple) -> tuple[tuple, int]:
@@ -72,3 +72,29 @@ def envelope_amplitudes_um(base_spec, params) -> dict:
         if p.table == "imperfections" and p.key in amp:
             amp[p.key] = max(amp[p.key], max(0.0, p.reach()))
     return amp
+
+
+def chunk_check(payload: dict):
+    """A check for :meth:`wgcad.sweep.store.Store.read`: a chunk's parameter columns must be the values this spec
+    draws for its samples (bit for bit), so a chunk of another spec (another seed, distribution or grid) left in
+    the folder is named and refused instead of entering the yield."""
+    from ..errors import OutputError
+
+    names = [p.name for p in payload["parameters"]]
+
+    def check(a: int, b: int, cols: dict) -> None:
+        for i in range(a, b):
+            want = sample_values(payload, i)
+            for n in names:
+                got = cols[n][i - a]
+                w = want[n]
+                same = (
+                    got == w if isinstance(w, str) else isinstance(got, (int, float, np.floating)) and float(got) == w
+                )
+                if not same:
+                    raise OutputError(
+                        f"chunk of samples [{a}, {b}): sample {i} has {n} = {got!r}, this spec draws {w!r}; the "
+                        "chunk is of another spec: remove it"
+                    )
+
+    return check

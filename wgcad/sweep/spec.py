@@ -34,12 +34,12 @@ from __future__ import annotations
 import difflib
 import hashlib
 import json
-import math
 import tomllib
 from dataclasses import dataclass, fields
 from pathlib import Path
 
 from ..errors import DesignError, InputFileError
+from ..numbers import read_float, show_value
 
 __all__ = ["Parameter", "SweepSpec", "parse_spec", "load_spec", "MAX_SAMPLES", "DISTRIBUTIONS"]
 
@@ -172,14 +172,12 @@ def _unknown(where: str, keys, known) -> None:
 
 
 def _number(where: str, v) -> float:
-    if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v):
-        raise DesignError(where, f"must be a finite number, got {v!r}")
-    return float(v)
+    return read_float(where, v)
 
 
 def _whole(where: str, v, lo: int, hi: int) -> int:
     if isinstance(v, bool) or not isinstance(v, int) or not lo <= v <= hi:
-        raise DesignError(where, f"must be a whole number in [{lo}, {hi}], got {v!r}")
+        raise DesignError(where, f"must be a whole number in [{lo}, {hi}], got {show_value(v)}")
     return v
 
 

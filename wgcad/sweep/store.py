@@ -21,10 +21,13 @@ import os
 import re
 from pathlib import Path
 
-from ..errors import OutputError
+from ..errors import InputFileError, OutputError
+from ..userfiles import read_user_text
 
 __all__ = ["Store", "have_pyarrow"]
 
+#: a sweep record is a few hundred bytes
+_MAX_META_BYTES = 1 << 20
 _NAME = re.compile(r"^chunk-(\d{9})-(\d{9})\.(parquet|csv)$")
 
 
@@ -64,11 +67,13 @@ class Store:
         from ..atomic import atomic_write, ensure_writable_dir, remove_stale_temps
 
         meta = self.folder / "sweep.json"
-        if meta.exists():
+        if meta.exists() or meta.is_symlink():
             try:
-                old = json.loads(meta.read_text())
-            except (OSError, ValueError) as e:
+                old = json.loads(read_user_text(meta, "sweep record", _MAX_META_BYTES, "JSON"))
+            except (InputFileError, ValueError) as e:
                 raise OutputError(f"{meta}: unreadable sweep record ({e}); choose another --out") from None
+            if not isinstance(old, dict):
+                raise OutputError(f"{meta}: not a sweep record (a JSON object); choose another --out")
             if old.get("fingerprint") != self.fingerprint:
                 raise OutputError(
                     f"{self.folder}: holds the results of another sweep spec (fingerprint {old.get('fingerprint')}, "
@@ -91,15 +96,35 @@ class Store:
         return self
 
     def done_ranges(self) -> list[tuple[int, int]]:
-        """Sample ranges ``[a, b)`` of the chunks present, sorted."""
+        """Sample ranges ``[a, b)`` of the chunks present, sorted.
+
+        Raises
+        ------
+        OutputError
+            A chunk's name that is not a regular file, a range outside ``[0, total)``, or two chunks holding the
+            same samples (named, so the user can remove one: the samples are then recomputed or kept once).
+        """
         out = []
         if not self.chunks.is_dir():
             return out
         for f in os.listdir(self.chunks):
             m = _NAME.match(f)
             if m and m.group(3) == self.fmt:
-                out.append((int(m.group(1)), int(m.group(2))))
-        return sorted(out)
+                a, b = int(m.group(1)), int(m.group(2))
+                p = self.chunks / f
+                if p.is_symlink() or not p.is_file():
+                    raise OutputError(f"{p}: named like a chunk but not a regular file; remove it")
+                if not 0 <= a < b <= self.total:
+                    raise OutputError(f"{p}: samples [{a}, {b}) outside this sweep's [0, {self.total}); remove it")
+                out.append((a, b))
+        out.sort()
+        for (a0, b0), (a1, b1) in zip(out, out[1:]):
+            if a1 < b0:
+                raise OutputError(
+                    f"{self.path(a0, b0)} and {self.path(a1, b1)} hold the same samples [{a1}, {min(b0, b1)}); "
+                    "remove one (its samples are computed again if missing)"
+                )
+        return out
 
     def missing(self) -> list[tuple[int, int]]:
         """Sample ranges not yet in any chunk."""
@@ -156,11 +181,31 @@ class Store:
         return s.getvalue().encode()
 
     # -- reading -------------------------------------------------------------
-    def read(self) -> dict:
-        """All chunks present, concatenated and sorted by sample: column -> numpy array (text columns as object arrays)."""
+    def read(self, check=None) -> dict:
+        """All chunks present, concatenated and sorted by sample: column -> numpy array (text columns as object arrays).
+
+        Every chunk is checked before use: readable, every column present, its samples those its name says;
+        ``check(a, b, columns)`` may check more (the sweep's parameters: a chunk of another spec) and raises
+        :class:`OutputError` naming the chunk.
+        """
         import numpy as np
 
-        parts = [self._decode(self.path(a, b)) for a, b in self.done_ranges()]
+        parts = []
+        for a, b in self.done_ranges():
+            p = self.path(a, b)
+            try:
+                cols = self._decode(p)
+            except Exception as e:  # a damaged file: whatever its reader raises
+                raise OutputError(
+                    f"{p}: damaged chunk ({type(e).__name__}: {str(e)[:120]}); remove it and run again to recompute "
+                    "its samples"
+                ) from None
+            samples = cols["sample"]
+            if len(samples) != b - a or not np.array_equal(samples, np.arange(a, b)):
+                raise OutputError(f"{p}: does not hold samples [{a}, {b}) as its name says; remove it")
+            if check is not None:
+                check(a, b, cols)
+            parts.append(cols)
         out = {}
         for c in self.columns:
             arrs = [p[c] for p in parts]
@@ -183,6 +228,8 @@ class Store:
             t = pq.read_table(path)
             out = {}
             for c in self.columns:
+                if c not in t.column_names:
+                    raise ValueError(f"no column {c!r}")
                 col = t.column(c)
                 if pa.types.is_string(col.type) or pa.types.is_large_string(col.type):
                     out[c] = np.asarray(col.to_pylist(), dtype=object)
@@ -192,6 +239,9 @@ class Store:
         with open(path, newline="") as f:
             rows = list(csv.reader(f))
         head = rows[0]
+        missing = [c for c in self.columns if c not in head]
+        if missing or any(len(r) != len(head) for r in rows[1:]):
+            raise ValueError(f"columns {missing} missing or rows of unequal length")
         cols = {c: [r[head.index(c)] for r in rows[1:]] for c in self.columns}
         out = {}
         for c, v in cols.items():

@@ -102,8 +102,24 @@ def _stats(v: np.ndarray) -> dict:
     }
 
 
+def _finite_or_none(obj):
+    """``obj`` with every NaN or infinity replaced by None (strict JSON: a grid point without a valid sample has no
+    mean, a constant column no correlation; the counts beside them say why)."""
+    if isinstance(obj, float):
+        return obj if math.isfinite(obj) else None
+    if isinstance(obj, dict):
+        return {k: _finite_or_none(v) for k, v in obj.items()}
+    if isinstance(obj, (list, tuple)):
+        return [_finite_or_none(v) for v in obj]
+    return obj
+
+
 def summarize(spec, cols: dict, conf: float = 0.95) -> dict:
-    """The summary document (JSON-ready) of the samples in ``cols`` (:meth:`Store.read`)."""
+    """The summary document (strict JSON: no NaN or infinity) of the samples in ``cols`` (:meth:`Store.read`)."""
+    return _finite_or_none(_summarize(spec, cols, conf))
+
+
+def _summarize(spec, cols: dict, conf: float) -> dict:
     n = len(cols["sample"])
     st = cols["status"]
     ok = st == "ok"
