@@ -180,7 +180,7 @@ def test_internal_error_exit_3_one_line_no_traceback(tmp_path, capsys, monkeypat
     code, out, err = run(["generate", D4, "--out", tmp_path / "o"], capsys)
     assert code == 3 and err.count("\n") == 1 and "Traceback" not in err
     assert err.startswith("wgcad: internal error: ZeroDivisionError: division by zero at wgcad/")
-    assert "please report it" in err and "WGCAD_TRACEBACK=1" in err
+    assert "please report it" in err and "WGCAD_TRACEBACK=1" in err and "on stderr" in err
     assert not (tmp_path / "o").exists()
     monkeypatch.setenv("WGCAD_TRACEBACK", "1")
     code, out, err = run(["generate", D4, "--out", tmp_path / "o"], capsys)
@@ -191,6 +191,9 @@ def test_internal_error_exit_3_one_line_no_traceback(tmp_path, capsys, monkeypat
     )
     monkeypatch.delenv("WGCAD_TRACEBACK")
     code, out, err = run(["--traceback", "generate", D4, "--out", tmp_path / "o"], capsys)
+    assert code == 3 and "Traceback (most recent call last)" in err
+    # after the subcommand too, where users put their other flags
+    code, out, err = run(["generate", D4, "--out", tmp_path / "o", "--traceback"], capsys)
     assert code == 3 and "Traceback (most recent call last)" in err
 
 

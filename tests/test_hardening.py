@@ -163,3 +163,15 @@ def test_a_design_with_a_byte_order_mark_is_read(tmp_path):
     path = tmp_path / "bom.toml"
     path.write_bytes(b"\xef\xbb\xbf" + (TEMPLATES / "d4_discrete.toml").read_bytes())
     assert load_design(path).drive.z_flex == load_design(TEMPLATES / "d4_discrete.toml").drive.z_flex
+
+
+def test_a_random_sweep_without_samples_is_refused():
+    from wgcad.sweep.spec import parse_spec
+
+    spec = {
+        "sweep": {"name": "x", "design": str(TEMPLATES / "d2_imperfect.toml"), "seed": 1},
+        "figures": {"record": ["ke_pp_arcsec"]},
+        "parameters": {"imperfections": {"flex_runout_um": {"distribution": "uniform", "lo": 0.0, "hi": 20.0}}},
+    }
+    with pytest.raises(DesignError, match="sweep.samples: required"):
+        parse_spec(spec)

@@ -210,7 +210,7 @@ def test_polyline_style_and_format_choice(tmp_path):
         == 0
     )
     names = sorted(p.name for p in (tmp_path / "o").iterdir())
-    assert names == ["parts.json", "small_flexspline.dxf", "small_plug.dxf", "small_rigid.dxf"]
+    assert names == ["small_flexspline.dxf", "small_parts.json", "small_plug.dxf", "small_rigid.dxf"]
     back = read_dxf(tmp_path / "o" / "small_flexspline.dxf")
     assert back["FLEXSPLINE"]["outlines"] and not back["FLEXSPLINE"]["paths"]
     # the polyline is the symmetric band around the exact curves (issue 8), not one-sided chords

@@ -153,6 +153,14 @@ def test_d1_pitch_circles_outside_the_teeth_are_not_shown_as_negative_widths():
     rep = drive_report(drive("d1_involute"))
     assert not rep["flexspline"]["pitch_circle_within_teeth"] and not rep["rigid"]["pitch_circle_within_teeth"]
     assert min(rep["flexspline"]["space_width_pitch_mm"], rep["rigid"]["tooth_thickness_pitch_mm"]) < 0  # virtual
+    # and the JSON says so next to the values (issue 21: a consumer could not tell)
+    assert rep["flexspline"]["pitch_figures"].startswith("virtual") and rep["rigid"]["pitch_figures"].startswith(
+        "virtual"
+    )
+    assert drive_report(drive("d4_discrete"))["flexspline"]["pitch_figures"] in (
+        "measured",
+        rep["rigid"]["pitch_figures"],
+    )
     text = format_summary(rep)
     assert "@pitch" not in text and "pitch circle lies outside the teeth" in text
 

@@ -43,7 +43,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument(
         "--traceback",
         action="store_true",
-        help=f"on an internal error (exit 3) also print the Python traceback (same as {TRACEBACK_ENV}=1)",
+        help=f"on an internal error (exit 3) also print the Python traceback on stderr (same as {TRACEBACK_ENV}=1)",
     )
     sub = p.add_subparsers(
         dest="command",
@@ -54,6 +54,14 @@ def build_parser() -> argparse.ArgumentParser:
     )
     for mod in (generate, audit, kinematics, ke, sector, parts, sweep):
         mod.register(sub)
+    # accepted after the subcommand too (wgcad audit D --traceback): users put it where the other flags are
+    for sp in sub.choices.values():
+        sp.add_argument(
+            "--traceback",
+            action="store_true",
+            default=argparse.SUPPRESS,
+            help="on an internal error (exit 3) also print the Python traceback on stderr",
+        )
     return p
 
 

@@ -119,7 +119,7 @@ def internal_error_line(exc: BaseException) -> str:
         what = "out of memory" + ("" if what == "(no message)" else f" ({what})")
     return (
         f"wgcad: internal error: {kind}: {what}{where}; this is a bug in wgcad, please report it with the design "
-        f"file and the command (run with --traceback or {TRACEBACK_ENV}=1 for the traceback)"
+        f"file and the command (run with --traceback or {TRACEBACK_ENV}=1 to print the traceback on stderr)"
     )
 
 

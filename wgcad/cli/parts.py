@@ -113,8 +113,9 @@ def cmd_parts(args) -> int:
             for p in parts:
                 if p.name.startswith("assembly"):
                     write_3mf(target(f"{stem}_{p.name}.3mf"), {f"{p.name}_{k}": m for k, m in p.info["meshes"].items()})
-        report["files"] = [f.name for f in files] + ["parts.json"]
-        Path(target("parts.json")).write_text(json.dumps(report, allow_nan=False, indent=2) + "\n")
+        # named by the design, as every other file here: two designs can share a folder
+        report["files"] = [f.name for f in files] + [f"{stem}_parts.json"]
+        Path(target(f"{stem}_parts.json")).write_text(json.dumps(report, allow_nan=False, indent=2) + "\n")
         files.pop()
     if args.json:
         print(json.dumps(report, allow_nan=False, indent=2))
@@ -161,6 +162,6 @@ def register(sub) -> None:
         metavar="DEG[,DEG...]",
         help="also write the deformed assembly (STL/3MF meshes) at these generator angles, degrees",
     )
-    g.add_argument("--json", action="store_true", help="print parts.json to stdout instead of the summary")
+    g.add_argument("--json", action="store_true", help="print DESIGN_parts.json to stdout instead of the summary")
     g.add_argument("--quiet", action="store_true", help="print nothing on success")
     g.set_defaults(func=cmd_parts)

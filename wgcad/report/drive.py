@@ -96,6 +96,8 @@ def gear_figures(gear, rim_radius: float, gs=None) -> dict:
         # design figures of the extended flanks, not shown as measurements
         "tooth_thickness_pitch_mm": _r(gear.tooth_thickness(gear.r)),
         "space_width_pitch_mm": _r(gear.space_width(gear.r)),
+        # said next to the values: a consumer of the JSON must not take them for measurements
+        "pitch_figures": "measured" if within else "virtual (extended flanks; the pitch circle lies outside the teeth)",
         "tip_thickness_mm": _r(gear.tip_thickness),
         "fillet_radius_mm": _r(sp.fillet_coef * sp.module) if sp.form == "involute" else None,
         "outline_vertices": int(len(gear.outline)),

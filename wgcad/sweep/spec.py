@@ -328,7 +328,10 @@ def parse_spec(
             raise DesignError(f"parameters.{p.name}", "given twice")
         seen.add((p.table, p.key))
     has_random = any(p.random for p in params)
-    samples = sw.get("samples", 1000 if has_random else 1)
+    if has_random and "samples" not in sw:
+        # how many drives to draw is the study's first decision: not a default taken silently
+        raise DesignError("sweep.samples", "required when a parameter has a distribution (random draws per grid point)")
+    samples = sw.get("samples", 1)
     samples = _whole("sweep.samples", samples, 1, MAX_SAMPLES)
     if not has_random and samples != 1:
         raise DesignError(
