@@ -175,3 +175,16 @@ def test_a_random_sweep_without_samples_is_refused():
     }
     with pytest.raises(DesignError, match="sweep.samples: required"):
         parse_spec(spec)
+
+
+def test_refusals_after_the_design_is_read_leave_no_folder(tmp_path, capsys):
+    # the output folder used to be created before the work (sector, parts, ke, the load audit): a refusal then
+    # left it empty behind (the long fuzz run found it on `wgcad sector` of a design without [sectors])
+    out = tmp_path / "s"
+    assert main(["sector", str(TEMPLATES / "d1_involute.toml"), "--out", str(out)]) == 2
+    assert not out.exists()
+    apart = tmp_path / "apart.toml"
+    apart.write_text(edit_toml((TEMPLATES / "d2_imperfect.toml").read_text(), "rigid", "shift", "-3.3"))
+    assert main(["ke", str(apart), "--json", str(tmp_path / "k" / "ke.json")]) == 4
+    assert not (tmp_path / "k").exists()
+    capsys.readouterr()

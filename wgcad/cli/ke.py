@@ -18,7 +18,7 @@ def cmd_ke(args) -> int:
     import numpy as np
 
     from ..accuracy import ke as K
-    from ..atomic import atomic_batch, ensure_writable_dir
+    from ..atomic import atomic_batch, check_writable_dir
     from ..design import load_design
     from ..drive import build_drive
     from ..placement.imperfect import Imperfections, shortcuts
@@ -33,9 +33,9 @@ def cmd_ke(args) -> int:
 
         require_bearing(design)  # ... and a design the elastic model cannot build
     if args.plot:
-        ensure_writable_dir(Path(args.plot).parent if str(Path(args.plot).parent) else Path("."))
+        check_writable_dir(Path(args.plot).parent if str(Path(args.plot).parent) else Path("."))
     if args.json:
-        ensure_writable_dir(Path(args.json).parent if str(Path(args.json).parent) else Path("."))
+        check_writable_dir(Path(args.json).parent if str(Path(args.json).parent) else Path("."))
     tab = K.contact_table(drive, imp, args.per_mesh)
     res = K.kinematic_error(drive, imp, table=tab)
     perfect = Imperfections()

@@ -171,12 +171,12 @@ def _levels(args) -> list[float]:
 
 def run_load(args) -> int:
     """The load audit: sweep, print, write JSON and PNGs atomically; exit 1 when the entry gap closes."""
-    from ..atomic import atomic_batch, ensure_writable_dir
+    from ..atomic import atomic_batch, check_writable_dir
 
     torques = _levels(args)
     for path in (args.json, args.plot):
         if path:
-            ensure_writable_dir(Path(path).parent if str(Path(path).parent) else Path("."))
+            check_writable_dir(Path(path).parent if str(Path(path).parent) else Path("."))
     prog = Progress(args.progress or sys.stderr.isatty())
     drive, res = _sweep(args.design, torques, args.cam_offset_um, args.cam_offset_deg, args.sections, prog)
     compare = None

@@ -37,7 +37,7 @@ def _jsonable(v):
 
 def cmd_parts(args) -> int:
     t0 = time.perf_counter()
-    from ..atomic import atomic_batch, ensure_writable_dir
+    from ..atomic import atomic_batch, check_writable_dir
     from ..design import load_design
     from ..design.parts import load_parts, part_sizes
     from ..drive import build_drive
@@ -66,7 +66,7 @@ def cmd_parts(args) -> int:
         for p in parts:
             if not p.name.startswith("assembly"):
                 solids[p.name] = p.solid()
-    ensure_writable_dir(out)
+    check_writable_dir(out)
     files = []
     report = {
         "design": str(args.design),

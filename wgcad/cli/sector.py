@@ -170,7 +170,7 @@ def cmd_sector(args) -> int:
 
     import numpy as np
 
-    from ..atomic import atomic_batch, ensure_writable_dir
+    from ..atomic import atomic_batch, check_writable_dir
     from ..design import load_design
     from ..design.budget import check_sector_budget
     from ..sector.scene import DEFAULT_STEP_DEG
@@ -180,7 +180,7 @@ def cmd_sector(args) -> int:
         design.drive.z_flex, DEFAULT_STEP_DEG if args.step_deg is None else args.step_deg, args.max_memory_mb
     )
     out = out_dir(args, args.design)
-    ensure_writable_dir(out)
+    check_writable_dir(out)
     res = run_sector(design, args.heights, args.assign, args.step_deg, args.tip_clearance_um)
     lay, cf, cfb, sim, built = (
         res["layout"],

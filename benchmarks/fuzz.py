@@ -1,0 +1,315 @@
+"""The long fuzz run of issue 21: every command on mutated templates and random flags, checked for what must never happen.
+
+Run from the repository root (hours for 10,000 runs on 2 cores; not part of the test run):
+
+    .venv/bin/python benchmarks/fuzz.py --runs 10000 --workers 2 --seed 1
+
+Each run is one ``wgcad`` command (generate, audit, the load audit, kinematics, ke, sector, parts, sweep) on a
+bundled template or sweep spec mutated in its numbers, types and structure, with flags drawn from valid and
+invalid values. A run is called in-process in a worker process (a fresh pool process every 20 runs) with a
+temporary output folder, under an address-space cap; the checks:
+
+- exit code 0, 1, 2 or 4 (never 3: an internal error; never a signal);
+- no traceback on stderr, and a refusal (2) or a model's refusal (4) is one line;
+- nothing written on a refusal: the output folder and the JSON target absent or empty;
+- no run longer than ``--timeout`` seconds (a hang), none above the memory cap (a MemoryError is exit 3).
+
+Prints a JSON line per failure (command, mutation, exit, stderr) and a summary (runs per command and exit code,
+failures, wall time). ``tests/test_fuzz.py`` is the short, seeded version run by the test suite.
+"""
+
+from __future__ import annotations
+
+import argparse
+import collections
+import contextlib
+import io
+import json
+import math
+import multiprocessing as mp
+import os
+import random
+import resource
+import shutil
+import sys
+import tempfile
+import time
+import tomllib
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parent.parent
+TEMPLATES = ROOT / "templates"
+DESIGNS = sorted(TEMPLATES.glob("*.toml"))
+SPECS = sorted((TEMPLATES / "sweeps").glob("*.toml"))
+#: address-space cap of a worker, bytes: above the default --max-memory-mb (2 GB) with room for the interpreter
+MEMORY_CAP = 4 << 30
+
+
+# ------------------------------------------------------------------ a TOML writer (nested tables)
+def _value(v) -> str:
+    if isinstance(v, bool):
+        return "true" if v else "false"
+    if isinstance(v, int):
+        return str(v)
+    if isinstance(v, float):
+        if math.isnan(v):
+            return "nan"
+        if math.isinf(v):
+            return "inf" if v > 0 else "-inf"
+        return repr(v)
+    if isinstance(v, str):
+        return '"' + v.replace("\\", "\\\\").replace('"', '\\"').replace("\n", "\\n") + '"'
+    if isinstance(v, list):
+        return "[" + ", ".join(_value(x) for x in v) + "]"
+    if isinstance(v, dict):
+        return "{" + ", ".join(f"{k} = {_value(x)}" for k, x in v.items()) + "}"
+    raise TypeError(type(v))
+
+
+def _is_table(v) -> bool:
+    return isinstance(v, dict)
+
+
+def to_toml(data: dict, prefix: str = "") -> str:
+    lines = [f"{k} = {_value(v)}" for k, v in data.items() if not _is_table(v)]
+    for k, v in data.items():
+        if _is_table(v):
+            name = f"{prefix}{k}"
+            scalars = {kk: vv for kk, vv in v.items() if not _is_table(vv)}
+            if scalars or not v:
+                lines.append(f"\n[{name}]")
+                lines += [f"{kk} = {_value(vv)}" for kk, vv in scalars.items()]
+            sub = {kk: vv for kk, vv in v.items() if _is_table(vv)}
+            if sub:
+                lines.append(to_toml(sub, f"{name}."))
+    return "\n".join(lines) + "\n"
+
+
+# ------------------------------------------------------------------ mutations
+NUMBERS = [0, -1, 1, 2, 7, 3000, 10**6, 10**12, 10**40, -(10**40), 2**63 - 1, 0.0, -0.0, 1e-300, -1e-9, 1e-6, 0.5]
+NUMBERS += [1e5, 1e9, 1e39, 1e308, -1e308, math.inf, -math.inf, math.nan]
+OTHERS = ["", "x", "ellipse", True, False, [], [1], [[1]], {"a": 1}, ["x", 1.5]]
+
+
+def _tables(data, path=()):
+    """Every table of ``data`` with its path."""
+    for k, v in data.items():
+        if _is_table(v):
+            yield path + (k,), v
+            yield from _tables(v, path + (k,))
+
+
+def mutate(data: dict, rng: random.Random) -> list[str]:
+    """Mutate ``data`` in place 1-3 times; returns what was done."""
+    done = []
+    for _ in range(rng.randint(1, 3)):
+        tabs = list(_tables(data))
+        if not tabs:
+            break
+        path, t = rng.choice(tabs)
+        keys = [k for k, v in t.items() if not _is_table(v)]
+        kind = rng.choice(["scale", "number", "other", "drop_key", "add_key", "drop_table", "list_item"])
+        k = rng.choice(keys) if keys else None
+        where = ".".join(path) + (f".{k}" if k else "")
+        if kind == "scale" and k is not None and isinstance(t[k], (int, float)) and not isinstance(t[k], bool):
+            f = rng.choice([0.0, -1.0, 0.5, 0.9, 0.99, 1.01, 1.1, 2.0, 10.0, 1e3, 1e-3])
+            t[k] = type(t[k])(t[k] * f) if isinstance(t[k], float) or f == int(f) else t[k] * f
+            done.append(f"{where} *= {f}")
+        elif kind == "number" and k is not None:
+            t[k] = rng.choice(NUMBERS)
+            done.append(f"{where} = {t[k]!r}")
+        elif kind == "other" and k is not None:
+            t[k] = rng.choice(OTHERS)
+            done.append(f"{where} = {t[k]!r}")
+        elif kind == "drop_key" and k is not None:
+            del t[k]
+            done.append(f"del {where}")
+        elif kind == "add_key":
+            t[rng.choice(["bogus", "w0", "teeth", "shift_x"])] = rng.choice(NUMBERS + OTHERS)
+            done.append(f"add key to {'.'.join(path)}")
+        elif kind == "drop_table" and len(path) >= 1:
+            parent = data
+            for p in path[:-1]:
+                parent = parent[p]
+            del parent[path[-1]]
+            done.append(f"del [{'.'.join(path)}]")
+        elif kind == "list_item" and k is not None and isinstance(t[k], list) and t[k]:
+            i = rng.randrange(len(t[k]))
+            t[k][i] = rng.choice(NUMBERS + OTHERS)
+            done.append(f"{where}[{i}] = {t[k][i]!r}")
+    return done
+
+
+# ------------------------------------------------------------------ commands
+def _pick(rng, good, bad, p_bad=0.15):
+    return rng.choice(bad) if rng.random() < p_bad else rng.choice(good)
+
+
+def command(rng: random.Random, design: Path, spec: Path, out: Path) -> tuple[str, list]:
+    """A command line (without ``wgcad``) for one run, writing under ``out``."""
+    cmd = rng.choice(["generate", "audit", "load", "kinematics", "ke", "sector", "parts", "sweep"])
+    d = str(design)
+    if cmd == "generate":
+        args = ["generate", d, "--out", str(out / "g"), "--no-stl", "--quiet"]
+        if rng.random() < 0.3:
+            args += ["--generator-angle", _pick(rng, ["0", "0,15", "7.5"], ["nan", "x", "1e9,0"])]
+        if rng.random() < 0.3:
+            args += ["--chord-tol-um", _pick(rng, ["1", "3", "10"], ["0", "-1", "1e9", "nan"])]
+    elif cmd == "audit":
+        args = ["audit", d, "--json", str(out / "a.json"), "--quiet"]
+        args += ["--step-deg", _pick(rng, ["1", "2", "4"], ["0", "-1", "nan", "1e-9", "100"])]
+        if rng.random() < 0.3:
+            args += ["--sections", _pick(rng, ["1", "3", "5"], ["0", "-2", "x", "1000"])]
+        if rng.random() < 0.3:
+            args.append("--no-refine")
+    elif cmd == "load":
+        args = ["audit", d, "--json", str(out / "l.json"), "--quiet"]
+        args += ["--torque-nm", _pick(rng, ["0,500", "100", "0:1000:500"], ["-5", "nan", "1e12", "x", "0:1:0"])]
+        if rng.random() < 0.3:
+            args += ["--cam-offset-um", _pick(rng, ["0", "20", "40"], ["-1", "1e6", "nan"])]
+    elif cmd == "kinematics":
+        args = ["kinematics", d, "--out", str(out / "k")]
+    elif cmd == "ke":
+        args = ["ke", d, "--json", str(out / "k.json")]
+        if rng.random() < 0.3:
+            args += ["--per-mesh", _pick(rng, ["4", "8", "16"], ["0", "-1", "x", "100000"])]
+        if rng.random() < 0.15:
+            args += [
+                "--torque-nm",
+                _pick(rng, ["80"], ["-1", "nan"]),
+                "--load-samples",
+                _pick(rng, ["8", "12"], ["1", "x"]),
+            ]
+    elif cmd == "sector":
+        args = ["sector", d, "--out", str(out / "s"), "--no-stl"]
+        args += ["--step-deg", _pick(rng, ["0.2", "0.5", "1"], ["0", "-1", "nan", "1e-7"])]
+    elif cmd == "parts":
+        args = [
+            "parts",
+            d,
+            "--out",
+            str(out / "p"),
+            "--format",
+            _pick(rng, ["dxf", "dxf,svg", "stl"], ["xyz", "", "step,bogus"]),
+        ]
+    else:
+        args = ["sweep", str(spec), "--workers", "0", "--out", str(out / "w"), "--no-plots"]
+    return cmd, args
+
+
+# ------------------------------------------------------------------ one run, in a worker
+def _init() -> None:
+    resource.setrlimit(resource.RLIMIT_AS, (MEMORY_CAP, MEMORY_CAP))
+    sys.path.insert(0, str(ROOT))
+
+
+def run_one(job: dict) -> dict:
+    from wgcad.cli import main
+
+    rng = random.Random(job["seed"])
+    tmp = Path(tempfile.mkdtemp(prefix="wgcad-fuzz-"))
+    try:
+        design = rng.choice(DESIGNS)
+        data = tomllib.loads(design.read_text())
+        what = mutate(data, rng) if rng.random() < 0.8 else ["unchanged"]
+        dpath = tmp / f"{design.stem}.toml"
+        dpath.write_text(to_toml(data))
+        spec_src = rng.choice(SPECS)
+        sdata = tomllib.loads(spec_src.read_text())
+        sdata["sweep"]["design"] = str(dpath)
+        # a sweep's work is kept small: few samples, coarse audits (the mutations may still grow it)
+        if "samples" in sdata["sweep"]:
+            sdata["sweep"]["samples"] = rng.choice([2, 3])
+        sdata.setdefault("figures", {})["audit_step_deg"] = 4.0
+        if rng.random() < 0.5:
+            what += ["spec: " + m for m in mutate(sdata, rng)]
+        spath = tmp / "spec.toml"
+        spath.write_text(to_toml(sdata))
+        out = tmp / "out"
+        cmd, args = command(rng, dpath, spath, out)
+        err, sink = io.StringIO(), io.StringIO()
+        t0 = time.perf_counter()
+        with contextlib.redirect_stderr(err), contextlib.redirect_stdout(sink):
+            try:
+                code = main(args)
+            except SystemExit as e:  # argparse
+                code = e.code if isinstance(e.code, int) else 2
+            except BaseException as e:  # noqa: BLE001  (anything escaping main is what the fuzz looks for)
+                code = f"escaped {type(e).__name__}: {e}"
+        dt = time.perf_counter() - t0
+        text = err.getvalue()
+        written = sorted(str(p.relative_to(out)) for p in out.rglob("*")) if out.exists() else []
+        bad = []
+        if code not in (0, 1, 2, 4):
+            bad.append(f"exit {code}")
+        if "Traceback" in text:
+            bad.append("traceback")
+        if code in (2, 4) and text.strip().count("\n") > 0 and cmd != "sweep":
+            bad.append("refusal not one line")
+        if code in (2, 4) and written:
+            bad.append(f"wrote on refusal: {written[:3]}")
+        return {
+            "seed": job["seed"],
+            "cmd": cmd,
+            "code": code,
+            "bad": bad,
+            "s": round(dt, 3),
+            "what": what,
+            "args": [a.replace(str(tmp), "TMP") for a in args],
+            "stderr": text.strip()[-400:],
+        }
+    finally:
+        shutil.rmtree(tmp, ignore_errors=True)
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--runs", type=int, default=200)
+    ap.add_argument("--workers", type=int, default=max(1, (os.cpu_count() or 2)))
+    ap.add_argument("--seed", type=int, default=1)
+    ap.add_argument("--timeout", type=float, default=300.0, help="seconds a run may take before it counts as a hang")
+    a = ap.parse_args()
+    os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
+    t0 = time.time()
+    jobs = [{"seed": a.seed * 1_000_003 + i} for i in range(a.runs)]
+    counts = collections.Counter()
+    failures = hangs = 0
+    slowest = (0.0, None)
+    with mp.get_context("fork").Pool(a.workers, initializer=_init, maxtasksperchild=20) as pool:
+        pending = [(j, pool.apply_async(run_one, (j,))) for j in jobs]
+        for k, (j, r) in enumerate(pending):
+            try:
+                res = r.get(timeout=a.timeout)
+            except mp.TimeoutError:
+                hangs += 1
+                print(json.dumps({"seed": j["seed"], "bad": ["hang"]}), flush=True)
+                continue
+            counts[(res["cmd"], str(res["code"]))] += 1
+            if res["s"] > slowest[0]:
+                slowest = (res["s"], res["args"])
+            if res["bad"]:
+                failures += 1
+                print(json.dumps(res), flush=True)
+            if (k + 1) % 500 == 0:
+                print(
+                    json.dumps(
+                        {"progress": k + 1, "failures": failures, "hangs": hangs, "elapsed_s": round(time.time() - t0)}
+                    ),
+                    flush=True,
+                )
+    summary = {
+        "runs": a.runs,
+        "seed": a.seed,
+        "workers": a.workers,
+        "failures": failures,
+        "hangs": hangs,
+        "wall_s": round(time.time() - t0, 1),
+        "slowest_s": slowest[0],
+        "slowest_args": slowest[1],
+        "by_command_and_exit": {f"{c} {e}": n for (c, e), n in sorted(counts.items())},
+    }
+    print(json.dumps(summary, indent=1))
+
+
+if __name__ == "__main__":
+    main()
