@@ -7,6 +7,7 @@ from math import pi
 import numpy as np
 
 from ..placement import tooth_pose, transform
+from ..roots import brentq
 from .scene import Scene
 from .search import _fold
 
@@ -68,8 +69,6 @@ def backlash(scene: Scene, phi_h: float, z=None, exact: bool = False) -> float:
             fb = f(b)
         if np.sign(fb) == np.sign(f0):
             return float("inf")
-        from scipy.optimize import brentq  # lazy: scipy.optimize costs 0.4-0.8 s to import (issue 13)
-
         return brentq(f, min(a, b), max(a, b), xtol=1e-13)
 
     # with ``exact``: polygon figures are within ``gap`` of the curves' (docs/models.md 5)

@@ -50,6 +50,7 @@ from math import pi
 
 import numpy as np
 
+from ..roots import brentq
 from . import cycloid as cy
 from . import involute as iv
 from .gear import Gear, _involute_base_angle, rotate
@@ -262,7 +263,7 @@ def pins_numerical(gear: Gear, d_pin: float) -> dict:
     if idx.size == 0:
         raise ArithmeticError("the pin does not touch both flanks")
     i = idx[0] if sp.internal else idx[-1]
-    R_m = _brentq(f, grid[i], grid[i + 1], xtol=1e-13)
+    R_m = brentq(f, grid[i], grid[i + 1], xtol=1e-13)
     span = 2 * R_m * (1.0 if sp.z % 2 == 0 else np.cos(pi / (2 * sp.z)))
     return {"centre_radius_mm": float(R_m), "dimension_mm": float(span - d_pin if sp.internal else span + d_pin)}
 
@@ -364,10 +365,3 @@ def workshop_figures(gear: Gear, measure_diameter: float | None = None, pin_diam
     out["smallest_concave_radius_mm"] = min(radii.values())
     out["thickness_method"] = "closed form"
     return out
-
-
-def _brentq(*args, **kwargs):
-    # scipy.optimize costs 0.3-0.8 s to import: only on first use
-    from scipy.optimize import brentq
-
-    return brentq(*args, **kwargs)
