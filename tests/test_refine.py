@@ -94,3 +94,54 @@ def test_backlash_on_the_exact_curves_matches_dense_polygons_at_any_chord_tolera
     assert abs(exact[0] - ref) < 2e-8 and abs(exact[1] - ref) < 2e-8
     assert abs(exact[0] - exact[1]) < 1e-10
     assert abs(poly - ref) > 5e-6  # the polygon figure was off: the test would have caught it
+
+
+@pytest.mark.parametrize("name", ["d1_involute", "d1_cycloidal", "d2"])
+def test_pairs_far_apart_match_dense_polygons(name):
+    # Teeth apart are measured from one side only (the other side's minimum is the same distance);
+    # the entry's gaps reach a millimetre, and there a flank nearly parallel to the other tooth's flank
+    # meets its tip corner: Newton on the first side alone stopped 1.2 um high on D1's non-working
+    # crossing gap (639.705 against 638.528 um) until such rows were flagged and the second side measured
+    drive = build_drive(load_design(TEMPLATES / f"{name}.toml"))
+    scene = Scene(drive)
+    z = None if not drive.coned else float(drive.sections(3)[-1])
+    half = np.pi / scene.n_w
+    phi = np.linspace(-half, half, 721)
+    rot, shift = scene.pose(phi, z)
+    det = clearance_at_poses(scene, rot, shift)
+    rows, idx = [], []
+    for key, jk in (("lower", "lo"), ("upper", "up")):
+        sel = np.nonzero((det[key] > 0.05) & (det[key] < 1.5))[0]
+        pick = sel[np.linspace(0, len(sel) - 1, min(10, len(sel))).astype(int)] if sel.size else sel
+        rows.append(pick)
+        idx.append(det[jk][pick])
+    rows, j = np.concatenate(rows), np.concatenate(idx)
+    assert len(rows) >= 10
+    rot, shift = rot[rows], shift[rows]
+    value = scene.exact_to(rot, shift, j)[0]
+    dense = build_drive(drive.design, tol=DENSE_TOL / 2)
+    a = transform(dense.flex.tooth_polygon(), rot, shift)
+    b = transform(dense.rigid.tooth_polygon(), scene.rigid_rot[j], scene.rigid_shift[j])
+    ref = np.array([dense_pair(a[k], b[k]) for k in range(len(rot))])
+    assert np.abs(value - ref).max() <= REFINE_TOL + DENSE_TOL, (1e3 * (value - ref)).round(5)
+
+
+def test_d1_entry_crossing_gap_of_the_non_working_edge_is_exact():
+    # the pair where the first side alone stopped short (above), at the audit's own poses
+    from wgcad.clearance.entry import crossings, edge_gaps, section_poses
+
+    drive = build_drive(load_design(TEMPLATES / "d1_involute.toml"))
+    scene = Scene(drive)
+    z = float(drive.sections(3)[-1])
+    poses = section_poses(scene, [z])
+    cross = float(crossings(scene, poses, 1)[0])
+    phi = cross + np.linspace(-0.02, 0.02, 9)
+    rot, shift = poses(phi, np.zeros(len(phi), dtype=int))
+    gaps = edge_gaps(scene, rot, shift)
+    dense = build_drive(drive.design, tol=DENSE_TOL / 2)
+    jw, jn = (lambda lo, up: (up, lo) if scene.working == "upper" else (lo, up))(*scene.neighbours(shift, rot)[:2])
+    a = transform(dense.flex.tooth_polygon(), rot, shift)
+    for col, j in ((0, jw), (1, jn)):
+        b = transform(dense.rigid.tooth_polygon(), scene.rigid_rot[j], scene.rigid_shift[j])
+        ref = np.array([dense_pair(a[k], b[k]) for k in range(len(rot))])
+        assert np.abs(gaps[:, col] - ref).max() <= REFINE_TOL + DENSE_TOL, (1e3 * (gaps[:, col] - ref)).round(5)

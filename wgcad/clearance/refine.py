@@ -6,7 +6,11 @@ clearance of teeth A and B is ``min(min_s sd_B(P_A(s)), min_t sd_A(P_B(t)))``
 with ``sd_X`` the signed distance to X's boundary (> 0 outside its
 material): the distance when apart, minus the deepest penetration of either
 boundary into the other when overlapping - the polygon engine's definition
-(:func:`wgcad.clearance.distance.signed_clearance`), on the curves.
+(:func:`wgcad.clearance.distance.signed_clearance`), on the curves. For
+teeth apart both minima are the one distance between the boundaries, so
+the second side is measured only where the polygons say the teeth can
+touch or overlap, or where a row of the first side stopped short of a
+stationary point or a corner (its figure is then only an upper bound).
 
 How: every polygon vertex lies on a piece with a known parameter. The
 vertices whose polygon signed distance is within a margin of the polygon
@@ -37,6 +41,10 @@ from .exact import ExactTooth, curv_h, point_signed_distance
 __all__ = ["ExactTooth", "refine_pairs", "point_signed_distance"]
 
 _NEWTON_STEPS = 40
+#: neighbours of a local minimum of the vertex distances also seeded (a coarse polygon's extremum can lie a
+#: vertex away from the curve's); the second neighbours once seeded too doubled the rows for no figure changed
+#: (4e-11 um over every template's audit calls), and tests/test_exact.py checks 10 um chords
+_NEAR = (1,)
 #: fractions of the Newton step tried at once (a vectorised line search)
 _FRACTIONS = np.array([1.0, 0.25, 1.0 / 16.0, 1.0 / 128.0])
 #: a row whose full Newton step improves its value by less than this (mm) is converged: the step
@@ -61,20 +69,25 @@ def _rotate(v, rot):
     return np.stack([c * v[:, 0] - s * v[:, 1], s * v[:, 0] + c * v[:, 1]], axis=-1)
 
 
-def _one_side(A: ExactTooth, B: ExactTooth, polyA: np.ndarray, ringB, rot, shift, margin):
-    """``min_s sd_B(P_A(s))`` for each pair (A placed in B's frame by ``rot, shift``), exact; with where it is.
-
-    Returns value (K,), the A piece and parameter, and the point (B frame).
-    """
+def _vertex_sd(A: ExactTooth, polyA: np.ndarray, ringB, rot, shift) -> np.ndarray:
+    """Polygon signed distance ``(K, nv)`` of A's period vertices (A placed in B's frame) to B's polygon."""
     K = len(rot)
     nv = A.n_vert
-    # polygon signed distance of A's (period) vertices to B's polygon, every pair
     va = np.einsum("kij,nj->kni", _rotmat(rot), polyA[:nv]) + shift[:, None, :]  # (K, nv, 2)
     flat = va.reshape(-1, 2)
     pts = shapely.points(flat)
     d = shapely.distance(ringB.exterior, pts)
     inside = shapely.contains_xy(ringB, flat[:, 0], flat[:, 1])
-    sd = np.where(inside, -d, d).reshape(K, nv)
+    return np.where(inside, -d, d).reshape(K, nv)
+
+
+def _one_side(A: ExactTooth, B: ExactTooth, sd: np.ndarray, rot, shift, margin):
+    """``min_s sd_B(P_A(s))`` for each pair (A placed in B's frame by ``rot, shift``), exact; with where it is.
+
+    ``sd`` is :func:`_vertex_sd` of the pairs. Returns value (K,), the A
+    piece and parameter, and the point (B frame).
+    """
+    K = len(rot)
     lo = sd.min(axis=1)
     # seeds: local minima of the vertex sequence within the margin of the pair's minimum (the
     # curve's extrema lie between a vertex and its neighbours; one seed per basin is enough)
@@ -83,7 +96,7 @@ def _one_side(A: ExactTooth, B: ExactTooth, polyA: np.ndarray, ringB, rot, shift
     # and the two vertices either side: where vertices are sparse (coarse chords, a cycloid's
     # pitch-point cusp) the curve's extremum can lie a chord or two away from the polygon's
     near = local.copy()
-    for sh in (1, 2):
+    for sh in _NEAR:
         near[:, sh:] |= local[:, :-sh]
         near[:, :-sh] |= local[:, sh:]
     seed_k, seed_v = np.nonzero(near & (sd <= lo[:, None] + margin))
@@ -178,6 +191,7 @@ def _one_side(A: ExactTooth, B: ExactTooth, polyA: np.ndarray, ringB, rot, shift
 
     ib, t, f, g0, red, sgn, a1n = inner(ia, s, ib, t, r_k, sh_k)
     active = np.arange(len(s))
+    stuck = np.zeros(len(s), dtype=bool)  # rows that stopped short of a stationary point or a corner
     for _ in range(_NEWTON_STEPS):
         if active.size == 0:
             break
@@ -232,12 +246,23 @@ def _one_side(A: ExactTooth, B: ExactTooth, polyA: np.ndarray, ringB, rot, shift
         full = np.zeros(len(A_), dtype=bool)
         full[okr] = pick[okr] == 0
         keep = (moved > 1e-8) & ((f_before - f[A_] > _DONE) | (~full & (f_before - f[A_] > 1e-12)))
+        # a row none of whose steps lowered the value although its slope promised more than _DONE from
+        # the shortest stopped short: the curvature that sized the steps changed within them (the nearest
+        # point of the other tooth reaching a corner: a flank parallel to a flank until it meets the
+        # tip's edge). Its figure is an upper bound only, and the caller is told. (A step that left the
+        # piece or was clamped at its end met a corner of this tooth instead: the value there was tried.)
+        with np.errstate(invalid="ignore"):
+            promise = np.abs(fp * ds) * _FRACTIONS[-1]
+        last = np.arange(len(A_)) * nf + nf - 1
+        inside = (ia_try[last] == ia[A_]) & (s_try[last] != s[A_])
+        stuck[A_[~okr & inside & (promise > _DONE)]] = True
         # rows of one pair that have reached the same spot on the same pieces are one row
         key = np.stack([kk[A_], ia[A_], ib[A_], np.round(s[A_] * 1e7)], axis=1)
         _, first = np.unique(key, axis=0, return_index=True)
         dup = np.ones(len(A_), dtype=bool)
         dup[first] = False
         active = A_[keep & ~dup]
+    stuck[active] = True  # still descending after _NEWTON_STEPS
     # each candidate measured exactly against the whole of B: a true signed distance of a true curve point
     Pa = _rotate(A.eval(ia, s, order=0)[0], r_k) + sh_k
     val = point_signed_distance(B, Pa)
@@ -251,7 +276,9 @@ def _one_side(A: ExactTooth, B: ExactTooth, polyA: np.ndarray, ringB, rot, shift
     where_t = np.full(K, np.nan)
     where_pt = np.full((K, 2), np.nan)
     where_piece[kk[pick]], where_t[kk[pick]], where_pt[kk[pick]] = ia[pick], s[pick], Pa[pick]
-    return out, where_piece, where_t, where_pt
+    sure = np.ones(K, dtype=bool)
+    sure[kk[stuck]] = False
+    return out, where_piece, where_t, where_pt, sure
 
 
 def _rotmat(rot):
@@ -287,9 +314,20 @@ def refine_pairs(
     shift_a = np.atleast_2d(np.asarray(shift_a, dtype=float))
     shift_b = np.broadcast_to(np.asarray(shift_b, dtype=float), (K, 2))
     r1, t1 = _rel(rot_a, shift_a, rot_b, shift_b)
-    v1, _, _, p1 = _one_side(A, B, polyA, geomB, r1, t1, margin)
     r2, t2 = _rel(rot_b, shift_b, rot_a, shift_a)
-    v2, _, _, p2 = _one_side(B, A, polyB, geomA, r2, t2, margin)
+    sd1 = _vertex_sd(A, polyA, geomB, r1, t1)
+    sd2 = _vertex_sd(B, polyB, geomA, r2, t2)
+    v1, _, _, p1, sure = _one_side(A, B, sd1, r1, t1, margin)
+    # the polygons' distance is the smaller vertex distance of the two sides (a polygon's closest point to
+    # another is a vertex of one of them); the curves are within margin / 2 of it, so above margin / 2
+    # the teeth are apart, and for teeth apart both sides' minima are the one distance between their
+    # boundaries: the second side is measured only for pairs that can touch or overlap, and for pairs
+    # whose first side has a row that stopped short of a stationary point (its figure only bounds)
+    v2 = np.full(K, np.inf)
+    p2 = np.full((K, 2), np.nan)
+    two = np.nonzero((np.minimum(sd1.min(axis=1), sd2.min(axis=1)) <= 0.5 * margin) | ~sure)[0]
+    if two.size:
+        v2[two], _, _, p2[two], _ = _one_side(B, A, sd2[two], r2[two], t2[two], margin)
     side = (v2 < v1).astype(int)
     value = np.minimum(v1, v2)
     point = np.where(side[:, None] == 0, p1, p2)
