@@ -55,7 +55,7 @@ def _model_xml(meshes: dict) -> str:
 
 
 def threemf_bytes(meshes: dict) -> bytes:
-    """The 3MF package of named meshes ``{name: trimesh.Trimesh}`` (mm), one object and one build item each."""
+    """The 3MF package of named meshes ``{name: Mesh}`` (mm), one object and one build item each."""
     buf = io.BytesIO()
     with zipfile.ZipFile(buf, "w", zipfile.ZIP_DEFLATED) as z:
         for name, text in (

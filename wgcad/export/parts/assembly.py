@@ -6,8 +6,9 @@ import numpy as np
 
 from wgcad.errors import GeometryError
 
+from ..mesh import concatenate
 from .part import Part
-from .solids import circle_points, prism_m, to_trimesh
+from .solids import circle_points, prism_m, to_mesh
 
 __all__ = ["deformed_assembly", "N_SLICES_CONED"]
 
@@ -38,7 +39,6 @@ def deformed_assembly(drive, sizes, generator_angle_deg: float, tol: float) -> P
         no STEP solid (``make_solid`` raises).
     """
     import shapely
-    import trimesh
 
     from wgcad.kinematics import gear_ratios
     from wgcad.placement import deformed_curve, join_teeth, place_flex_teeth
@@ -93,17 +93,17 @@ def deformed_assembly(drive, sizes, generator_angle_deg: float, tol: float) -> P
     def mesh():
         if not meshes:
             if drive.external:
-                meshes["rigid"] = to_trimesh(prism_m(rigid_outline, [rim_c], 0.0, bw))
-                meshes["plug"] = to_trimesh(prism_m(ring, [plug], pz0, pz1))
+                meshes["rigid"] = to_mesh(prism_m(rigid_outline, [rim_c], 0.0, bw))
+                meshes["plug"] = to_mesh(prism_m(ring, [plug], pz0, pz1))
             else:
-                meshes["rigid"] = to_trimesh(prism_m(rim_c, [rigid_outline], 0.0, bw))
-                meshes["plug"] = to_trimesh(prism_m(plug, [], pz0, pz1))
+                meshes["rigid"] = to_mesh(prism_m(rim_c, [rigid_outline], 0.0, bw))
+                meshes["plug"] = to_mesh(prism_m(plug, [], pz0, pz1))
             flex = None
             for outer, hole, z0, z1 in slices:
                 s = prism_m(outer, [hole], z0, z1)
                 flex = s if flex is None else flex + s
-            meshes["flexspline"] = to_trimesh(flex)
-        return trimesh.util.concatenate([meshes[n] for n in ("rigid", "flexspline", "plug")])
+            meshes["flexspline"] = to_mesh(flex)
+        return concatenate([meshes[n] for n in ("rigid", "flexspline", "plug")])
 
     def solid():
         raise GeometryError("the deformed assembly is exported as a mesh only")

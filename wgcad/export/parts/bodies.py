@@ -12,7 +12,7 @@ from wgcad.export.dxf import DxfLayer
 from wgcad.export.gear_data import data_lines, gear_data
 
 from .part import Part
-from .solids import bolt_circle, circle_points, holes_m, n_segments, prism_m, revolve_m, to_trimesh
+from .solids import bolt_circle, circle_points, holes_m, n_segments, prism_m, revolve_m, to_mesh
 
 __all__ = ["flexspline", "plug", "rigid", "plug_outline", "data_layer"]
 
@@ -75,7 +75,7 @@ def flexspline(drive, sizes, style: str, tol: float) -> Part:
             return S.prism(S.circle_wire(R), [S.wire_from_path(path.vertices, path.bulges)], bw)
 
         def mesh():
-            return to_trimesh(prism_m(circle_points(R, tol), [band], 0.0, bw))
+            return to_mesh(prism_m(circle_points(R, tol), [band], 0.0, bw))
 
         info["kind"] = "toothed flexible ring (external deformation: no cup)"
         return Part("flexspline", layers, solid, mesh, vol, ((-R, -R, 0.0), (R, R, bw)), info)
@@ -100,7 +100,7 @@ def flexspline(drive, sizes, style: str, tol: float) -> Part:
     def mesh():
         ring = prism_m(band, [circle_points(r_rim, tol)], 0.0, bw)
         n = n_segments(r_rim + ts, tol)
-        return to_trimesh(ring + (revolve_m(rz, n) - holes_m(holes, L - td, L, tol)))
+        return to_mesh(ring + (revolve_m(rz, n) - holes_m(holes, L - td, L, tol)))
 
     info.update(
         {
@@ -217,7 +217,7 @@ def plug(drive, sizes, tol: float) -> Part:
             return S.prism(S.bspline_wire(outline), [S.circle_wire(r_b)], width, z0)
 
         def mesh():
-            return to_trimesh(prism_m(outline, [circle_points(r_b, tol)], z0, z1))
+            return to_mesh(prism_m(outline, [circle_points(r_b, tol)], z0, z1))
 
         rmax = float(radii.max())
     else:
@@ -234,7 +234,7 @@ def plug(drive, sizes, tol: float) -> Part:
             return S.prism(S.circle_wire(R_out), [S.bspline_wire(outline)], width, z0)
 
         def mesh():
-            return to_trimesh(prism_m(circle_points(R_out, tol), [outline], z0, z1))
+            return to_mesh(prism_m(circle_points(R_out, tol), [outline], z0, z1))
 
         rmax = R_out
     info["volume_tol_mm3"] = tol * perim * width  # outline known to the chord tolerance along its whole length
@@ -295,8 +295,8 @@ def rigid(drive, sizes, style: str, tol: float) -> Part:
                 circle_points(Rf, tol), [band] + [circle_points(0.5 * h, tol, x, y) for x, y, h in holes], bw - tf, bw
             )
             if tf >= bw:
-                return to_trimesh(plate)
-            return to_trimesh(prism_m(circle_points(R, tol), [band], 0.0, bw - tf) + plate)
+                return to_mesh(plate)
+            return to_mesh(prism_m(circle_points(R, tol), [band], 0.0, bw - tf) + plate)
     else:
         tip_r = float(np.hypot(*g.outline.T).max())
         vol = (area - PI * R * R - hole_area) * bw
@@ -317,7 +317,7 @@ def rigid(drive, sizes, style: str, tol: float) -> Part:
             )
 
         def mesh():
-            return to_trimesh(
+            return to_mesh(
                 prism_m(
                     band, [circle_points(R, tol)] + [circle_points(0.5 * h, tol, x, y) for x, y, h in holes], 0.0, bw
                 )

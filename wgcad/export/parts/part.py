@@ -19,7 +19,7 @@ class Part:
     layers : list of DxfLayer
         Top-view drawing, incl. a ``GEAR_DATA`` text layer for gears.
     make_solid : callable -> OCP TopoDS_Shape
-    make_mesh : callable -> trimesh.Trimesh
+    make_mesh : callable -> wgcad.export.mesh.Mesh
     volume_mm3 : float
         Volume from the 2D areas (area x height, annuli, holes), computed
         without any 3D kernel.
@@ -46,7 +46,7 @@ class Part:
         return self._solid
 
     def mesh(self):
-        """The trimesh mesh (built once)."""
+        """The mesh (built once)."""
         if self._mesh is None:
             self._mesh = self.make_mesh()
         return self._mesh

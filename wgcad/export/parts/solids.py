@@ -6,7 +6,7 @@ import math
 
 import numpy as np
 
-__all__ = ["n_segments", "circle_points", "prism_m", "revolve_m", "holes_m", "to_trimesh", "ccw"]
+__all__ = ["n_segments", "circle_points", "prism_m", "revolve_m", "holes_m", "to_mesh", "ccw"]
 
 
 def n_segments(radius: float, tol: float) -> int:
@@ -56,16 +56,16 @@ def holes_m(holes, z0: float, z1: float, tol: float):
     return out
 
 
-def to_trimesh(m):
-    """float64 trimesh of a manifold (``to_mesh64``: ``to_mesh`` would round to float32)."""
-    import trimesh
-
+def to_mesh(m):
+    """float64 :class:`wgcad.export.mesh.Mesh` of a manifold (``to_mesh64``: ``to_mesh`` would round to float32)."""
     from wgcad.errors import GeometryError
+
+    from ..mesh import Mesh
 
     mesh64 = m.to_mesh64()
     v = np.asarray(mesh64.vert_properties, dtype=np.float64)[:, :3]
     f = np.asarray(mesh64.tri_verts, dtype=np.int64)
-    mesh = trimesh.Trimesh(vertices=v, faces=f, process=False)
+    mesh = Mesh(v, f)
     if len(f) == 0 or not mesh.is_watertight or not mesh.is_volume:
         raise GeometryError("part mesh is empty or not a closed volume")
     return mesh
