@@ -195,3 +195,23 @@ def test_librecad_reads_the_file(tmp_path):
     )
     pdf = tmp_path / "gear.pdf"
     assert pdf.exists() and pdf.stat().st_size > 1000
+
+
+def test_layer_name_rule_agrees_with_ezdxf():
+    # wgcad checks layer names without importing ezdxf (a STEP-only part set need not load it); on plain names
+    # (no AutoCAD-special "*" layers, no backslash escapes: wgcad writes neither) both rules agree
+    import random
+
+    from ezdxf.lldxf.validator import is_valid_layer_name as ezdxf_rule
+
+    from wgcad.export.dxf import is_valid_layer_name
+
+    rng = random.Random(5)
+    alphabet = "AZaz09_- .#$%&()+,!@[]{}~'" + '<>/":;?*|=`'
+    names = ["FLEXSPLINE", "GEAR_DATA", "RIGID OUTER", "a<b", "xref|y", "q=1", 'say "hi"', "back`tick"]
+    names += ["".join(rng.choice(alphabet) for _ in range(rng.randint(1, 12))) for _ in range(2000)]
+    for name in names:
+        if name.startswith("*"):
+            continue
+        assert is_valid_layer_name(name) == ezdxf_rule(name), name
+    assert not is_valid_layer_name("")

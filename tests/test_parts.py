@@ -1,6 +1,9 @@
 """Tests of the part set (wgcad parts): every export read back and checked against the 2D areas, the plug against the law's neutral line, bad sizes refused with nothing written."""
 
 import re
+import shutil
+import subprocess
+import sys
 
 import numpy as np
 import pytest
@@ -131,6 +134,31 @@ def test_step_solids_valid_with_2d_volumes_and_bounds(small_run):
         assert np.all(np.abs(hi[:2]) <= np.abs(ehi[:2]) + 1e-6)
 
 
+@pytest.mark.skipif(shutil.which("freecadcmd") is None, reason="FreeCAD (freecadcmd) not installed")
+def test_freecad_reads_every_step_solid(small_run, tmp_path):
+    # a second reader, the way a user's CAD program opens the files: the STEP carries no pcurves (issue 22,
+    # write.surfacecurve.mode 0), so the reader builds them; every part must come back one valid solid of the
+    # volume OCP reads
+    from wgcad.export.step import read_step, solid_props
+
+    out, parts, drive = small_run
+    script = tmp_path / "read.py"
+    files = [out / f"small_{n}.step" for n in ("flexspline", "plug", "rigid")]
+    script.write_text(
+        "import Part\n"
+        + "".join(
+            f"s = Part.read({str(f)!r}); print('PART', s.isValid(), len(s.Solids), repr(s.Volume))\n" for f in files
+        )
+    )
+    res = subprocess.run(["freecadcmd", str(script)], capture_output=True, text=True, timeout=600)
+    rows = [line.split()[1:] for line in res.stdout.splitlines() if line.startswith("PART ")]
+    assert len(rows) == 3, res.stdout + res.stderr
+    for f, (valid, n_solids, volume) in zip(files, rows):
+        assert valid == "True" and n_solids == "1", f.name
+        ocp = solid_props(read_step(f)[0])["volume"]
+        assert float(volume) == pytest.approx(ocp, rel=1e-9), f.name
+
+
 def test_step_is_byte_reproducible(small_run, tmp_path):
     out, parts, drive = small_run
     from wgcad.export.step import write_step
@@ -231,3 +259,31 @@ def test_parts_json_reports_sizes_and_defaults(tmp_path, capsys):
     assert rep["sizes_mm"]["cup_bolt_count"] == 6 and "cup_bolt_count" not in rep["derived_from_gear_size"]
     assert "cup_length" in rep["derived_from_gear_size"]
     assert rep["parts"]["flexspline"]["gear_data"]["teeth"] == 40
+
+
+def test_step_only_part_set_does_not_load_ezdxf(tmp_path):
+    # issue 22: a STEP-only run imported ezdxf (and its DXF writer) for nothing
+    code = (
+        "import sys; from wgcad.cli import main; "
+        f"rc = main(['parts', {str(TEMPLATES / 'd3_external.toml')!r}, '--out', {str(tmp_path)!r}, "
+        "'--format', 'step', '--quiet']); "
+        "print(rc, 'ezdxf' in sys.modules, 'trimesh' in sys.modules)"
+    )
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=600)
+    assert out.stdout.split() == ["0", "False", "False"], out.stdout + out.stderr
+    assert list(tmp_path.glob("*.step"))
+
+
+@pytest.mark.parametrize("name", ["d1_involute", "d2", "d4_discrete"])
+def test_cup_flexspline_step_solid_on_templates(name):
+    # the cup is glued onto the toothed ring (OCCT's glue mode: they share a face, no volume); on the real
+    # templates the glued solid must be one valid solid of the volume its 2D areas give
+    from wgcad.export.step import solid_props
+
+    path = TEMPLATES / f"{name}.toml"
+    drive = build_drive(load_design(path))
+    flex = build_parts(drive, part_sizes(load_parts(path), drive))[0]
+    assert flex.info["kind"] == "cup flexspline"
+    pr = solid_props(flex.solid())
+    assert pr["valid"], name
+    assert pr["volume"] == pytest.approx(flex.volume_mm3, rel=1e-9), name

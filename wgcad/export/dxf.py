@@ -7,9 +7,7 @@ import math
 import os
 from dataclasses import dataclass, field
 
-import ezdxf
 import numpy as np
-from ezdxf.lldxf.validator import is_valid_layer_name
 
 from wgcad.atomic import atomic_writer
 from wgcad.constants import DUPLICATE_TOL  # noqa: F401  (re-exported for callers)
@@ -27,6 +25,20 @@ INSUNITS_MM = 4
 
 #: ``$MEASUREMENT`` 1 = metric.
 MEASUREMENT_METRIC = 1
+
+
+#: characters DXF forbids in a layer name (AutoCAD's symbol-table rule)
+_BAD_LAYER_CHARS = frozenset('<>/\\":;?*=`')
+
+
+def is_valid_layer_name(name: str) -> bool:
+    """A plain DXF layer name: 1-255 printable characters, none of ``<>/\\":;?*=`` or the backquote.
+
+    ezdxf's rule less AutoCAD-special ``*`` layers and ``\\U+`` escapes, which
+    wgcad's names never need (``|`` is allowed: external-reference layers); checked here so that building
+    layers does not import ezdxf (tests/test_dxf.py compares the two).
+    """
+    return 0 < len(name) <= 255 and name.isprintable() and not (_BAD_LAYER_CHARS & set(name))
 
 
 def _readonly(a: np.ndarray) -> np.ndarray:
@@ -106,7 +118,7 @@ class DxfLayer:
         object.__setattr__(self, "color", int(self.color))
 
 
-def build_dxf(layers) -> ezdxf.document.Drawing:
+def build_dxf(layers):
     """Build an in-memory DXF R2010 drawing of the layers.
 
     Each outline becomes one closed LWPOLYLINE (after :func:`clean_outline`),
@@ -130,6 +142,8 @@ def build_dxf(layers) -> ezdxf.document.Drawing:
         On a duplicate layer name or an outline with fewer than 3 distinct
         vertices.
     """
+    import ezdxf  # here, not at the top: building layers (the part set for a STEP-only run) needs no ezdxf
+
     with _fixed_metadata():
         doc = ezdxf.new(DXF_VERSION)
     doc.header["$INSUNITS"] = INSUNITS_MM
@@ -223,6 +237,8 @@ def clean_path(vertices, bulges, tol: float | None = None):
 def _fixed_metadata():
     """ezdxf stamps times and random GUIDs into new and written documents;
     fixed values make the same design give byte-identical files."""
+    import ezdxf
+
     saved = ezdxf.options.write_fixed_meta_data_for_testing
     ezdxf.options.write_fixed_meta_data_for_testing = True
     try:
@@ -282,7 +298,9 @@ def _canonical_classes(doc) -> None:
     section.classes = OrderedDict(head + rest)
 
 
-def _readfile(path) -> ezdxf.document.Drawing:
+def _readfile(path):
+    import ezdxf
+
     try:
         return ezdxf.readfile(path)
     except OSError as exc:

@@ -165,11 +165,19 @@ def revolve_profile(rz):
     return BRepPrimAPI_MakeRevol(face, gp_Ax1(_pnt(0, 0, 0), gp_Dir(0, 0, 1)), 2 * np.pi).Shape()
 
 
-def fuse(a, b):
-    """Boolean union of two shapes."""
+def fuse(a, b, touching: bool = False):
+    """Boolean union of two shapes.
+
+    ``touching``: the shapes only touch (faces in common, no common volume);
+    OCCT's glue mode then skips the face-face intersections (the cup onto the
+    toothed ring: 1.0 -> 0.8 s and 14 MB less on D1, the same solid).
+    """
+    from OCP.BOPAlgo import BOPAlgo_GlueShift
     from OCP.BRepAlgoAPI import BRepAlgoAPI_Fuse
 
     op = BRepAlgoAPI_Fuse()
+    if touching:
+        op.SetGlue(BOPAlgo_GlueShift)
     _run(op, a, b)
     if not op.IsDone():
         raise GeometryError("solid union failed")
@@ -229,10 +237,17 @@ def step_text(shapes: dict, name: str = "wgcad") -> str:
     from OCP.STEPControl import STEPControl_AsIs, STEPControl_Writer
 
     _quiet()
-    Interface_Static.SetCVal_s("write.step.unit", "MM")
-    Interface_Static.SetCVal_s("write.step.schema", "AP214IS")
-    Interface_Static.SetCVal_s("write.step.product.name", name)
+    # the writer first: its constructor loads the STEP controller, and a static set before that does not exist
+    # yet (SetCVal_s returns False, silently)
     w = STEPControl_Writer()
+    for key, val in (("write.step.unit", "MM"), ("write.step.schema", "AP214IS"), ("write.step.product.name", name)):
+        if not Interface_Static.SetCVal_s(key, val):
+            raise GeometryError(f"OpenCASCADE has no STEP setting {key}")
+    # no 2D parameter curves of the edges on their faces (pcurves): every edge is written as its 3D curve,
+    # which is the geometry; readers rebuild pcurves as they load. On D1's part set this is 16.7 -> 6.6 MB
+    # and 1.8 -> 1.1 s, and OCP and FreeCAD read back the same valid solids (tests/test_parts.py)
+    if not Interface_Static.SetIVal_s("write.surfacecurve.mode", 0):
+        raise GeometryError("OpenCASCADE has no STEP setting write.surfacecurve.mode")
     for part, shape in shapes.items():
         Interface_Static.SetCVal_s("write.step.product.name", part)
         if w.Transfer(shape, STEPControl_AsIs) != IFSelect_RetDone:

@@ -95,7 +95,7 @@ def flexspline(drive, sizes, style: str, tol: float) -> Part:
     def solid():
         # holes first, in the small shell: booleans cost grows with the faces involved
         ring = S.prism(S.wire_from_path(path.vertices, path.bulges), [S.circle_wire(r_rim)], bw)
-        return S.fuse(ring, S.drill(S.revolve_profile(rz), holes, L - td, L))
+        return S.fuse(ring, S.drill(S.revolve_profile(rz), holes, L - td, L), touching=True)
 
     def mesh():
         ring = prism_m(band, [circle_points(r_rim, tol)], 0.0, bw)
