@@ -15,7 +15,7 @@ ROOT = Path(__file__).resolve().parent.parent / "wgcad"
 
 #: ground first; a unit is a top-level module or package of wgcad
 FLOORS = [
-    {"errors", "constants", "roots"},
+    {"errors", "constants", "roots", "units", "plane"},
     {"numbers", "userfiles", "atomic"},
     {"design"},
     {"laws"},

@@ -49,6 +49,8 @@ from math import pi
 
 import numpy as np
 
+from wgcad.units import ARCSEC_PER_RAD
+
 from ..clearance.closing import closing_direct
 from ..errors import DesignError, ModelError
 from ..kinematics import gear_ratios
@@ -94,7 +96,7 @@ def _side_coeffs(tab, side, imp, lever):
 #: is apart were within 0.5''; turning back by up to 300'' within 1.8''; by more than 600'' (the open end
 #: with the full [S4] errors) up to 650'' off, median 38''. The separating feature of so deep an overlap
 #: changes with the errors. 300..600'' were not met.
-DEEP_OVERLAP = 300.0 / 206264.80624709636
+DEEP_OVERLAP = 300.0 / ARCSEC_PER_RAD
 
 
 def _theta(tab, dw, dn):

@@ -14,6 +14,8 @@ from math import pi
 
 import numpy as np
 
+from wgcad.units import ARCSEC_PER_RAD
+
 from ..clearance.closing import closing_rotation
 from ..clearance.distance import Template
 from ..errors import DesignError
@@ -297,7 +299,7 @@ def _can_be_first(tab: ContactTable, side: int, imp: Imperfections, pending, fle
 _RADIAL_STEPS = (-0.25, 0.25, -0.5, 0.5, -1.0, 1.0)
 #: a contact found with the tooth moved is another feature when it closes earlier than the lines known
 #: predict by more than this, rad (0.01 arcsec)
-_LINE_TOL = 0.01 / 206264.80624709636
+_LINE_TOL = 0.01 / ARCSEC_PER_RAD
 
 
 def _second_features(

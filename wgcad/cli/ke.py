@@ -5,11 +5,13 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
+from wgcad.units import ARCSEC_PER_RAD
+
 from .common import EPILOG, EXIT_OK, whole_number
 
 __all__ = ["register", "cmd_ke"]
 
-_AS = 180.0 / 3.141592653589793 * 3600.0
+_AS = ARCSEC_PER_RAD
 
 
 def cmd_ke(args) -> int:

@@ -4,12 +4,14 @@ from __future__ import annotations
 
 import numpy as np
 
+from wgcad.units import ARCSEC_PER_RAD
+
 from .mpl import png_bytes
 from .mpl import pyplot as _plt
 
 __all__ = ["ke_png", "install_png", "flank_png", "ke_load_png"]
 
-_AS = 180.0 / np.pi * 3600.0
+_AS = ARCSEC_PER_RAD
 
 
 def _png(fig, plt) -> bytes:

@@ -18,6 +18,7 @@ from wgcad.atomic import atomic_write
 from wgcad.errors import GeometryError
 from wgcad.export.mesh import Mesh
 from wgcad.export.rings import clean_outline
+from wgcad.plane import signed_area
 
 __all__ = ["ring_solid", "stl_bytes", "write_stl"]
 
@@ -37,11 +38,6 @@ def _ring(points, what: str) -> np.ndarray:
     # repeated points are removed before extrusion: trimesh's extruder silently
     # builds broken meshes from them and manifold3d would merge them anyway
     return clean_outline(points, what=what, too_few=GeometryError)
-
-
-def _signed_area(pts: np.ndarray) -> float:
-    x, y = pts[:, 0], pts[:, 1]
-    return 0.5 * float(np.dot(x, np.roll(y, -1)) - np.dot(np.roll(x, -1), y))
 
 
 def ring_solid(outer, holes=(), height: float = 1.0) -> Mesh:
@@ -87,12 +83,12 @@ def ring_solid(outer, holes=(), height: float = 1.0) -> Mesh:
     if not (math.isfinite(height) and height > 0):
         raise ValueError(f"height must be a positive finite number of mm, got {height}")
     outer = _ring(outer, "outer boundary")
-    if _signed_area(outer) < 0:
+    if signed_area(outer) < 0:
         outer = outer[::-1]
     ring_holes = []
     for k, hole in enumerate(holes):
         h = _ring(hole, f"hole {k}")
-        if _signed_area(h) > 0:
+        if signed_area(h) > 0:
             h = h[::-1]
         ring_holes.append(h)
 

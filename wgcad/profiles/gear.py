@@ -9,6 +9,7 @@ import numpy as np
 
 from .. import constants
 from ..errors import DesignError
+from ..plane import signed_area
 from . import cycloid as cy
 from . import involute as iv
 from . import pieces as pc
@@ -142,8 +143,7 @@ class Gear:
 
     def area(self) -> float:
         """Area enclosed by :attr:`outline` (shoelace), mm^2."""
-        x, y = self.outline[:, 0], self.outline[:, 1]
-        return 0.5 * float(np.dot(x, np.roll(y, -1)) - np.dot(np.roll(x, -1), y))
+        return signed_area(self.outline)
 
 
 def _thin_angle(sp: ToothSpec, r: float) -> float:

@@ -25,13 +25,15 @@ from collections import OrderedDict
 
 import numpy as np
 
+from wgcad.units import ARCSEC_PER_RAD
+
 from ..errors import DesignError, ModelError, WgcadError
 from .figures import parse_figure
 from .sampling import envelope_amplitudes_um, sample_design_data, sample_values
 
 __all__ = ["run_batch", "run_sample", "columns_of", "cache_info", "clear_cache", "noop"]
 
-_AS = 180.0 / math.pi * 3600.0
+_AS = ARCSEC_PER_RAD
 #: entries kept per kind: a grid study walks its grid point by point (samples of a point are
 #: consecutive), so a few entries suffice; each D2 contact table is ~100 MB at most
 _SIZES = {"base": 4, "drive": 4, "table": 3, "model": 2, "audit": 64, "load": 64}

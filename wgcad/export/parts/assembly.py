@@ -5,6 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 from wgcad.errors import GeometryError
+from wgcad.plane import signed_area
 
 from ..mesh import concatenate
 from .part import Part
@@ -24,8 +25,7 @@ def _rot(p, a):
 
 
 def _area(p) -> float:
-    x, y = p[:, 0], p[:, 1]
-    return abs(0.5 * float(np.dot(x, np.roll(y, -1)) - np.dot(np.roll(x, -1), y)))
+    return abs(signed_area(p))
 
 
 def deformed_assembly(drive, sizes, generator_angle_deg: float, tol: float) -> Part:

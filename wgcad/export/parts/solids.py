@@ -6,6 +6,8 @@ import math
 
 import numpy as np
 
+from wgcad.plane import signed_area
+
 __all__ = ["n_segments", "circle_points", "prism_m", "revolve_m", "holes_m", "to_mesh", "ccw"]
 
 
@@ -23,9 +25,7 @@ def circle_points(radius: float, tol: float, cx: float = 0.0, cy: float = 0.0) -
 
 def ccw(pts: np.ndarray, positive: bool = True) -> np.ndarray:
     """The polygon oriented counter-clockwise (``positive``) or clockwise."""
-    x, y = pts[:, 0], pts[:, 1]
-    area = 0.5 * float(np.dot(x, np.roll(y, -1)) - np.dot(np.roll(x, -1), y))
-    return pts if (area > 0) == positive else pts[::-1]
+    return pts if (signed_area(pts) > 0) == positive else pts[::-1]
 
 
 def prism_m(outer, holes, z0: float, z1: float):
