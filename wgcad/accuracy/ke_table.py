@@ -415,8 +415,13 @@ def _refine(tab: ContactTable, side: int, imp: Imperfections, flex, rigid, reach
     for ax in (0, 1):
         dv = np.zeros((e.size, 2))
         dv[:, ax] = _FD_H
-        cp = closing_rotation(flex, S["rot"][e], S["shift"][e], rigid, rb, dv, side, reach, start=start)
-        cm = closing_rotation(flex, S["rot"][e], S["shift"][e], rigid, rb, -dv, side, reach, start=start)
+        # only the rotations are differenced: no nearest points read at the contacts (one measurement less)
+        cp = closing_rotation(
+            flex, S["rot"][e], S["shift"][e], rigid, rb, dv, side, reach, start=start, contact_data=False
+        )
+        cm = closing_rotation(
+            flex, S["rot"][e], S["shift"][e], rigid, rb, -dv, side, reach, start=start, contact_data=False
+        )
         nt[:, ax] = (cp.delta - cm.delta) / (2 * _FD_H)
     # a difference across a switch of the touching feature is no derivative: keep the nearest-point
     # normal's value there (within 50 % of it is a slide along one feature; the corner cases differ by ~10 %)

@@ -71,7 +71,16 @@ def _turn(rot, shift, t):
 
 
 def closing_rotation(
-    flex: Template, rot, shift, rigid: Template, rot_b, shift_b, side: float, reach: float, start=None
+    flex: Template,
+    rot,
+    shift,
+    rigid: Template,
+    rot_b,
+    shift_b,
+    side: float,
+    reach: float,
+    start=None,
+    contact_data: bool = True,
 ) -> Contact:
     """Rotation of the flexspline (about the axis, direction ``side``) that brings each tooth into contact with its rigid tooth.
 
@@ -97,6 +106,11 @@ def closing_rotation(
         a start where the pair is still apart (before its contact) is safe:
         from an overlapping start the search turns back and can end at
         another contact.
+    contact_data : bool
+        Read the nearest points and ``nt`` at a fixed small gap before the
+        contact (one more measurement of every pair); without it ``p``,
+        ``q``, ``nt`` are those of the last iterate, for callers that use
+        only ``delta`` (the finite differences of the KE table).
 
     Returns
     -------
@@ -201,7 +215,7 @@ def closing_rotation(
     # 11 % of the KE samples were up to 35 arcsec off the direct computation);
     # at a fixed gap just before touching it is the direction the contact closes along.
     back = np.nonzero(ok & np.all(np.isfinite(nt), axis=1))[0]
-    if back.size:
+    if back.size and contact_data:
         tb = delta[back] - BACKOFF * np.hypot(nt[back, 0], nt[back, 1])
         d, line = measure(tb, back)
         good = d > 0.25 * BACKOFF
