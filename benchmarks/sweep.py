@@ -1,4 +1,4 @@
-"""Benchmark of `wgcad sweep` on Dask: per-task overhead, tasks per second, scaling from 1 to 2 workers, and D2's 10,000-sample KE tolerance Monte Carlo.
+"""Benchmark of `wgcad sweep` on Dask: per-task overhead, tasks per second, scaling over 1, 2 and 4 workers, and D2's 10,000-sample KE tolerance Monte Carlo.
 
 Run from the repository root (not part of the test run):
 
@@ -15,10 +15,12 @@ machine may be shared):
   shared data (drive and KE contact table, built once per worker) and the
   per-sample time after it (best of 3 over 5 samples), wall and CPU (on a
   shared machine the CPU time is the process's own work);
-* the same spec, N samples, on LocalClusters of 1 and 2 workers (each started
+* the same spec, N samples, on LocalClusters of 1, 2 and 4 workers (``--workers``; each started
   fresh: cluster start and the per-worker shared data included): samples/s,
   the speed-up, worker time per sample, and the share of the workers' time
-  not spent computing samples (Dask, the client storing chunks, idle at the end);
+  not spent computing samples (Dask, the client storing chunks, idle at the end),
+  each with the cores that were free before it (cores less the 1-minute load
+  average): more workers than free cores cannot scale, and the figures say so;
 * tasks of 1 sample against the measured grain on the same samples: what the
   per-task overhead costs when tasks are too small;
 * with --full: the 10,000 samples of the template on 2 workers, end to end.
@@ -105,7 +107,12 @@ def run(spec, workers, batch=None, samples=None):
 
 def main():
     ap = argparse.ArgumentParser()
-    ap.add_argument("--samples", type=int, default=160, help="samples of the 1-vs-2-worker runs")
+    ap.add_argument("--samples", type=int, default=160, help="samples of each worker-count run")
+    ap.add_argument(
+        "--workers",
+        default="1,2,4",
+        help="worker counts to run (comma list; more than the cores shows oversubscription)",
+    )
     ap.add_argument("--full", action="store_true", help="also the 10,000-sample Monte Carlo")
     args = ap.parse_args()
     spec = load_spec(SPEC)
@@ -119,10 +126,15 @@ def main():
     out["sample_cpu_s_in_process"] = round(cpu, 4)
     n = args.samples
     res = {}
-    for w in (1, 2):
+    counts = sorted({int(x) for x in args.workers.split(",")} | {1, 2})
+    for w in counts:
+        before = os.getloadavg()[0]
         info = run(spec, w, samples=n)
         res[w] = info
         out[f"workers_{w}"] = {
+            # what else was running: the cores not busy before the run, from the 1-minute load average
+            "cores": os.cpu_count(),
+            "cores_free_before": round(max(0.0, os.cpu_count() - before), 2),
             "samples": n,
             "wall_s": round(info.wall_s, 2),
             "samples_per_s": round(n / info.wall_s, 3),
@@ -133,7 +145,8 @@ def main():
             "share_not_computing": round(1 - info.worker_s / (w * info.wall_s), 3),
             "load": load(),
         }
-    out["speedup_2_vs_1"] = round(res[1].wall_s / res[2].wall_s, 3)
+    for w in counts[1:]:
+        out[f"speedup_{w}_vs_1"] = round(res[1].wall_s / res[w].wall_s, 3)
     small = run(spec, 2, batch=1, samples=n)
     out["batch_1_on_2_workers"] = {
         "wall_s": round(small.wall_s, 2),
