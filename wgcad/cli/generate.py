@@ -10,106 +10,7 @@ from pathlib import Path
 
 from .common import EPILOG, EXIT_OK, add_memory_flag, angle_tag, angles_deg, circle, out_dir, positive_float
 
-__all__ = ["register", "cmd_generate", "deformed_scene", "report_name"]
-
-
-def deformed_scene(drive, phi_h_abs: float, imp=None) -> dict:
-    """Geometry of the deformed drive at generator angle ``phi_h_abs`` (rad, relative to the fixed member).
-
-    With ``imp`` (:class:`wgcad.placement.imperfect.Imperfections`, rigid gear
-    fixed) every tooth of both gears sits where its errors put it
-    (``flex_poses``, ``rigid_poses``), and the rim and neutral line move with
-    the cam offset (docs/models.md 6.2).
-    """
-    import numpy as np
-
-    from ..kinematics import gear_ratios
-    from ..placement import deformed_curve, join_teeth, place_flex_teeth, tooth_angles, transform
-
-    d = drive.design.drive
-    ratios = gear_ratios(d.z_flex, d.z_rigid)
-    if d.fixed == "rigid":
-        phi_h, frame = phi_h_abs, 0.0
-    else:  # flexspline fixed: the rigid gear turns by phi_h / u_hb; draw in the flexspline's frame
-        phi_b = phi_h_abs / ratios["u_hb"]
-        phi_h, frame = phi_h_abs - phi_b, phi_b
-    _, phi = tooth_angles(d.z_flex, d.z_rigid, phi_h)
-    if imp is not None:
-        from ..placement.imperfect import cam_offset, flex_poses, rigid_poses
-
-        teeth = transform(drive.flex.period, *flex_poses(drive, imp, phi_h))
-        rigid_outline = join_teeth(transform(drive.rigid.period, *rigid_poses(drive, imp)))
-        E = cam_offset(imp, phi_h, phi_h / ratios["u_hg"])  # the rim and its neutral line move with the cam
-    else:
-        teeth = place_flex_teeth(drive, phi_h, local=drive.flex.period)
-        rigid_outline, E = drive.rigid.outline, np.zeros(2)
-    n_rim = max(720, int(np.ceil(2 * np.pi / np.sqrt(8 * drive.tol / drive.r_m))))
-    ph = np.linspace(0.0, 2 * np.pi, n_rim, endpoint=False)
-    rim = deformed_curve(drive.law, drive.r_m, drive.flex_rim_radius - drive.r_m, ph)
-    neutral = deformed_curve(drive.law, drive.r_m, 0.0, ph)
-
-    def rot(p, a):
-        c, s = np.cos(a), np.sin(a)
-        return np.stack([c * p[..., 0] - s * p[..., 1], s * p[..., 0] + c * p[..., 1]], axis=-1)
-
-    teeth = rot(teeth, frame)
-    outline = join_teeth(teeth)
-    import shapely
-
-    if not shapely.LinearRing(outline).is_simple:
-        from ..errors import GeometryError
-
-        raise GeometryError(
-            f"deformed flexspline outline at generator angle {np.rad2deg(phi_h_abs):g} deg is not simple"
-        )
-    # how far toward the minor axis the tips still overlap the rigid tip circle (close-up extent)
-    R = np.hypot(teeth[..., 0], teeth[..., 1])
-    over = (R.min(axis=1) < drive.rigid.r_a) if drive.external else (R.max(axis=1) > drive.rigid.r_a)
-    phw = (phi + np.pi) % (2 * np.pi) - np.pi
-    side = phw * (1.0 if d.rotation == "ccw" else -1.0)
-    reach = side[over & (side >= 0) & (side <= np.pi / d.waves)]
-    entry_deg = float(np.rad2deg(reach.max())) + 4.0 if reach.size else 45.0
-    st = drive.law.state(ph)
-    return {
-        "flex_teeth": teeth,
-        "flex_phi": phi,
-        "flex_outline": outline,
-        "entry_deg": min(entry_deg, 180.0 / d.waves),
-        "neutral_phi": ph + phi_h + frame,
-        "neutral_w": st.w,
-        "r_m": drive.r_m,
-        "waves": d.waves,
-        "w0": drive.law.w0,
-        "flex_rim": rot(rot(rim, phi_h), frame) + E,
-        "neutral": rot(rot(neutral, phi_h), frame) + E,
-        "rigid_outline": rot(rigid_outline, frame),
-        "imperfect": imp is not None,
-        "rigid_rim_radius": drive.rigid_rim_radius,
-        "major_axis": phi_h + frame,
-        "entry_sign": 1.0 if d.rotation == "ccw" else -1.0,
-        "r_ref": drive.rigid.r,
-        "module": d.module,
-        "rigid_outward": not drive.external,
-        # radial window of the close-up: both gears' teeth, the flexspline's moved by up to +-1.2 W0
-        "y_range": (
-            min(
-                drive.rigid.r_a,
-                drive.rigid.r_f,
-                drive.flex.r_a - 1.2 * drive.law.w0,
-                drive.flex.r_f - 1.2 * drive.law.w0,
-            )
-            - drive.rigid.r
-            - 0.2 * d.module,
-            max(
-                drive.rigid.r_a,
-                drive.rigid.r_f,
-                drive.flex.r_a + 1.2 * drive.law.w0,
-                drive.flex.r_f + 1.2 * drive.law.w0,
-            )
-            - drive.rigid.r
-            + 0.2 * d.module,
-        ),
-    }
+__all__ = ["register", "cmd_generate", "report_name"]
 
 
 # Relative cost of the steps of `generate`, for the progress bar (measured on D1 involute:
@@ -231,6 +132,7 @@ def cmd_generate(args) -> int:
             import numpy as np
 
             from ..export.figures import assembly_png
+            from ..report.deformed import deformed_scene
         for deg in angles:
             bar.set(done / total, f"{deg:g} deg: DXF")
             scene = deformed_scene(drive, np.deg2rad(deg), imp)

@@ -19,11 +19,6 @@ __all__ = ["deformed_assembly", "N_SLICES_CONED"]
 N_SLICES_CONED = 6
 
 
-def _rot(p, a):
-    c, s = np.cos(a), np.sin(a)
-    return np.stack([c * p[..., 0] - s * p[..., 1], s * p[..., 0] + c * p[..., 1]], axis=-1)
-
-
 def _area(p) -> float:
     return abs(signed_area(p))
 
@@ -38,41 +33,26 @@ def deformed_assembly(drive, sizes, generator_angle_deg: float, tol: float) -> P
         mesh per body (``rigid``, ``flexspline``, ``plug``) for 3MF; there is
         no STEP solid (``make_solid`` raises).
     """
-    import shapely
-
-    from wgcad.kinematics import gear_ratios
-    from wgcad.placement import deformed_curve, join_teeth, place_flex_teeth
+    from wgcad.placement.deformed import deformed_state, rim_samples, rotate
 
     from .bodies import plug_outline
 
     d = drive.design.drive
     bw = d.face_width
     phi_abs = float(np.deg2rad(generator_angle_deg))
-    if d.fixed == "rigid":
-        phi_h, frame = phi_abs, 0.0
-    else:  # flexspline fixed: draw in its frame (as `wgcad generate` does)
-        phi_b = phi_abs / gear_ratios(d.z_flex, d.z_rigid)["u_hb"]
-        phi_h, frame = phi_abs - phi_b, phi_b
-    n_rim = max(720, int(np.ceil(2 * np.pi / np.sqrt(8 * tol / drive.r_m))))
-    ph = np.linspace(0.0, 2 * np.pi, n_rim, endpoint=False)
     k = N_SLICES_CONED if drive.coned else 1
     edges = np.linspace(0.0, bw, k + 1)
     slices = []
     vol = 0.0
     for z0, z1 in zip(edges[:-1], edges[1:]):
-        zc = 0.5 * (z0 + z1)
-        teeth = _rot(place_flex_teeth(drive, phi_h, local=drive.flex.period, z=zc if drive.coned else None), frame)
-        outline = join_teeth(teeth)
-        law = drive.law_at(zc) if drive.coned else drive.law
-        rim = _rot(_rot(deformed_curve(law, drive.r_m, drive.flex_rim_radius - drive.r_m, ph), phi_h), frame)
-        if not shapely.LinearRing(outline).is_simple:
-            raise GeometryError(
-                f"deformed flexspline outline at {generator_angle_deg:g} deg, z = {zc:.3f} mm is not simple"
-            )
-        outer, hole = (rim, outline) if drive.external else (outline, rim)
+        # each slice the deformed section at its middle (the centre law without coning)
+        st = deformed_state(drive, phi_abs, tol, z=0.5 * (z0 + z1) if drive.coned else None)
+        outer, hole = (st.rim, st.flex_outline) if drive.external else (st.flex_outline, st.rim)
         slices.append((outer, hole, z0, z1))
         vol += (_area(outer) - _area(hole)) * (z1 - z0)
-    rigid_outline = _rot(drive.rigid.outline, frame)
+    phi_h, frame = st.phi_h, st.frame
+    n_rim = len(rim_samples(drive, tol))
+    rigid_outline = st.rigid_outline
     R = drive.rigid_rim_radius
     rim_c = circle_points(R, tol)
     if drive.external:
@@ -80,7 +60,7 @@ def deformed_assembly(drive, sizes, generator_angle_deg: float, tol: float) -> P
     else:
         vol += (_area(rim_c) - _area(rigid_outline)) * bw
     po = plug_outline(drive, sizes, n_rim)
-    plug = _rot(_rot(po["outline"], phi_h), frame)
+    plug = rotate(rotate(po["outline"], phi_h), frame)
     pz0, pz1 = po["z_mm"] - 0.5 * sizes.bearing_width, po["z_mm"] + 0.5 * sizes.bearing_width
     if drive.external:
         R_out = float(np.hypot(*po["outline"].T).max()) + max(2.0, sizes.bearing_thickness)
