@@ -58,7 +58,7 @@ def cmd_audit(args) -> int:
     bar = Progress(want_progress(args.progress) and (args.progress or not args.quiet))
     bar.start("loading modules")
     _check_outputs(args)
-    from ..audit import RunSettings, run_audit
+    from ..audit import RunSettings
 
     bar.set(0.0, "reading the design")
 
@@ -96,38 +96,19 @@ def cmd_audit(args) -> int:
     rs.check()
     # the engine reports (done, total, stage); it fills the bar up to 90 % (95 % without pictures)
     work_end = 0.6 if args.plot else (0.9 if args.engine == "2d" else 0.8)
-    drive, result = run_audit(args.design, rs, progress=bar.span(0.02, work_end, "clearance"))
-    from ..report.audit import audit_json
+    from ..report.audit_run import audit_document
 
-    res = audit_json(result)
-    res["design"] = drive.design.drive.name
-    res["source"] = drive.design.source
-    from .common import not_modelled
-
-    imperfect = bool(res["settings"].get("imperfections"))
-    res["not_checked"] = not_modelled(drive.design, "this audit", imperfections=imperfect)
-    if imperfect:
-        res["not_checked"] += _imperfect_not_checked(args, res["settings"])
-    if args.engine in ("fcl", "both"):
-        bar.set(work_end, "3D check (fcl)")
-        from ..clearance.fcl3d import verify_worst
-
-        imp = None
-        if imperfect:
-            from ..placement.imperfect import Imperfections
-
-            imp = Imperfections.from_spec(drive.design.imperfections)
-        res["fcl"] = verify_worst(drive, result, imp=imp)
-        if args.engine == "fcl":
-            res["settings"]["engine"] = "fcl (3D check of the pairs the 2D engine singles out)"
-        else:
-            res["settings"]["engine"] = "2d + fcl"
-    drifts = None
-    if base is not None:
-        from ..regression import baseline_figures, compare
-
-        drifts = compare(base, baseline_figures(drive, res))
-        res["baseline"] = {"path": str(args.baseline), "drifts": [d.__dict__ for d in drifts]}
+    run = audit_document(
+        args.design,
+        rs,
+        engine=args.engine,
+        baseline=base,
+        baseline_path=args.baseline,
+        plot=bool(args.plot),
+        progress=bar.span(0.02, work_end, "clearance"),
+        on_stage=lambda name: bar.set(work_end, name),
+    )
+    drive, result, res, drifts = run.drive, run.result, run.doc, run.drifts
     res_text = json.dumps(res, allow_nan=False, indent=2) + "\n"
     base_text = None
     if args.write_baseline:
@@ -154,7 +135,9 @@ def cmd_audit(args) -> int:
                     Path(batch.temp_path(path)).write_text(text)
             if args.plot:
                 bar.set(0.9 if args.engine == "2d" else 0.95, "pictures")
-                pngs = dict(_audit_pngs(drive, result))
+                from ..export.audit_figures import audit_pngs
+
+                pngs = dict(audit_pngs(drive, result))
                 for suffix, path in _plot_paths(args.plot):
                     Path(batch.temp_path(path)).write_bytes(pngs[suffix])
     bar.set(1.0, "done")
@@ -177,162 +160,7 @@ def cmd_audit(args) -> int:
             write_stdout("\n".join(lines) + "\n")
         else:
             print("\n".join(lines), file=sys.stderr)
-    if drifts:
-        return EXIT_INTERFERENCE
-    return EXIT_INTERFERENCE if res["interference"] else EXIT_OK
-
-
-def _imperfect_not_checked(args, settings: dict) -> list[str]:
-    """What the audit of an imperfect drive (wgcad.clearance.imperfect) leaves to the perfect drive, said in the summary."""
-    notes = []
-    full = settings.get("full_cycle_turns")
-    done = settings.get("generator_turns", 1.0)
-    if not settings.get("shortcuts_that_hold", {}).get("one_generator_turn", True) and full and done < full - 1e-9:
-        notes.append(
-            f"generator turns beyond the first {done:g} of the {full}-turn cycle: the flexspline-borne errors "
-            f"(run-out, eccentricity, e_h^g) meet the housing's and the cam's in other phases there "
-            f"(--turns full sweeps all {full}, {full / max(done, 1e-9):g}x the samples)"
-        )
-    if args.plot:
-        notes.append(
-            "--plot with [imperfections]: the profile picture shows the perfect drive's passage (the vs_angle picture "
-            "shows every imperfect passage's entry gap, the tightest-spot picture the imperfect parts)"
-        )
-    return notes
-
-
-def _audit_pngs(drive, result):
-    import numpy as np
-    import shapely
-
-    from ..clearance.engine import Scene, clearance_profile, clearance_vs_angle
-    from ..export.figures import clearance_profile_png, clearance_vs_angle_png, tightest_spot_png
-    from ..placement import tooth_pose, transform
-
-    scene = Scene(drive)
-    imperfect = bool(result.settings.get("imperfections"))
-    perfect_note = " (perfect drive)" if imperfect else ""
-    secs = [None] if not drive.coned else [s for s in result.settings["sections_z_mm"]]
-    prof = clearance_profile(scene, secs)
-    from ..report.audit import audit_json
-
-    doc = audit_json(result)
-    w, e = doc["worst"], doc["entry"]
-    name = drive.design.drive.name
-    ent = result.findings["entry_crossing"].details
-    extra = {}
-    if imperfect and "perfect_gaps" in ent:
-        # the perfect drive's curve with its own entry crossing (on the exact curves) marked, and the imperfect
-        # parts' entry gap beside it (every passage has its own picture)
-        from ..clearance.entry import entry_crossings
-
-        gaps = entry_crossings(scene, secs, exact=True)
-        i = int(np.nanargmin([g for g, _ in gaps]))
-        entry_deg, entry_um = float(np.rad2deg(gaps[i][1])), 1e3 * gaps[i][0]
-        entry_label = "perfect drive's entry gap"
-        if np.isfinite(result.entry_gap):
-            extra = {
-                "entry2_deg": e["tooth_angle_deg"],
-                "entry2_um": 1e3 * result.entry_gap,
-                "entry2_label": f"imperfect parts' entry gap Delta (tooth {e.get('pinch_tooth' if e.get('kind') == 'pinch' else 'tooth')}, the smallest of "
-                f"{ent.get('passages', 0)} passages)",
-            }
-    else:
-        entry_deg, entry_um, entry_label = e["tooth_angle_deg"], 1e3 * result.entry_gap, "entry gap Delta"
-    data = {
-        "phi_deg": np.rad2deg(prof["phi"]),
-        "sections": [
-            {"z": s["z"], "working_um": 1e3 * s["working"], "nonworking_um": 1e3 * s["nonworking"]}
-            for s in prof["sections"]
-        ],
-        "entry_deg": entry_deg,
-        "entry_um": entry_um,
-        "entry_label": entry_label,
-        **extra,
-        "worst_label": "imperfect parts' minimum" if imperfect else "minimum",
-        "worst_deg": w["tooth_angle_deg"],
-        "worst_um": w["clearance_um"],
-        "tol_um": 1e3 * result.interference_tol,
-    }
-    yield (
-        "profile",
-        clearance_profile_png(
-            data, f"{name}: clearance of a flexspline tooth along its passage (every tooth follows it){perfect_note}"
-        ),
-    )
-    mesh = 360.0 / drive.design.drive.z_rigid
-    if imperfect and "all_passages" in ent:
-        # the errors break the mesh period: every passage of a tooth through the entry has its own gap
-        from ..export.imperfect_figures import entry_passages_png
-
-        a = ent["all_passages"]
-        yield (
-            "vs_angle",
-            entry_passages_png(
-                np.rad2deg(a["phi_h"]),
-                1e3 * a["gap"],
-                a["section"],
-                secs,
-                [1e3 * g for g in ent["perfect_gaps"]],
-                1e3 * result.interference_tol,
-                f"{name}: entry gap of every passage of a tooth through the entry, imperfect parts "
-                f"({result.settings.get('generator_turns', 1):g} generator turn(s); the audit's smallest is refined on the exact curves)",
-            ),
-        )
-    else:
-        ang = np.deg2rad(np.linspace(0.0, 3 * mesh, 601))
-        wv, nv = clearance_vs_angle(scene, prof, ang)
-        yield (
-            "vs_angle",
-            clearance_vs_angle_png(
-                np.rad2deg(ang),
-                1e3 * wv,
-                1e3 * nv,
-                1e3 * result.interference_tol,
-                f"{name}: smallest clearance over all teeth; periodic with the mesh period {mesh:.4f} deg (3 shown){perfect_note}",
-            ),
-        )
-    # the teeth around the tightest spot, at the worst sample's generator angle and section
-    phi_h = np.deg2rad(w["generator_angle_deg"])
-    z = w["section_z_mm"]
-    d = drive.design.drive
-    k = (w["tooth"] + np.arange(-3, 4)) % d.z_flex
-    mat = 2 * np.pi * k / d.z_flex + phi_h / scene.ratios["u_hg"]
-    rot, shift = tooth_pose(scene.law(z), mat - phi_h, drive.r_m, frame_angle=phi_h)
-    if imperfect:
-        # the imperfect drive's own teeth, where the audit found its tightest spot
-        from ..clearance.imperfect import ImperfectScene, flex_poses_batch
-        from ..placement.imperfect import Imperfections
-
-        imp = Imperfections.from_spec(drive.design.imperfections)
-        scene = ImperfectScene.from_scene(scene, imp)
-        rot, shift = flex_poses_batch(drive, imp, np.full(len(k), phi_h), k, [z])[0]
-        shift = scene.relative(shift)  # drawn in the frame of the rigid gear's own centre
-    teeth = transform(scene.flex_local, rot, shift)
-    lo, up, _ = scene.neighbours(shift, rot)
-    rig_idx = np.unique(np.concatenate([lo, up]))
-    rig = scene.rigid_pts[rig_idx]
-    overlaps = []
-    for t in teeth[3:4]:  # the worst tooth
-        a = shapely.Polygon(t)
-        for j in rig_idx:
-            inter = a.intersection(scene.rigid_geoms[j])
-            for g in getattr(inter, "geoms", [inter]):
-                if g.geom_type == "Polygon" and not g.is_empty:
-                    overlaps.append(np.asarray(g.exterior.coords))
-    labels = [f"{np.rad2deg(((p + np.pi) % (2 * np.pi)) - np.pi):.1f} deg" for p in (mat - phi_h)]
-    sec = "" if z is None else f", section z = {z:g} mm"
-    yield (
-        "tightest",
-        tightest_spot_png(
-            teeth,
-            labels,
-            rig,
-            overlaps,
-            f"{name}{' (imperfect parts)' if imperfect else ''}: tightest spot, tooth {w['tooth']} at generator angle {w['generator_angle_deg']:g} deg{sec}: "
-            f"{w['clearance_um']:.2f} um ({w['location']})",
-        ),
-    )
+    return EXIT_INTERFERENCE if run.failed else EXIT_OK
 
 
 def register(sub) -> None:

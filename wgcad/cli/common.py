@@ -34,7 +34,6 @@ __all__ = [
     "internal_error_line",
     "want_progress",
     "add_memory_flag",
-    "not_modelled",
 ]
 
 EXIT_OK = 0
@@ -244,22 +243,3 @@ def circle(radius: float, tol: float):
     n = max(64, int(np.ceil(2 * np.pi / step)))
     t = np.linspace(0.0, 2 * np.pi, n, endpoint=False)
     return np.stack([radius * np.cos(t), radius * np.sin(t)], axis=1)
-
-
-def not_modelled(design, command: str, imperfections: bool = False) -> list[str]:
-    """What a design's optional tables ask for that ``command`` does not model: said in every summary, never silent.
-
-    ``imperfections``: the command models ``[imperfections]`` (the 2D audit does).
-    """
-    notes = []
-    if design.sectors.active:
-        notes.append(
-            f"[sectors]: {command} uses the plain rigid gear of drive.z_rigid = {design.drive.z_rigid} teeth; "
-            "`wgcad sector` builds and audits the sectored gear"
-        )
-    if design.imperfections.any and not imperfections:
-        why = " (imperfect parts are modelled with a fixed rigid gear only)" if design.drive.fixed != "rigid" else ""
-        notes.append(
-            f"[imperfections]: {command} uses perfect parts{why}; `wgcad ke` computes the imperfect drive's kinematic error"
-        )
-    return notes

@@ -91,7 +91,7 @@ def cmd_generate(args) -> int:
         DxfLayer("RIGID_RIM", circles=((0.0, 0.0, drive.rigid_rim_radius),), color=1),
     ]
     rep = drive_report(drive)
-    from .common import not_modelled
+    from ..report.notes import not_modelled
 
     # the deformed assembly places the parts with their errors (rigid gear fixed: docs/models.md 6.2); the
     # gears' own DXF and STL stay nominal, the part a shop makes

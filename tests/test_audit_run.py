@@ -1,0 +1,47 @@
+"""The audit as a library call (wgcad.report.audit_run.audit_document) gives the CLI's document and verdict.
+
+Issue 20: the 3D check, the baseline comparison and the NOT CHECKED notes were wired in the CLI, so a
+library user of run_audit got none of them.
+"""
+
+from __future__ import annotations
+
+import json
+
+from conftest import TEMPLATES
+
+from wgcad.audit import RunSettings
+from wgcad.cli import main
+from wgcad.regression import load_baseline
+from wgcad.report.audit_run import audit_document
+
+D4 = TEMPLATES / "d4_discrete.toml"
+
+
+def _strip(doc):
+    doc = json.loads(json.dumps(doc))
+    doc.pop("elapsed_s", None)
+    for pair in doc.get("fcl", {}).get("pairs", []):
+        pair.pop("timing_ms", None)
+    doc.get("fcl", {}).pop("timing_ms", None)
+    return doc
+
+
+def test_library_document_equals_the_cli_json(tmp_path):
+    out = tmp_path / "a.json"
+    base = tmp_path / "base.json"
+    code = main(["audit", str(D4), "--step-deg", "2", "--engine", "both", "--json", str(out), "--quiet"])
+    assert main(["audit", str(D4), "--step-deg", "2", "--write-baseline", str(base), "--quiet"]) == code
+    run = audit_document(D4, RunSettings(step_deg=2.0), engine="both")
+    assert _strip(run.doc) == _strip(json.loads(out.read_text()))
+    assert run.failed == (code == 1)
+    assert "fcl" in run.doc and run.doc["not_checked"] == json.loads(out.read_text())["not_checked"]
+    # against its own baseline: no drift
+    again = audit_document(D4, RunSettings(step_deg=2.0), baseline=load_baseline(base), baseline_path=base)
+    assert again.drifts == [] and again.doc["baseline"]["drifts"] == []
+
+
+def test_library_document_says_what_it_did_not_check():
+    # D4 sectored: the audit uses the plain rigid gear, and says so in the document as the CLI does
+    run = audit_document(TEMPLATES / "d4_sectored.toml", RunSettings(step_deg=3.0, refine=False))
+    assert any("[sectors]" in n for n in run.doc["not_checked"])
