@@ -45,3 +45,19 @@ def test_library_document_says_what_it_did_not_check():
     # D4 sectored: the audit uses the plain rigid gear, and says so in the document as the CLI does
     run = audit_document(TEMPLATES / "d4_sectored.toml", RunSettings(step_deg=3.0, refine=False))
     assert any("[sectors]" in n for n in run.doc["not_checked"])
+
+
+def test_settings_errors_name_the_field_in_the_library_and_the_flag_in_the_cli(capsys):
+    import pytest
+
+    from wgcad.errors import DesignError
+
+    with pytest.raises(DesignError) as e:
+        RunSettings(step_deg=0.0).check()
+    assert e.value.field == "step_deg"
+    with pytest.raises(DesignError) as e:  # more turns of a perfect drive: refused inside the run
+        audit_document(D4, RunSettings(turns=2))
+    assert e.value.field == "turns"
+    assert main(["audit", str(D4), "--step-deg", "0.00001"]) == 2  # argparse takes it; the settings do not
+    err = capsys.readouterr().err
+    assert "--step-deg" in err and "step_deg" not in err

@@ -37,17 +37,23 @@ class RunSettings:
     def as_dict(self) -> dict:
         return dict(self.__dict__)
 
-    def check(self) -> RunSettings:
+    def check(self, names: dict | None = None) -> RunSettings:
+        """Raise DesignError naming the field (or ``names[field]``, e.g. the CLI's flag) whose value is out of bounds."""
+        names = names or {}
+
+        def bad(field, rule):
+            raise DesignError(names.get(field, field), rule)
+
         if not 1e-4 <= self.step_deg <= 90.0:
-            raise DesignError("--step-deg", f"must be in [1e-4, 90] degrees, got {self.step_deg:g}")
+            bad("step_deg", f"must be in [1e-4, 90] degrees, got {self.step_deg:g}")
         if not 1 <= self.sections <= 200:
-            raise DesignError("--sections", f"must be 1..200, got {self.sections}")
+            bad("sections", f"must be 1..200, got {self.sections}")
         if not 0.0 < self.chord_tol_um <= 100.0:
-            raise DesignError("--chord-tol-um", f"must be in (0, 100] um, got {self.chord_tol_um:g}")
+            bad("chord_tol_um", f"must be in (0, 100] um, got {self.chord_tol_um:g}")
         if self.turns is not None and not 1 <= self.turns <= 10_000:
-            raise DesignError("--turns", f"must be 1..10000 generator turns or 'full', got {self.turns}")
+            bad("turns", f"must be 1..10000 generator turns or 'full', got {self.turns}")
         if not 0.0 <= self.interference_tol_um <= 1000.0:
-            raise DesignError("--interference-tol-um", f"must be in [0, 1000] um, got {self.interference_tol_um:g}")
+            bad("interference_tol_um", f"must be in [0, 1000] um, got {self.interference_tol_um:g}")
         return self
 
 
@@ -56,6 +62,16 @@ def _sections(drive, k: int) -> np.ndarray:
     checked only mid-face, -14.6 um where the open end was at -58.8 um)."""
     bw = drive.design.drive.face_width
     return np.unique(np.concatenate([drive.sections(k), [0.0, bw]]))
+
+
+#: the CLI's flag of each RunSettings field, for its error lines
+FLAGS = {
+    "step_deg": "--step-deg",
+    "sections": "--sections",
+    "chord_tol_um": "--chord-tol-um",
+    "turns": "--turns",
+    "interference_tol_um": "--interference-tol-um",
+}
 
 
 def run_audit(design_path, rs: RunSettings, progress=None):
@@ -95,7 +111,7 @@ def run_audit(design_path, rs: RunSettings, progress=None):
         turns = full_cycle_turns(design.drive.z_flex, design.drive.z_rigid) if rs.turns is None else rs.turns
     elif rs.turns != 1:
         raise DesignError(
-            "--turns",
+            "turns",
             "sweeps more generator turns only for an imperfect drive (an [imperfections] table, "
             "rigid gear fixed): a perfect drive repeats every mesh period",
         )

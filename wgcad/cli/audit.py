@@ -58,7 +58,8 @@ def cmd_audit(args) -> int:
     bar = Progress(want_progress(args.progress) and (args.progress or not args.quiet))
     bar.start("loading modules")
     _check_outputs(args)
-    from ..audit import RunSettings
+    from ..audit import FLAGS, RunSettings
+    from ..errors import DesignError
 
     bar.set(0.0, "reading the design")
 
@@ -93,21 +94,26 @@ def cmd_audit(args) -> int:
             refine=not args.no_refine,
             turns=args.turns,
         )
-    rs.check()
+    rs.check(FLAGS)
     # the engine reports (done, total, stage); it fills the bar up to 90 % (95 % without pictures)
     work_end = 0.6 if args.plot else (0.9 if args.engine == "2d" else 0.8)
     from ..report.audit_run import audit_document
 
-    run = audit_document(
-        args.design,
-        rs,
-        engine=args.engine,
-        baseline=base,
-        baseline_path=args.baseline,
-        plot=bool(args.plot),
-        progress=bar.span(0.02, work_end, "clearance"),
-        on_stage=lambda name: bar.set(work_end, name),
-    )
+    try:
+        run = audit_document(
+            args.design,
+            rs,
+            engine=args.engine,
+            baseline=base,
+            baseline_path=args.baseline,
+            plot=bool(args.plot),
+            progress=bar.span(0.02, work_end, "clearance"),
+            on_stage=lambda name: bar.set(work_end, name),
+        )
+    except DesignError as exc:  # a run setting the design cannot take: named by the flag the user typed
+        if exc.field in FLAGS:
+            raise DesignError(FLAGS[exc.field], exc.rule) from None
+        raise
     drive, result, res, drifts = run.drive, run.result, run.doc, run.drifts
     res_text = json.dumps(res, allow_nan=False, indent=2) + "\n"
     base_text = None
