@@ -377,3 +377,23 @@ def test_drive_errors_in_s2_terms_are_the_drive_poses_errors(zone):
             float(dt + kin / math.cos(alpha)),
         )
         assert np.hypot(*rel) > 0.05  # the errors do move the teeth by tens of micrometres here
+
+
+def test_imperfections_from_spec_maps_every_key_with_its_unit():
+    # issue 20: from_spec was a 16-argument positional constructor renaming fields; every attribute must come
+    # from its own key, um -> mm and deg -> rad, and every key of the table must be used
+    import dataclasses
+    import math
+
+    from wgcad.design.imperfections import ImperfectionsSpec
+    from wgcad.placement.imperfect import SPEC_KEYS, Imperfections
+
+    keys = [f.name for f in dataclasses.fields(ImperfectionsSpec) if f.name.endswith(("_um", "_deg"))]
+    assert sorted(SPEC_KEYS.values()) == sorted(keys)
+    assert sorted(SPEC_KEYS) == sorted(f.name for f in dataclasses.fields(Imperfections))
+    values = {k: 1.0 + i for i, k in enumerate(keys)}  # a distinct value per key
+    spec = ImperfectionsSpec(**values)
+    imp = Imperfections.from_spec(spec)
+    for attr, key in SPEC_KEYS.items():
+        want = values[key] * 1e-3 if key.endswith("_um") else math.radians(values[key])
+        assert getattr(imp, attr) == pytest.approx(want, rel=1e-15), attr

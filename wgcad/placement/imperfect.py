@@ -50,6 +50,27 @@ __all__ = [
 ]
 
 
+#: the ``[imperfections]`` key (um or deg, by its suffix) of each :class:`Imperfections` attribute (mm or rad)
+SPEC_KEYS = {
+    "flex_runout": "flex_runout_um",
+    "flex_runout_phase": "flex_runout_phase_deg",
+    "rigid_runout": "rigid_runout_um",
+    "rigid_runout_phase": "rigid_runout_phase_deg",
+    "flex_ecc": "flex_eccentricity_um",
+    "flex_ecc_phase": "flex_eccentricity_phase_deg",
+    "rigid_ecc": "rigid_eccentricity_um",
+    "rigid_ecc_phase": "rigid_eccentricity_phase_deg",
+    "cam_cam": "cam_offset_cam_um",
+    "cam_cam_phase": "cam_offset_cam_phase_deg",
+    "cam_flex": "cam_offset_flex_um",
+    "cam_flex_phase": "cam_offset_flex_phase_deg",
+    "cam_fixed": "cam_offset_fixed_um",
+    "cam_fixed_phase": "cam_offset_fixed_phase_deg",
+    "rigid_install": "rigid_install_angle_deg",
+    "flex_install": "flex_install_angle_deg",
+}
+
+
 @dataclass(frozen=True)
 class Imperfections:
     """The errors of :class:`~wgcad.design.imperfections.ImperfectionsSpec` in mm and rad.
@@ -87,25 +108,12 @@ class Imperfections:
 
     @classmethod
     def from_spec(cls, spec) -> Imperfections:
-        """From the design table (um, deg) to mm, rad."""
-        s = spec
+        """From the design table (um, deg) to mm, rad: each attribute from its named key (:data:`SPEC_KEYS`)."""
         return cls(
-            1e-3 * s.flex_runout_um,
-            radians(s.flex_runout_phase_deg),
-            1e-3 * s.rigid_runout_um,
-            radians(s.rigid_runout_phase_deg),
-            1e-3 * s.flex_eccentricity_um,
-            radians(s.flex_eccentricity_phase_deg),
-            1e-3 * s.rigid_eccentricity_um,
-            radians(s.rigid_eccentricity_phase_deg),
-            1e-3 * s.cam_offset_cam_um,
-            radians(s.cam_offset_cam_phase_deg),
-            1e-3 * s.cam_offset_flex_um,
-            radians(s.cam_offset_flex_phase_deg),
-            1e-3 * s.cam_offset_fixed_um,
-            radians(s.cam_offset_fixed_phase_deg),
-            radians(s.rigid_install_angle_deg),
-            radians(s.flex_install_angle_deg),
+            **{
+                attr: (1e-3 * getattr(spec, key) if key.endswith("_um") else radians(getattr(spec, key)))
+                for attr, key in SPEC_KEYS.items()
+            }
         )
 
     def replace(self, **changes) -> Imperfections:
