@@ -234,3 +234,28 @@ def test_names_are_one_line(tmp_path, capsys):
 @pytest.mark.parametrize("name", NAMES)
 def test_every_template_is_within_every_bound(name):
     build_drive(load_design(TEMPLATES / f"{name}.toml"))
+
+
+@pytest.mark.parametrize(
+    "table,key,value,says",
+    [
+        ("imperfections", "flex_runout_um", float("nan"), "must be finite"),
+        ("imperfections", "cam_offset_fixed_um", -1.0, "must be in [0, m/4 (in um)"),
+        ("imperfections", "rigid_install_angle_deg", 400.0, "must be in [-360, 360]"),
+        ("material", "poisson", 0.5, "must be in [0, 0.5)"),
+        ("bearing", "groove_conformity", 1.0, "must be in (0.5, 1)"),
+        ("bearing", "balls", 2, "must be in [3, 1000]"),
+        ("load", "cam_offset_um", float("inf"), "must be finite"),
+    ],
+)
+def test_table_bounds_come_from_the_key_declarations(table, key, value, says):
+    # issue 20: [imperfections] and the load tables were checked twice, by their keys' bounds and by hand;
+    # the keys' bounds are the one rule now, also for a design changed in code (where NaN can reach them)
+    from wgcad.design import load_design
+    from wgcad.design.schema import with_changes
+    from wgcad.errors import DesignError
+
+    d = load_design(TEMPLATES / "d1_involute.toml")
+    with pytest.raises(DesignError) as e:
+        with_changes(d, **{table: {key: value}})
+    assert e.value.field == f"{table}.{key}" and says in e.value.rule, str(e.value)

@@ -265,13 +265,13 @@ def test_step_only_part_set_does_not_load_ezdxf(tmp_path):
     # issue 22: a STEP-only run imported ezdxf (and its DXF writer) for nothing
     code = (
         "import sys; from wgcad.cli import main; "
-        f"rc = main(['parts', {str(TEMPLATES / 'd3_external.toml')!r}, '--out', {str(tmp_path)!r}, "
+        f"rc = main(['parts', {str(small_design(tmp_path))!r}, '--out', {str(tmp_path / 'out')!r}, "
         "'--format', 'step', '--quiet']); "
         "print(rc, 'ezdxf' in sys.modules, 'trimesh' in sys.modules)"
     )
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=600)
     assert out.stdout.split() == ["0", "False", "False"], out.stdout + out.stderr
-    assert list(tmp_path.glob("*.step"))
+    assert list((tmp_path / "out").glob("*.step"))
 
 
 @pytest.mark.parametrize("name", ["d1_involute", "d2", "d4_discrete"])

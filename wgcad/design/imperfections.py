@@ -2,13 +2,11 @@
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass, fields
 
-from ..errors import DesignError
 from .rules import Rel, key
 
-__all__ = ["ImperfectionsSpec", "validate_imperfections"]
+__all__ = ["ImperfectionsSpec"]
 
 
 @dataclass(frozen=True)
@@ -125,27 +123,3 @@ class ImperfectionsSpec:
     def any(self) -> bool:
         """True if any error amplitude is non-zero (the installation angles alone change nothing)."""
         return any(v != 0.0 for v in self.amplitudes_um.values())
-
-
-def validate_imperfections(spec: ImperfectionsSpec, module: float) -> ImperfectionsSpec:
-    """Check the rules of ``[imperfections]``; return it unchanged or raise :class:`DesignError`.
-
-    Amplitudes are >= 0 (the phase carries the direction) and below a
-    quarter module: the KE model perturbs the perfect contact linearly
-    (docs/models.md 6.2) and an error of that size is a different drive,
-    not a tolerance. Angles lie in [-360, 360] degrees.
-    """
-    limit_um = 250.0 * module  # a quarter module, in um
-    for f in fields(spec):
-        val = getattr(spec, f.name)
-        where = f"imperfections.{f.name}"
-        if isinstance(val, bool) or not isinstance(val, (int, float)) or not math.isfinite(val):
-            raise DesignError(where, f"must be a finite number, got {val!r}")
-        if f.name.endswith("_um"):
-            if val < 0.0:
-                raise DesignError(where, f"must be >= 0 um (the phase carries the direction), got {val:g}")
-            if val > limit_um:
-                raise DesignError(where, f"must be at most a quarter module ({limit_um:g} um), got {val:g}")
-        elif not -360.0 <= val <= 360.0:
-            raise DesignError(where, f"must be in [-360, 360] degrees, got {val:g}")
-    return spec

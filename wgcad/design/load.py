@@ -7,7 +7,7 @@ from dataclasses import dataclass
 from ..errors import DesignError
 from .rules import key as _key
 
-__all__ = ["MaterialSpec", "BearingSpec", "LoadSpec", "validate_load_tables", "require_bearing"]
+__all__ = ["MaterialSpec", "BearingSpec", "LoadSpec", "require_bearing"]
 
 
 @dataclass(frozen=True)
@@ -185,36 +185,6 @@ class LoadSpec:
         default=None,
         default_doc="the cup wall as a thin tube from the diaphragm to the generator centre line; 0 without [generator] cone_length",
     )
-
-
-def _nonneg(where: str, value) -> None:
-    if value is not None and value < 0:
-        raise DesignError(where, f"must be >= 0, got {value:g}")
-
-
-def _pos(where: str, value) -> None:
-    if value is not None and not value > 0:
-        raise DesignError(where, f"must be > 0, got {value:g}")
-
-
-def validate_load_tables(d) -> None:
-    """Field rules of the three tables (raises :class:`DesignError` naming the field)."""
-    mat, br, ld = d.material, d.bearing, d.load
-    _pos("material.youngs_modulus_gpa", mat.youngs_modulus_gpa)
-    if not 0.0 <= mat.poisson < 0.5:
-        raise DesignError("material.poisson", f"must be in [0, 0.5), got {mat.poisson:g}")
-    _pos("material.rim_equivalent_thickness_mm", mat.rim_equivalent_thickness_mm)
-    _pos("material.cup_wall_thickness_mm", mat.cup_wall_thickness_mm)
-    if br.balls is not None and br.balls < 3:
-        raise DesignError("bearing.balls", f"must be at least 3, got {br.balls}")
-    for key in ("ball_diameter_mm", "width_mm", "outer_ring_thickness_mm"):
-        _pos(f"bearing.{key}", getattr(br, key))
-    for key in ("internal_clearance_um", "fit_clearance_um"):
-        _nonneg(f"bearing.{key}", getattr(br, key))
-    if not 0.5 < br.groove_conformity < 1.0:
-        raise DesignError("bearing.groove_conformity", f"must be in (0.5, 1), got {br.groove_conformity:g}")
-    _nonneg("load.rated_torque_nm", ld.rated_torque_nm)
-    _nonneg("load.cam_offset_um", ld.cam_offset_um)
 
 
 def require_bearing(d) -> BearingSpec:
