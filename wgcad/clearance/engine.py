@@ -40,6 +40,7 @@ import numpy as np
 from .. import constants
 from ..placement import tooth_pose
 from .backlash import backlash
+from .cascade import FINE, refine_candidates
 from .entry import (
     EDGES,
     entry_crossings,
@@ -120,13 +121,6 @@ class AuditResult:
             "pinch_phi": f["entry_pinch"].tooth_angle,
             "min_clearance_polygon": f["min_clearance"].polygon_value,
         }
-
-
-#: refinement: above this many candidate samples they are first sorted out on polygons _FINE
-#: times finer (chord tolerance / 8: margin 8 times smaller), which costs one finer outline
-#: (~30 ms) and a polygon pass, far less than refining hundreds of samples on the curves
-_FINE_ABOVE = 48
-_FINE = 8
 
 
 #: samples measured at once in the refinement stages: a flat minimum (D1's tip against a flank near the major axis
@@ -248,58 +242,33 @@ def audit(drive, settings: AuditSettings, progress=None) -> AuditResult:
         cand_i.append(keep)
         cand_v.append(r.value[keep])
     cand_s, cand_i, cand_v = np.concatenate(cand_s), np.concatenate(cand_i), np.concatenate(cand_v)
-    o = np.argsort(cand_v, kind="stable")
-    cand_s, cand_i, cand_v = cand_s[o], cand_i[o], cand_v[o]
-    n_refined = 0
-    n_fine = 0
-    ref_scene = scene
-    if settings.refine and len(cand_v) > _FINE_ABOVE:
-        # many samples within the polygon-curve margin (a flat minimum): sort them out on polygons
-        # FINE times finer first (cheap), whose margin is FINE times smaller, then refine the few left
-        from ..drive import build_drive
-
-        ref_scene = Scene(build_drive(drive.design, tol=drive.tol / _FINE))
-        cand_v = _chunked(
-            lambda sl: tooth_clearance_sections(ref_scene, phi_sorted[cand_i[sl]], cand_s[sl], sections), len(cand_i)
-        )
-        n_fine = len(cand_v)
-        o = np.argsort(cand_v, kind="stable")
-        cand_s, cand_i, cand_v = cand_s[o], cand_i[o], cand_v[o]
-        keep = cand_v <= cand_v[0] + 2.0 * ref_scene.chord_gap
-        cand_s, cand_i, cand_v = cand_s[keep], cand_i[keep], cand_v[keep]
+    n_refined = n_fine = 0
     if settings.refine:
-        exact_best, where = np.inf, (int(cand_s[0]), int(cand_i[0]))
-        at = 0
-        while at < len(cand_v):
-            # a sample whose polygon figure less the polygon-curve difference is not below the best exact
-            # figure cannot hold the minimum: stop there (candidates are in increasing order)
-            if cand_v[at] - ref_scene.chord_gap >= exact_best:
-                break
-            # the 16 lowest first (they set the bar), then every remaining candidate in one batch:
-            # the refinement's cost is per call, not per sample
-            live = (
-                np.nonzero(cand_v[at:] - ref_scene.chord_gap < exact_best)[0] + at
-                if at
-                else np.arange(min(16, len(cand_v)))
-            )
-            if live.size == 0:
-                break
-            sl = live
+
+        def fine(idx):
+            # many samples within the polygon-curve margin (a flat minimum): polygons FINE times finer
+            from ..drive import build_drive
+
+            ref_scene = Scene(build_drive(drive.design, tol=drive.tol / FINE))
             vals = _chunked(
-                lambda c: tooth_clearance_sections(
-                    scene, phi_sorted[cand_i[sl][c]], cand_s[sl][c], sections, exact=True
-                ),
-                len(sl),
+                lambda sl: tooth_clearance_sections(ref_scene, phi_sorted[cand_i[idx[sl]]], cand_s[idx[sl]], sections),
+                len(idx),
             )
-            n_refined += len(vals)
-            j = int(np.argmin(vals))
-            if vals[j] < exact_best:
-                exact_best, where = float(vals[j]), (int(cand_s[sl][j]), int(cand_i[sl][j]))
-            at = int(sl[-1]) + 1 if at == 0 else len(cand_v)
-            stg(at / len(cand_v))
-        best = exact_best
+            return vals, ref_scene.chord_gap
+
+        def exact(idx):
+            return _chunked(
+                lambda c: tooth_clearance_sections(
+                    scene, phi_sorted[cand_i[idx[c]]], cand_s[idx[c]], sections, exact=True
+                ),
+                len(idx),
+            )
+
+        best, w, n_refined, n_fine = refine_candidates(cand_v, scene.chord_gap, exact, fine=fine, progress=stg)
+        where = (int(cand_s[w]), int(cand_i[w]))
     else:
-        where = (int(cand_s[0]), int(cand_i[0]))
+        w = int(np.argsort(cand_v, kind="stable")[0])
+        where = (int(cand_s[w]), int(cand_i[w]))
     si, i = where
     z_w = sections[si]
     worst = _worst_finding(scene, phi_all, period, float(phi_sorted[i]), z_w, settings.refine, angles, best, best_poly)

@@ -24,6 +24,7 @@ What still saves work (docs/models.md 7, last paragraph):
 from __future__ import annotations
 
 import time
+from dataclasses import dataclass
 from math import pi
 
 import numpy as np
@@ -31,6 +32,8 @@ import shapely
 
 from ..placement import transform
 from ..placement.imperfect import Imperfections, flex_poses_batch, full_cycle_turns, rigid_translation, shortcuts
+from .cascade import FINE, refine_candidates
+from .findings import Finding
 from .imperfect_bounds import ErrorBound, PerfectBound, PerfectBounds, chunk_bounds
 from .imperfect_scene import ImperfectScene
 from .scene import Scene, clearance_at_poses, refine_min
@@ -53,10 +56,7 @@ CHUNK_SAMPLES = 1 << 16
 _BATCH = 4096
 #: samples with the lowest bounds evaluated first, to set the bar for the sweep
 _SEED = 256
-#: candidates above this many are first sorted out on polygons 8 times finer (as the engine does)
-_FINE_ABOVE = 48
-_FINE = 8
-#: candidates measured at once on the finer polygons
+#: candidates measured at once on the finer polygons (wgcad.clearance.cascade)
 _FINE_BATCH = 256
 #: candidates refined in one call (the 16 lowest first above that)
 _ONE_CALL = 48
@@ -137,57 +137,158 @@ def audit_imperfect(drive, settings, imp: Imperfections, progress=None, chunk_sa
         (:mod:`wgcad.clearance.imperfect_entry`); the backlash is the
         imperfect drive's at the first generator angle.
     """
-    from .engine import AuditResult, accuracy_settings
-    from .findings import Finding
+    from .engine import AuditResult
 
     t0 = time.perf_counter()
-    scene = Scene(drive)
-    isc = ImperfectScene.from_scene(scene, imp)
-    angles = np.asarray(settings.angles, dtype=float)
-    sections = [None] if not drive.coned else [float(z) for z in settings.sections]
-    z_g = scene.z_g
-    S = len(sections)
-    margin = 2.0 * scene.chord_gap if settings.refine else 0.0
-    B = min(len(angles), chunk_angles(z_g, S, chunk_samples))
+    run = _Run.make(drive, settings, imp, chunk_samples)
+    if progress is not None:
+        progress(300, 1000, "clearance")
+    found = _search(run, progress)
+    best_poly = float(found.best)
+    best, where, n_refined, n_fine = _refine(run, found)
+    if progress is not None:
+        progress(900, 1000, "refine")
+    worst = _worst_finding(run, found, where, best, best_poly)
+    if progress is not None:
+        progress(920, 1000, "entry gap")
+    gaps, ent = _entry(run)
+    # backlash of the imperfect drive at the first generator angle, middle section: the rigid turn of the
+    # flexspline between contact either way, from the exact poses (wgcad.clearance.closing.closing_direct)
+    z_mid = run.sections[len(run.sections) // 2]
+    bl = _backlash(drive, imp, float(run.angles[0]), z_mid)
+    if progress is not None:
+        progress(1000, 1000, "done")
+    A, S = len(run.angles), len(run.sections)
+    counts = {
+        "samples": int(A * run.z_g * S),
+        "unique_tooth_angles": int(A * run.z_g),
+        "sections": S,
+        "evaluated": int(found.n_ev),
+        "culled": int(found.n_pruned),
+        "perfect_evaluated": found.perfect.evaluated,
+        "refined": int(n_refined),
+        "fine_polygon": int(n_fine),
+        "chunks": -(-A // run.B),
+    }
+    gap_f, pinch_f, delta_f = _entry_findings(run, gaps, ent)
+    findings = {
+        "min_clearance": worst,
+        "entry_gap": delta_f,
+        "entry_crossing": gap_f,
+        "entry_pinch": pinch_f,
+        "backlash": Finding("backlash", float(bl), "brent", generator_angle=float(run.angles[0]), section_z=z_mid),
+    }
+    res = AuditResult(
+        settings=_settings_doc(run),
+        findings=findings,
+        interference=best < -settings.interference_tol,
+        interference_tol=settings.interference_tol,
+        counts=counts,
+        settings_angles=run.angles,
+    )
+    res.elapsed_s = time.perf_counter() - t0
+    return res
+
+
+@dataclass
+class _Run:
+    """What every step of an imperfect audit shares: the drive and its errors, the scenes, the samples' axes."""
+
+    drive: object
+    settings: object
+    imp: Imperfections
+    scene: Scene
+    isc: ImperfectScene
+    angles: np.ndarray
+    sections: list
+    z_g: int
+    B: int  # generator angles per chunk
+    margin: float  # the polygon-curve margin of the candidates (0 without refinement)
+
+    @classmethod
+    def make(cls, drive, settings, imp, chunk_samples):
+        scene = Scene(drive)
+        angles = np.asarray(settings.angles, dtype=float)
+        sections = [None] if not drive.coned else [float(z) for z in settings.sections]
+        return cls(
+            drive,
+            settings,
+            imp,
+            scene,
+            ImperfectScene.from_scene(scene, imp),
+            angles,
+            sections,
+            scene.z_g,
+            min(len(angles), chunk_angles(scene.z_g, len(sections), chunk_samples)),
+            2.0 * scene.chord_gap if settings.refine else 0.0,
+        )
+
+    def poses(self, a_, k_, s_):
+        return _poses_of(self.drive, self.imp, self.angles, a_, k_, s_, self.sections)
+
+
+@dataclass
+class _Found:
+    """The polygon search's result: its best figure, the candidates within the margin of it, what it cost."""
+
+    best: float
+    v: np.ndarray
+    a: np.ndarray
+    k: np.ndarray
+    s: np.ndarray
+    n_ev: int
+    n_pruned: int
+    perfect: PerfectBounds
+
+
+class _Keeper:
+    """Evaluates samples in batches and keeps those within the margin of the best so far."""
+
+    def __init__(self, run: _Run):
+        self.run = run
+        self.best = np.inf
+        self.n_ev = 0
+        self.keep = [[np.zeros(0)], [np.zeros(0, int)], [np.zeros(0, int)], [np.zeros(0, int)]]
+
+    def __call__(self, sel_s, sel_k, sel_a):
+        run, margin = self.run, self.run.margin
+        kv, ka, kk, ks = self.keep
+        for a in range(0, len(sel_s), _BATCH):
+            s_, k_, a_ = sel_s[a : a + _BATCH], sel_k[a : a + _BATCH], sel_a[a : a + _BATCH]
+            rot, shift = run.poses(a_, k_, s_)
+            v = _evaluate_poses(run.isc, rot, shift)
+            self.n_ev += len(v)
+            self.best = min(self.best, float(v.min()))
+            ok = v <= self.best + margin
+            kv.append(v[ok]), ka.append(a_[ok]), kk.append(k_[ok]), ks.append(s_[ok])
+        v = np.concatenate(kv)
+        ok = v <= self.best + margin
+        self.keep = [[x[ok]] for x in (v, np.concatenate(ka), np.concatenate(kk), np.concatenate(ks))]
+
+
+def _search(run: _Run, progress) -> _Found:
+    """Every sample that can hold the imperfect minimum on polygons (branch and bound on the perfect drive's
+    bounds less the errors' reach, or every sample with ``settings.bound`` off)."""
+    settings, angles, z_g, S, B = run.settings, run.angles, run.z_g, len(run.sections), run.B
     A = len(angles)
-    eb = ErrorBound(scene, imp, sections)
+    margin = run.margin
+    eb = ErrorBound(run.scene, run.imp, run.sections)
     # the widest the errors can move a tooth against its rigid teeth: the imperfect minimum is within
     # that of the perfect one, so the perfect bounds are needed up to twice that above it
     e_max = eb.largest(angles)
     # the perfect drive's bounds, first as far as a perfect audit needs them; then as far as the sweep
     # needs them: a grid point whose bound is above (imperfect best + margin + e_max) prunes every sample
-    perfect = PerfectBounds(scene, sections, settings)
+    perfect = PerfectBounds(run.scene, run.sections, settings)
     perfect.extend(margin)
     pb = perfect.pb
-    if progress is not None:
-        progress(300, 1000, "clearance")
-    best = np.inf
-    n_ev = n_pruned = 0
-    keep_v, keep_a, keep_k, keep_s = [np.zeros(0)], [np.zeros(0, int)], [np.zeros(0, int)], [np.zeros(0, int)]
-
-    def run(sel_s, sel_k, sel_a):
-        """Evaluate samples (in the order given, in batches), keep those within the margin; returns the best."""
-        nonlocal best, n_ev, keep_v, keep_a, keep_k, keep_s
-        for a in range(0, len(sel_s), _BATCH):
-            s_, k_, a_ = sel_s[a : a + _BATCH], sel_k[a : a + _BATCH], sel_a[a : a + _BATCH]
-            rot, shift = _poses_of(drive, imp, angles, a_, k_, s_, sections)
-            v = _evaluate_poses(isc, rot, shift)
-            n_ev += len(v)
-            best = min(best, float(v.min()))
-            ok = v <= best + margin
-            keep_v.append(v[ok]), keep_a.append(a_[ok]), keep_k.append(k_[ok]), keep_s.append(s_[ok])
-        v = np.concatenate(keep_v)
-        ok = v <= best + margin
-        keep_v, keep_a, keep_k, keep_s = (
-            [x[ok]] for x in (v, np.concatenate(keep_a), np.concatenate(keep_k), np.concatenate(keep_s))
-        )
-
+    keeper = _Keeper(run)
+    n_pruned = 0
     if not settings.bound:
         # the reference: every sample in every chunk
         for a0 in range(0, A, B):
             a1 = min(A, a0 + B)
             s_, k_, b_ = np.meshgrid(np.arange(S), np.arange(z_g), np.arange(a0, a1), indexing="ij")
-            run(s_.ravel(), k_.ravel(), b_.ravel())
+            keeper(s_.ravel(), k_.ravel(), b_.ravel())
     else:
         # first pass: the few samples with the lowest bounds anywhere set the bar; second pass: every
         # sample whose bound is below it, chunk by chunk, lowest bounds first
@@ -207,14 +308,14 @@ def audit_imperfect(drive, settings, imp: Imperfections, progress=None, chunk_sa
             s_, k_, b_ = np.unravel_index(idx[mine], (S, z_g, a1 - a0))
             sel.append((s_, k_, b_ + a0))
             at += len(L)
-        run(*(np.concatenate(x) for x in zip(*sel)))
+        keeper(*(np.concatenate(x) for x in zip(*sel)))
         # the seeds' best is the imperfect minimum's upper bound; it is within e_max of the perfect one
-        perfect.extend(min(best + margin + e_max - perfect.best, 2.0 * e_max + margin))
+        perfect.extend(min(keeper.best + margin + e_max - perfect.best, 2.0 * e_max + margin))
         done = set(zip(*(np.concatenate(x).tolist() for x in zip(*sel))))
         for a0 in range(0, A, B):
             a1 = min(A, a0 + B)
             L = chunk_bounds(pb, eb, angles, a0, a1, z_g, S).ravel()
-            idx = np.nonzero(L < best + margin)[0]
+            idx = np.nonzero(L < keeper.best + margin)[0]
             n_pruned += L.size - idx.size
             idx = idx[np.argsort(L[idx], kind="stable")]
             s_, k_, b_ = np.unravel_index(idx, (S, z_g, a1 - a0))
@@ -225,77 +326,62 @@ def audit_imperfect(drive, settings, imp: Imperfections, progress=None, chunk_sa
             # re-checked against the bar as it falls: a batch is dropped once its bounds are above it
             s_, k_, b_, Lc = s_[fresh], k_[fresh], b_[fresh], L[idx][fresh]
             for a in range(0, len(s_), _BATCH):
-                live = Lc[a : a + _BATCH] < best + margin
+                live = Lc[a : a + _BATCH] < keeper.best + margin
                 if not live.any():
                     n_pruned += len(Lc) - a
                     break
                 n_pruned += int((~live).sum())
-                run(s_[a : a + _BATCH][live], k_[a : a + _BATCH][live], b_[a : a + _BATCH][live])
+                keeper(s_[a : a + _BATCH][live], k_[a : a + _BATCH][live], b_[a : a + _BATCH][live])
             if progress is not None:
                 progress(300 + int(500 * a1 / A), 1000, "clearance")
-    cand_v, cand_a, cand_k, cand_s = keep_v[0], keep_a[0], keep_k[0], keep_s[0]
-    o = np.argsort(cand_v, kind="stable")
-    cand_v, cand_a, cand_k, cand_s = cand_v[o], cand_a[o], cand_k[o], cand_s[o]
-    best_poly = float(best)
-    n_refined = n_fine = 0
-    where = 0
-    if settings.refine and len(cand_v):
-        ref = isc
-        if len(cand_v) > _FINE_ABOVE:
-            from ..drive import build_drive
+    v, a_, k_, s_ = (x[0] for x in keeper.keep)
+    return _Found(keeper.best, v, a_, k_, s_, keeper.n_ev, n_pruned, perfect)
 
-            fine_drive = build_drive(drive.design, tol=drive.tol / _FINE)
-            ref = ImperfectScene.from_scene(Scene(fine_drive), imp)
-            rot, shift = _poses_of(drive, imp, angles, cand_a, cand_k, cand_s, sections)
-            # in batches: a candidate on the finer polygons holds ~18 kB while measured, and their number
-            # grows with the sampling density (2900 at 0.05 deg on D1 [S4])
-            cand_v = np.concatenate(
-                [
-                    clearance_at_poses(ref, rot[a : a + _FINE_BATCH], shift[a : a + _FINE_BATCH])["min"]
-                    for a in range(0, len(rot), _FINE_BATCH)
-                ]
-            )
-            n_fine = len(cand_v)
-            o = np.argsort(cand_v, kind="stable")
-            cand_v, cand_a, cand_k, cand_s = cand_v[o], cand_a[o], cand_k[o], cand_s[o]
-            keep = cand_v <= cand_v[0] + 2.0 * ref.chord_gap
-            cand_v, cand_a, cand_k, cand_s = cand_v[keep], cand_a[keep], cand_k[keep], cand_s[keep]
-        exact_best = np.inf
-        at = 0
-        while at < len(cand_v):
-            if cand_v[at] - ref.chord_gap >= exact_best:
-                break
-            # a refinement's cost is mostly per call: a few candidates go in one call, many in two
-            # (the 16 lowest set the bar for the rest)
-            first = len(cand_v) if len(cand_v) <= _ONE_CALL else 16
-            live = np.nonzero(cand_v[at:] - ref.chord_gap < exact_best)[0] + at if at else np.arange(first)
-            if live.size == 0:
-                break
-            rot, shift = _poses_of(drive, imp, angles, cand_a[live], cand_k[live], cand_s[live], sections)
-            vals = refine_min(isc, rot, shift, clearance_at_poses(isc, rot, shift))["min"]
-            n_refined += len(vals)
-            j = int(np.argmin(vals))
-            if vals[j] < exact_best:
-                exact_best, where = float(vals[j]), int(live[j])
-            at = int(live[-1]) + 1 if at == 0 else len(cand_v)
-        best = exact_best
-    if progress is not None:
-        progress(900, 1000, "refine")
-    ai, k, si = int(cand_a[where]), int(cand_k[where]), int(cand_s[where])
-    z_w = sections[si]
-    rot, shift = _poses_of(drive, imp, angles, np.array([ai]), np.array([k]), np.array([si]), sections)
+
+def _refine(run: _Run, found: _Found) -> tuple[float, int, int, int]:
+    """The candidates on the exact curves (wgcad.clearance.cascade): ``(best, where, n_refined, n_fine)``."""
+    if not (run.settings.refine and len(found.v)):
+        return found.best, int(np.argsort(found.v, kind="stable")[0]), 0, 0
+
+    def fine(idx):
+        from ..drive import build_drive
+
+        ref = ImperfectScene.from_scene(Scene(build_drive(run.drive.design, tol=run.drive.tol / FINE)), run.imp)
+        rot, shift = run.poses(found.a[idx], found.k[idx], found.s[idx])
+        # in batches: a candidate on the finer polygons holds ~18 kB while measured, and their number
+        # grows with the sampling density (2900 at 0.05 deg on D1 [S4])
+        vals = np.concatenate(
+            [
+                clearance_at_poses(ref, rot[a : a + _FINE_BATCH], shift[a : a + _FINE_BATCH])["min"]
+                for a in range(0, len(rot), _FINE_BATCH)
+            ]
+        )
+        return vals, ref.chord_gap
+
+    def exact(idx):
+        rot, shift = run.poses(found.a[idx], found.k[idx], found.s[idx])
+        return refine_min(run.isc, rot, shift, clearance_at_poses(run.isc, rot, shift))["min"]
+
+    return refine_candidates(found.v, run.isc.chord_gap, exact, fine=fine, one_call=_ONE_CALL)
+
+
+def _worst_finding(run: _Run, found: _Found, where: int, best: float, best_poly: float) -> Finding:
+    """The tightest sample as a ``min_clearance`` Finding: where it is, against which rigid tooth, its overlap area."""
+    angles, scene, isc = run.angles, run.scene, run.isc
+    ai, k, si = int(found.a[where]), int(found.k[where]), int(found.s[where])
+    rot, shift = run.poses(np.array([ai]), np.array([k]), np.array([si]))
     det = clearance_at_poses(isc, rot, shift, area=True)
     side = min(("lower", "upper", "third"), key=lambda s: det[s][0])
     j = int(det["lo"][0] if side == "lower" else det["up"][0] if side == "upper" else det["th"][0])
     area = det.get(f"{side}_area", np.zeros(1))[0] if side != "third" else 0.0
-    phi_tooth = float((2 * pi * k / z_g + angles[ai] / scene.ratios["u_hg"] - angles[ai] + pi) % (2 * pi) - pi)
+    phi_tooth = float((2 * pi * k / run.z_g + angles[ai] / scene.ratios["u_hg"] - angles[ai] + pi) % (2 * pi) - pi)
     phi_major = float((phi_tooth + pi / scene.n_w) % (2 * pi / scene.n_w) - pi / scene.n_w)
-    worst = Finding(
+    return Finding(
         "min_clearance",
         float(best),
-        "exact" if settings.refine else "polygon",
+        "exact" if run.settings.refine else "polygon",
         tooth_angle=phi_major,
-        section_z=z_w,
+        section_z=run.sections[si],
         location=_classify(isc, float(rot[0]), shift[0], j),
         generator_angle=float(angles[ai]),
         tooth=k,
@@ -307,28 +393,34 @@ def audit_imperfect(drive, settings, imp: Imperfections, progress=None, chunk_sa
             "overlap_area": float(area),
         },
     )
-    # entry gap and pinch: every passage of a tooth through the entry in the swept angles, each with its
-    # own crossing (wgcad.clearance.imperfect_entry), found from the perfect drive's (polygons suffice there:
-    # they only say where to look)
+
+
+def _entry(run: _Run):
+    """Every passage of a tooth through the entry in the swept angles, each with its own crossing
+    (wgcad.clearance.imperfect_entry), found from the perfect drive's (polygons suffice there: they only say
+    where to look). Returns the perfect drive's crossings per section and the passages' figures."""
     from .entry import entry_crossings, entry_pinch
     from .imperfect_entry import imperfect_entry
 
-    if progress is not None:
-        progress(920, 1000, "entry gap")
+    scene, sections, angles = run.scene, run.sections, run.angles
     gaps = list(zip(entry_crossings(scene, sections, exact=False), sections))
     crossed = any(np.isfinite(g[0]) for g, _ in gaps)
     p_pinch = entry_pinch(scene, [(g[1], z) for g, z in gaps if np.isfinite(g[0])], exact=False) if crossed else None
     # with the cam-borne offset alone (or no errors) every passage of a section is congruent (the mesh period
     # holds, docs/models.md 7): one passage per section stands for all
-    span = np.array([angles[0], angles[0] + 2 * pi / scene.z_b]) if shortcuts(imp)["mesh_period"] else angles
-    ent = imperfect_entry(drive, imp, isc, scene, gaps, p_pinch, span, sections, settings.refine) if crossed else {}
-    # backlash of the imperfect drive at the first generator angle, middle section: the rigid turn of the
-    # flexspline between contact either way, from the exact poses (wgcad.clearance.closing.closing_direct)
-    z_mid = sections[len(sections) // 2]
-    bl = _backlash(drive, imp, float(angles[0]), z_mid)
-    if progress is not None:
-        progress(1000, 1000, "done")
-    sc = shortcuts(imp)
+    span = np.array([angles[0], angles[0] + 2 * pi / scene.z_b]) if shortcuts(run.imp)["mesh_period"] else angles
+    if not crossed:
+        return gaps, {}
+    return gaps, imperfect_entry(run.drive, run.imp, run.isc, scene, gaps, p_pinch, span, sections, run.settings.refine)
+
+
+def _settings_doc(run: _Run) -> dict:
+    """The settings the audit ran with, as its JSON document states them."""
+    from .engine import accuracy_settings
+
+    drive, settings, angles, sections, scene = run.drive, run.settings, run.angles, run.sections, run.scene
+    A, B = len(angles), run.B
+    sc = shortcuts(run.imp)
     bw = drive.design.drive.face_width
     ends = (not drive.coned) or (min(sections) <= 1e-9 and max(sections) >= bw - 1e-9)
     rs = {
@@ -363,19 +455,14 @@ def audit_imperfect(drive, settings, imp: Imperfections, progress=None, chunk_sa
         "working_flank": scene.working,
         "rigid_pitch_radius_mm": drive.rigid.r,
     }
-    counts = {
-        "samples": int(A * z_g * S),
-        "unique_tooth_angles": int(A * z_g),
-        "sections": S,
-        "evaluated": int(n_ev),
-        "culled": int(n_pruned),
-        "perfect_evaluated": perfect.evaluated,
-        "refined": int(n_refined),
-        "fine_polygon": int(n_fine),
-        "chunks": -(-A // B),
-    }
-    exact = "exact" if settings.refine else "polygon"
     rs["entry_side"] = "entry (+phi)" if scene.entry_sign > 0 else "entry (-phi)"
+    return rs
+
+
+def _entry_findings(run: _Run, gaps, ent: dict):
+    """The entry crossing, the pinch and [S1]'s Delta of every passage as Findings."""
+    drive, imp, isc, settings, scene = run.drive, run.imp, run.isc, run.settings, run.scene
+    exact = "exact" if settings.refine else "polygon"
     fold = lambda a: float((a + pi / scene.n_w) % (2 * pi / scene.n_w) - pi / scene.n_w)  # noqa: E731  (nearest major axis)
     if np.isfinite(ent.get("gap", np.nan)):
         edge, gloc = _entry_edge(drive, imp, isc, ent["gap_phi_h"], ent["gap_tooth"], ent["gap_z"], settings.refine)
@@ -448,23 +535,7 @@ def audit_imperfect(drive, settings, imp: Imperfections, progress=None, chunk_sa
             "tip_to_tip_risk": bool(pinch_f.details.get("tip_to_tip_risk", False) and kind == "pinch"),
         },
     )
-    findings = {
-        "min_clearance": worst,
-        "entry_gap": delta_f,
-        "entry_crossing": gap_f,
-        "entry_pinch": pinch_f,
-        "backlash": Finding("backlash", float(bl), "brent", generator_angle=float(angles[0]), section_z=z_mid),
-    }
-    res = AuditResult(
-        settings=rs,
-        findings=findings,
-        interference=best < -settings.interference_tol,
-        interference_tol=settings.interference_tol,
-        counts=counts,
-        settings_angles=angles,
-    )
-    res.elapsed_s = time.perf_counter() - t0
-    return res
+    return gap_f, pinch_f, delta_f
 
 
 def _entry_edge(drive, imp: Imperfections, isc: ImperfectScene, phi_h: float, k: int, z, exact: bool, rigid=None):
