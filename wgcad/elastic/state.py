@@ -273,85 +273,33 @@ def solve_load(
     n_ang = len(tab.angles)
     Z = len(model.bearing.psi)
     n_keys = len(model.zs) * tab.z_g * 2
-    loads = np.zeros((n_ang, 3))
-    rigid = np.zeros(3)
-    F_ball = np.zeros(Z)
+    loads, rigid, F_ball, pairs = _start(model, e, warm)
     prev_active = np.zeros(n_keys, dtype=bool)
     F_teeth_prev = np.zeros(n_keys)
-    if warm is not None:
-        loads, rigid = _loads_on_table(tab, warm.laws[0].psi, warm.laws[0].loads), np.array(warm.rigid)
-        F_ball = warm.contacts["force"][warm.contacts["kind"] == 0].copy()
-    else:
-        # a cold start begins on the cam: the rim pressed onto it by the balls alone (no teeth, no torque)
-        mnt = mounted(model, e)
-        loads, rigid, F_ball = mnt.loads.copy(), mnt.rigid.copy(), mnt.force.copy()
-    centre = model.drive.law
-    t_geo = t_sol = 0.0
+    times = {"geometry": 0.0, "solver": 0.0}
     pivots = 0
     omega, last_change = 1.0, np.inf
     acc = Anderson(model.drive.r_m, ANDERSON_DEPTH)
     settled, relaxed = 0, False
     change = 0.0
-    # a warm start's pairs were measured at exactly its state: the first pass measures only what moves
-    if warm is not None and warm.pairs is not None and warm.pairs.model is model:
-        pairs = warm.pairs.copy()
-    else:
-        # a cold start's first pass is the mounted state: its pairs are measured once per model and cam offset
-        key = ("mounted_pairs", float(e[0]), float(e[1]))
-        if key not in model.cache:
-            nominal = MeasuredPairs(model)
-            rot0, shift0, origin0, el0, cand0 = _poses(model, loads, rigid)
-            nominal.update(rot0, shift0, origin0, el0, cand0, rigid, full=True)
-            model.cache[key] = nominal
-        pairs = model.cache[key].copy()
     for it in range(_MAX_LINEARISATIONS):
-        t0 = time.perf_counter()
-        rot, shift, origin, el, cand = _poses(model, loads, rigid, tooth_errors)
-        if cand.size == 0 and torque_nm > 0:
-            raise DesignError(
-                "generator.w0_coef",
-                "the flexspline teeth never reach the rigid teeth (no tooth tip within "
-                f"{RADIAL_MARGIN:g} mm of the rigid tip circle): no torque can be carried",
-            )
-        keys = pairs.update(rot, shift, origin, el, cand, rigid) if cand.size else np.zeros(0, dtype=int)
-        t1 = time.perf_counter()
-        idx, b, f, A, q, s_c = _assemble(model, pairs, keys, el, rigid, e, F_ball, F_teeth_prev[keys])
-        M = Compliance(tab, idx, b * f[:, None], s_c)
-        active = np.concatenate([F_ball > 0, prev_active[keys]])
-        F_h = F = None  # F: the solution of the pass (set by the first solve below)
-        for h in range(_HERTZ_START if it == 0 else 1):
-            if h:
-                if F_h is not None and np.abs(F - F_h).max() <= _HERTZ_TOL * F.max():
-                    break
-                # the first pass: the Hertz contacts linearised again about the forces just found,
-                # on the same geometry (its poses have not moved: no engine call), before the teeth move
-                _, _, _, _, q, s_c = _assemble(model, pairs, keys, el, rigid, e, F[:Z], F[Z:])
-                M = M.with_contact(s_c)
-                active = F > 0
-            try:
-                sol = solve_supported(
-                    M,
-                    q,
-                    A,
-                    f_ext,
-                    model.support_stiffness,
-                    active=active if (it or h) else _first_guess(model, keys, q, Z, torque_nm),
-                )
-                cam_shift = sol.a[3:].copy()
-                sol = replace(sol, a=sol.a[:3])
-            except ContactSolveError as exc:
-                if torque_nm > 0 and len(keys) and "balance" in str(exc):
-                    raise DesignError(
-                        "generator.w0_coef",
-                        f"no set of tooth contacts can carry {torque_nm:g} N m: the teeth never meet "
-                        "on the working flanks",
-                    ) from None
-                raise
-            pivots += sol.iterations
-            F_h, F = (F if h else None), sol.F
-        t_sol += time.perf_counter() - t1
-        t_geo += t1 - t0
-        last = (keys, F, sol, idx, b, f, pairs.point[keys], pairs.normal[keys])
+        lin = _linearise(
+            model, torque_nm, e, f_ext, pairs, loads, rigid, F_ball, F_teeth_prev, prev_active, it, tooth_errors
+        )
+        keys, F, sol, idx, b, f, origin, cam_shift = (
+            lin.keys,
+            lin.F,
+            lin.sol,
+            lin.idx,
+            lin.b,
+            lin.f,
+            lin.origin,
+            lin.cam_shift,
+        )
+        pivots += lin.pivots
+        times["geometry"] += lin.t_geo
+        times["solver"] += lin.t_sol
+        last = (keys, F, sol, idx, b, f, pairs.point[keys], pairs.normal[keys], cam_shift)
         # under-relaxed update once the plain iteration stops contracting: the exact gaps are piecewise
         # smooth in the poses (polygon vertices), which can leave a 2-cycle of sub-micrometre amplitude
         loads_new = _dense_loads(n_ang, idx, F, f, b)
@@ -399,9 +347,112 @@ def solve_load(
             f"{1e3 * change:.3g} um after {_MAX_LINEARISATIONS} re-linearisations; a looser tolerance, "
             "a nearby torque or more side clearance may let it settle"
         )
+    progress = {"iterations": it + 1, "pivots": pivots, "position_change_mm": change, "settled_by_relaxation": relaxed}
+    return _report(model, torque_nm, e, pairs, last, progress, times, tooth_errors)
+
+
+def _start(model: ElasticModel, e: np.ndarray, warm: LoadState | None):
+    """The state the iteration starts from: ring loads per table angle, rim freedoms, ball forces, measured pairs."""
+    tab = model.tables
+    if warm is not None:
+        loads, rigid = _loads_on_table(tab, warm.laws[0].psi, warm.laws[0].loads), np.array(warm.rigid)
+        F_ball = warm.contacts["force"][warm.contacts["kind"] == 0].copy()
+    else:
+        # a cold start begins on the cam: the rim pressed onto it by the balls alone (no teeth, no torque)
+        mnt = mounted(model, e)
+        loads, rigid, F_ball = mnt.loads.copy(), mnt.rigid.copy(), mnt.force.copy()
+    # a warm start's pairs were measured at exactly its state: the first pass measures only what moves
+    if warm is not None and warm.pairs is not None and warm.pairs.model is model:
+        return loads, rigid, F_ball, warm.pairs.copy()
+    # a cold start's first pass is the mounted state: its pairs are measured once per model and cam offset
+    key = ("mounted_pairs", float(e[0]), float(e[1]))
+    if key not in model.cache:
+        nominal = MeasuredPairs(model)
+        rot0, shift0, origin0, el0, cand0 = _poses(model, loads, rigid)
+        nominal.update(rot0, shift0, origin0, el0, cand0, rigid, full=True)
+        model.cache[key] = nominal
+    return loads, rigid, F_ball, model.cache[key].copy()
+
+
+@dataclass
+class _Pass:
+    """One linearisation: the pairs measured at the current poses and the contact problem's solution there."""
+
+    keys: np.ndarray
+    F: np.ndarray
+    sol: object
+    idx: np.ndarray
+    b: np.ndarray
+    f: np.ndarray
+    origin: np.ndarray
+    cam_shift: np.ndarray
+    pivots: int
+    t_geo: float
+    t_sol: float
+
+
+def _linearise(model, torque_nm, e, f_ext, pairs, loads, rigid, F_ball, F_teeth_prev, prev_active, it, tooth_errors):
+    """Measure the contact geometry at the current loaded poses (the clearance engine) and solve the linearised
+    contact problem there (docs/models.md 4.1); the first pass linearises the Hertz contacts again about the
+    forces it finds before the teeth move."""
+    Z = len(model.bearing.psi)
+    t0 = time.perf_counter()
+    rot, shift, origin, el, cand = _poses(model, loads, rigid, tooth_errors)
+    if cand.size == 0 and torque_nm > 0:
+        raise DesignError(
+            "generator.w0_coef",
+            "the flexspline teeth never reach the rigid teeth (no tooth tip within "
+            f"{RADIAL_MARGIN:g} mm of the rigid tip circle): no torque can be carried",
+        )
+    keys = pairs.update(rot, shift, origin, el, cand, rigid) if cand.size else np.zeros(0, dtype=int)
+    t1 = time.perf_counter()
+    idx, b, f, A, q, s_c = _assemble(model, pairs, keys, el, rigid, e, F_ball, F_teeth_prev[keys])
+    M = Compliance(model.tables, idx, b * f[:, None], s_c)
+    active = np.concatenate([F_ball > 0, prev_active[keys]])
+    F_h = F = None  # F: the solution of the pass (set by the first solve below)
+    pivots = 0
+    for h in range(_HERTZ_START if it == 0 else 1):
+        if h:
+            if F_h is not None and np.abs(F - F_h).max() <= _HERTZ_TOL * F.max():
+                break
+            # the first pass: the Hertz contacts linearised again about the forces just found,
+            # on the same geometry (its poses have not moved: no engine call), before the teeth move
+            _, _, _, _, q, s_c = _assemble(model, pairs, keys, el, rigid, e, F[:Z], F[Z:])
+            M = M.with_contact(s_c)
+            active = F > 0
+        try:
+            sol = solve_supported(
+                M,
+                q,
+                A,
+                f_ext,
+                model.support_stiffness,
+                active=active if (it or h) else _first_guess(model, keys, q, Z, torque_nm),
+            )
+            cam_shift = sol.a[3:].copy()
+            sol = replace(sol, a=sol.a[:3])
+        except ContactSolveError as exc:
+            if torque_nm > 0 and len(keys) and "balance" in str(exc):
+                raise DesignError(
+                    "generator.w0_coef",
+                    f"no set of tooth contacts can carry {torque_nm:g} N m: the teeth never meet on the working flanks",
+                ) from None
+            raise
+        pivots += sol.iterations
+        F_h, F = (F if h else None), sol.F
+    return _Pass(keys, F, sol, idx, b, f, origin, cam_shift, pivots, t1 - t0, time.perf_counter() - t1)
+
+
+def _report(model, torque_nm, e, pairs, last, progress, times, tooth_errors) -> LoadState:
+    """The loaded state of the last contact solution: contacts, residuals, the laws of the loaded rim."""
+    tab = model.tables
+    n_ang = len(tab.angles)
+    Z = len(model.bearing.psi)
+    n_keys = len(model.zs) * tab.z_g * 2
+    centre = model.drive.law
     # the reported state is the last contact solution itself (not a relaxed mixture): its forces, points and
     # normals are in equilibrium to round-off; the exact gaps are then measured on the final poses
-    keys, F, sol, idx, b, f, point, normal = last
+    keys, F, sol, idx, b, f, point, normal, cam_shift = last
     loads = _dense_loads(n_ang, idx, F, f, b)
     rigid = sol.a.copy()
     F_ball, Ft = F[:Z], F[Z:]
@@ -409,7 +460,7 @@ def solve_load(
     t0 = time.perf_counter()
     pairs2 = pairs.copy()
     keys2, gaps2, exact2 = pairs2.report(*_poses(model, loads, rigid, tooth_errors), rigid)
-    t_geo += time.perf_counter() - t0
+    times["geometry"] += time.perf_counter() - t0
     psi, law_loads = _merge_loads(tab.angles, loads)
     laws = [
         LoadedLaw(centre, model.section_law(i), model.ring, psi, law_loads, model.scales[i], tuple(rigid))
@@ -462,10 +513,7 @@ def solve_load(
         "complementarity": sol.complementarity,
         "linearisation_mm": lin,
         "min_gap_plus_approach_mm": float(g_all.min()) if g_all.size else 0.0,
-        "iterations": it + 1,
-        "pivots": pivots,
-        "position_change_mm": change,
-        "settled_by_relaxation": relaxed,
+        **progress,
     }
     # the torque the balls put on the cam (docs/models.md 4.1)
     return LoadState(
@@ -476,7 +524,7 @@ def solve_load(
         rigid,
         contacts,
         residuals,
-        {"geometry": t_geo, "solver": t_sol},
+        times,
         pairs2,
         generator_torque(rows, F_ball),
         cam_shift,
