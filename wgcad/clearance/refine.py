@@ -81,49 +81,15 @@ def _vertex_sd(A: ExactTooth, polyA: np.ndarray, ringB, rot, shift) -> np.ndarra
     return np.where(inside, -d, d).reshape(K, nv)
 
 
-def _one_side(A: ExactTooth, B: ExactTooth, sd: np.ndarray, rot, shift, margin):
-    """``min_s sd_B(P_A(s))`` for each pair (A placed in B's frame by ``rot, shift``), exact; with where it is.
+class _Sides:
+    """A's points measured against B: the projection, the signed value and its derivatives, the step along A."""
 
-    ``sd`` is :func:`_vertex_sd` of the pairs. Returns value (K,), the A
-    piece and parameter, and the point (B frame).
-    """
-    K = len(rot)
-    lo = sd.min(axis=1)
-    # seeds: local minima of the vertex sequence within the margin of the pair's minimum (the
-    # curve's extrema lie between a vertex and its neighbours; one seed per basin is enough)
-    pad = np.pad(sd, ((0, 0), (1, 1)), constant_values=np.inf)
-    local = (sd <= pad[:, :-2]) & (sd <= pad[:, 2:])
-    # and the two vertices either side: where vertices are sparse (coarse chords, a cycloid's
-    # pitch-point cusp) the curve's extremum can lie a chord or two away from the polygon's
-    near = local.copy()
-    for sh in _NEAR:
-        near[:, sh:] |= local[:, :-sh]
-        near[:, :-sh] |= local[:, sh:]
-    seed_k, seed_v = np.nonzero(near & (sd <= lo[:, None] + margin))
-    # each seed: its vertex's piece (and the neighbouring piece at a junction) against every B piece
-    ia = A.vert_piece[seed_v]
-    sa = A.vert_t[seed_v]
-    rows_k, rows_ia, rows_sa = [seed_k], [ia], [sa]
-    at_end = np.isclose(sa, np.where(A.sense[ia] > 0, A.hi[ia], A.lo[ia]), rtol=0, atol=1e-12) & (ia + 1 < A.n)
-    if at_end.any():
-        nxt = ia[at_end] + 1
-        rows_k.append(seed_k[at_end])
-        rows_ia.append(nxt)
-        rows_sa.append(np.where(A.sense[nxt] > 0, A.lo[nxt], A.hi[nxt]))
-    kk = np.concatenate(rows_k)
-    ia = np.concatenate(rows_ia)
-    s = np.concatenate(rows_sa)
-    # the B pieces that can hold the nearest point to the seed (as in point_signed_distance)
-    P0 = _rotate(A.eval(ia, s, order=0)[0], rot[kk]) + shift[kk]
-    d2 = B.grid_d2(P0)  # (m, nB, G)
-    gmin = np.sqrt(d2.min(axis=2))
-    cand = gmin <= gmin.min(axis=1, keepdims=True) + B.grid_step[None, :]
-    row, ib = np.nonzero(cand)
-    t = B.grid_t[ib, d2[row, ib].argmin(axis=1)]
-    kk, ia, s = kk[row], ia[row], s[row]
-    r_k, sh_k = rot[kk], shift[kk]
+    def __init__(self, A: ExactTooth, B: ExactTooth):
+        self.A, self.B = A, B
 
-    def project(ib, t, Pa):
+    def project(self, ib, t, Pa):
+        """Projection of points ``Pa`` on B's pieces ``ib`` (Newton warm-started at ``t``): parameter and distance."""
+        B = self.B
         for _ in range(3):  # warm-started from the last iterate: Newton converges in a few steps
             Qb, b1, b2 = B.eval(ib, t)
             D = Pa - Qb
@@ -131,7 +97,8 @@ def _one_side(A: ExactTooth, B: ExactTooth, sd: np.ndarray, rot, shift, margin):
         Qb = B.eval(ib, t, order=0)[0]
         return t, np.hypot(*(Pa - Qb).T)
 
-    def inner(ia, s, ib, t, r_k, sh_k):
+    def inner(self, ia, s, ib, t, r_k, sh_k):
+        A, B, project = self.A, self.B, self.project
         """A's point at (ia, s); its projection on B's piece ib, or the neighbouring piece when it runs off an end."""
         Pa, a1, a2 = A.eval(ia, s)
         Pa, a1, a2 = _rotate(Pa, r_k) + sh_k, _rotate(a1, r_k), _rotate(a2, r_k)
@@ -166,7 +133,8 @@ def _one_side(A: ExactTooth, B: ExactTooth, sd: np.ndarray, rot, shift, margin):
         red = np.where(np.isnan(red), -fprime * 1e300, red)  # marks the rows; read back in the loop
         return ib, t, sgn * dist, g0, red, sgn, (a1 * a1).sum(-1)
 
-    def advance(ia, s_old, s_new):
+    def advance(self, ia, s_old, s_new):
+        A = self.A
         """Clamp to the piece; from the piece's end, continue on the next/previous piece of A past the junction."""
         ia = ia.copy()
         hi_end = (s_new > A.hi[ia]) & (s_old >= A.hi[ia])
@@ -189,6 +157,52 @@ def _one_side(A: ExactTooth, B: ExactTooth, sd: np.ndarray, rot, shift, margin):
                 ia[go] = n
         return ia, s_new
 
+
+def _seeds(A: ExactTooth, B: ExactTooth, sd: np.ndarray, rot, shift, margin):
+    """Newton's starting rows: ``(pair, A piece, A parameter, B piece, B parameter)`` from the polygon vertices
+    whose distance is a local minimum within ``margin`` of the pair's smallest (module docstring)."""
+    lo = sd.min(axis=1)
+    # seeds: local minima of the vertex sequence within the margin of the pair's minimum (the
+    # curve's extrema lie between a vertex and its neighbours; one seed per basin is enough)
+    pad = np.pad(sd, ((0, 0), (1, 1)), constant_values=np.inf)
+    local = (sd <= pad[:, :-2]) & (sd <= pad[:, 2:])
+    # and the two vertices either side: where vertices are sparse (coarse chords, a cycloid's
+    # pitch-point cusp) the curve's extremum can lie a chord or two away from the polygon's
+    near = local.copy()
+    for sh in _NEAR:
+        near[:, sh:] |= local[:, :-sh]
+        near[:, :-sh] |= local[:, sh:]
+    seed_k, seed_v = np.nonzero(near & (sd <= lo[:, None] + margin))
+    # each seed: its vertex's piece (and the neighbouring piece at a junction) against every B piece
+    ia = A.vert_piece[seed_v]
+    sa = A.vert_t[seed_v]
+    rows_k, rows_ia, rows_sa = [seed_k], [ia], [sa]
+    at_end = np.isclose(sa, np.where(A.sense[ia] > 0, A.hi[ia], A.lo[ia]), rtol=0, atol=1e-12) & (ia + 1 < A.n)
+    if at_end.any():
+        nxt = ia[at_end] + 1
+        rows_k.append(seed_k[at_end])
+        rows_ia.append(nxt)
+        rows_sa.append(np.where(A.sense[nxt] > 0, A.lo[nxt], A.hi[nxt]))
+    kk = np.concatenate(rows_k)
+    ia = np.concatenate(rows_ia)
+    s = np.concatenate(rows_sa)
+    # the B pieces that can hold the nearest point to the seed (as in point_signed_distance)
+    P0 = _rotate(A.eval(ia, s, order=0)[0], rot[kk]) + shift[kk]
+    d2 = B.grid_d2(P0)  # (m, nB, G)
+    gmin = np.sqrt(d2.min(axis=2))
+    cand = gmin <= gmin.min(axis=1, keepdims=True) + B.grid_step[None, :]
+    row, ib = np.nonzero(cand)
+    t = B.grid_t[ib, d2[row, ib].argmin(axis=1)]
+    kk, ia, s = kk[row], ia[row], s[row]
+
+    return kk, ia, s, ib, t
+
+
+def _newton(sides: _Sides, ia, s, ib, t, r_k, sh_k, kk):
+    """Newton on the signed value of each row (module docstring): the rows' final A pieces and parameters, and
+    which rows stopped short of a stationary point or a corner."""
+    A = sides.A
+    inner, advance = sides.inner, sides.advance
     ib, t, f, g0, red, sgn, a1n = inner(ia, s, ib, t, r_k, sh_k)
     active = np.arange(len(s))
     stuck = np.zeros(len(s), dtype=bool)  # rows that stopped short of a stationary point or a corner
@@ -263,6 +277,20 @@ def _one_side(A: ExactTooth, B: ExactTooth, sd: np.ndarray, rot, shift, margin):
         dup[first] = False
         active = A_[keep & ~dup]
     stuck[active] = True  # still descending after _NEWTON_STEPS
+    return ia, s, stuck
+
+
+def _one_side(A: ExactTooth, B: ExactTooth, sd: np.ndarray, rot, shift, margin):
+    """``min_s sd_B(P_A(s))`` for each pair (A placed in B's frame by ``rot, shift``), exact; with where it is.
+
+    ``sd`` is :func:`_vertex_sd` of the pairs. Returns value (K,), the A
+    piece and parameter, the point (B frame), and whether every row of the
+    pair reached a stationary point or a corner.
+    """
+    K = len(rot)
+    kk, ia, s, ib, t = _seeds(A, B, sd, rot, shift, margin)
+    r_k, sh_k = rot[kk], shift[kk]
+    ia, s, stuck = _newton(_Sides(A, B), ia, s, ib, t, r_k, sh_k, kk)
     # each candidate measured exactly against the whole of B: a true signed distance of a true curve point
     Pa = _rotate(A.eval(ia, s, order=0)[0], r_k) + sh_k
     val = point_signed_distance(B, Pa)
