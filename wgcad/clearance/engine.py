@@ -213,62 +213,12 @@ def audit(drive, settings: AuditSettings, progress=None) -> AuditResult:
         phi_u = key.ravel()
     order = np.argsort(phi_u, kind="stable")
     phi_sorted = phi_u[order]
-    results = [_SectionSearch(scene, phi_sorted, z, settings) for z in sections]
-    for r in results:
-        r.prepare_bound()
-    st = _stage(tick, "clearance")
-    st(0.0)
-    # coarse pass over every section first: the best of any prunes all; then finer strides
-    best = _evaluate(scene, results, [r.coarse() for r in results], sections, lambda f: st(0.3 * f))
-    for step, stride in enumerate((64, 16, 4, 1)):
-        best = _evaluate(
-            scene,
-            results,
-            [r.candidates(stride, best) for r in results],
-            sections,
-            lambda f, s=step: st(0.3 + 0.15 * (s + f)),
-        )
-    best = _evaluate(scene, results, [r.culled_needed(best) for r in results], sections, lambda f: st(0.9 + 0.1 * f))
-    best_poly = best
+    results, best_poly = _polygon_search(scene, phi_sorted, sections, settings, _stage(tick, "clearance"))
     # refinement on the exact curves of every sample that can hold the minimum
     stg = _stage(tick, "refine")
     stg(0.0)
-    cand_s, cand_i, cand_v = [], [], []
-    for si, r in enumerate(results):
-        ev = np.nonzero(r.evaluated)[0]
-        lim = best_poly + (2.0 * scene.chord_gap if settings.refine else 0.0)
-        keep = ev[r.value[ev] <= lim]
-        cand_s.append(np.full(keep.size, si))
-        cand_i.append(keep)
-        cand_v.append(r.value[keep])
-    cand_s, cand_i, cand_v = np.concatenate(cand_s), np.concatenate(cand_i), np.concatenate(cand_v)
-    n_refined = n_fine = 0
-    if settings.refine:
-
-        def fine(idx):
-            # many samples within the polygon-curve margin (a flat minimum): polygons FINE times finer
-            from ..drive import build_drive
-
-            ref_scene = Scene(build_drive(drive.design, tol=drive.tol / FINE))
-            vals = _chunked(
-                lambda sl: tooth_clearance_sections(ref_scene, phi_sorted[cand_i[idx[sl]]], cand_s[idx[sl]], sections),
-                len(idx),
-            )
-            return vals, ref_scene.chord_gap
-
-        def exact(idx):
-            return _chunked(
-                lambda c: tooth_clearance_sections(
-                    scene, phi_sorted[cand_i[idx[c]]], cand_s[idx[c]], sections, exact=True
-                ),
-                len(idx),
-            )
-
-        best, w, n_refined, n_fine = refine_candidates(cand_v, scene.chord_gap, exact, fine=fine, progress=stg)
-        where = (int(cand_s[w]), int(cand_i[w]))
-    else:
-        w = int(np.argsort(cand_v, kind="stable")[0])
-        where = (int(cand_s[w]), int(cand_i[w]))
+    cands = _candidates(scene, results, best_poly, settings)
+    best, where, n_refined, n_fine = _refine(drive, scene, phi_sorted, sections, cands, settings, best_poly, stg)
     si, i = where
     z_w = sections[si]
     worst = _worst_finding(scene, phi_all, period, float(phi_sorted[i]), z_w, settings.refine, angles, best, best_poly)
@@ -307,6 +257,95 @@ def audit(drive, settings: AuditSettings, progress=None) -> AuditResult:
         "refined": int(n_refined),
         "fine_polygon": int(n_fine),
     }
+    rs = settings_doc(drive, scene, settings, angles, sections)
+    res = AuditResult(
+        settings=rs,
+        findings={
+            "min_clearance": worst,
+            "entry_gap": entry,
+            "entry_crossing": crossing_f,
+            "entry_pinch": pinch_f,
+            "backlash": backlash_f,
+        },
+        interference=best < -settings.interference_tol,
+        interference_tol=settings.interference_tol,
+        counts=counts,
+        settings_angles=angles,
+    )
+    res.elapsed_s = time.perf_counter() - t0
+    return res
+
+
+def _polygon_search(scene: Scene, phi_sorted: np.ndarray, sections: list, settings: AuditSettings, st):
+    """Branch and bound on the polygons over every section: the sections' searches and the smallest figure."""
+    results = [_SectionSearch(scene, phi_sorted, z, settings) for z in sections]
+    for r in results:
+        r.prepare_bound()
+    st(0.0)
+    # coarse pass over every section first: the best of any prunes all; then finer strides
+    best = _evaluate(scene, results, [r.coarse() for r in results], sections, lambda f: st(0.3 * f))
+    for step, stride in enumerate((64, 16, 4, 1)):
+        best = _evaluate(
+            scene,
+            results,
+            [r.candidates(stride, best) for r in results],
+            sections,
+            lambda f, s=step: st(0.3 + 0.15 * (s + f)),
+        )
+    best = _evaluate(scene, results, [r.culled_needed(best) for r in results], sections, lambda f: st(0.9 + 0.1 * f))
+    return results, best
+
+
+def _candidates(scene: Scene, results: list, best_poly: float, settings: AuditSettings):
+    """Every evaluated sample within the polygon-curve margin of the polygon minimum: (section, sample, figure)."""
+    cand_s, cand_i, cand_v = [], [], []
+    for si, r in enumerate(results):
+        ev = np.nonzero(r.evaluated)[0]
+        lim = best_poly + (2.0 * scene.chord_gap if settings.refine else 0.0)
+        keep = ev[r.value[ev] <= lim]
+        cand_s.append(np.full(keep.size, si))
+        cand_i.append(keep)
+        cand_v.append(r.value[keep])
+    cand_s, cand_i, cand_v = np.concatenate(cand_s), np.concatenate(cand_i), np.concatenate(cand_v)
+    return cand_s, cand_i, cand_v
+
+
+def _refine(drive, scene: Scene, phi_sorted, sections, cands, settings: AuditSettings, best_poly: float, stg):
+    """The minimum on the exact curves (wgcad.clearance.cascade) and the (section, sample) holding it."""
+    cand_s, cand_i, cand_v = cands
+    best = best_poly
+    n_refined = n_fine = 0
+    if settings.refine:
+
+        def fine(idx):
+            # many samples within the polygon-curve margin (a flat minimum): polygons FINE times finer
+            from ..drive import build_drive
+
+            ref_scene = Scene(build_drive(drive.design, tol=drive.tol / FINE))
+            vals = _chunked(
+                lambda sl: tooth_clearance_sections(ref_scene, phi_sorted[cand_i[idx[sl]]], cand_s[idx[sl]], sections),
+                len(idx),
+            )
+            return vals, ref_scene.chord_gap
+
+        def exact(idx):
+            return _chunked(
+                lambda c: tooth_clearance_sections(
+                    scene, phi_sorted[cand_i[idx[c]]], cand_s[idx[c]], sections, exact=True
+                ),
+                len(idx),
+            )
+
+        best, w, n_refined, n_fine = refine_candidates(cand_v, scene.chord_gap, exact, fine=fine, progress=stg)
+        where = (int(cand_s[w]), int(cand_i[w]))
+    else:
+        w = int(np.argsort(cand_v, kind="stable")[0])
+        where = (int(cand_s[w]), int(cand_i[w]))
+    return best, where, n_refined, n_fine
+
+
+def settings_doc(drive, scene: Scene, settings: AuditSettings, angles: np.ndarray, sections: list) -> dict:
+    """The settings a perfect drive's audit ran with, as its JSON document states them."""
     bw = drive.design.drive.face_width
     ends = (not drive.coned) or (min(sections) <= 1e-9 and max(sections) >= bw - 1e-9)
     rs = {
@@ -330,22 +369,7 @@ def audit(drive, settings: AuditSettings, progress=None) -> AuditResult:
         "entry_side": "entry (+phi)" if scene.entry_sign > 0 else "entry (-phi)",
         "rigid_pitch_radius_mm": drive.rigid.r,
     }
-    res = AuditResult(
-        settings=rs,
-        findings={
-            "min_clearance": worst,
-            "entry_gap": entry,
-            "entry_crossing": crossing_f,
-            "entry_pinch": pinch_f,
-            "backlash": backlash_f,
-        },
-        interference=best < -settings.interference_tol,
-        interference_tol=settings.interference_tol,
-        counts=counts,
-        settings_angles=angles,
-    )
-    res.elapsed_s = time.perf_counter() - t0
-    return res
+    return rs
 
 
 def entry_findings(scene: Scene, sections: list, refine: bool, interference_tol: float):
