@@ -9,7 +9,8 @@ from conftest import TEMPLATES
 
 from wgcad.design import load_design
 from wgcad.drive import build_drive
-from wgcad.export.gear_data import data_lines, gear_data, inv, inv_inverse
+from wgcad.export.gear_data import data_lines, gear_data
+from wgcad.profiles.involute import inv
 
 INVOLUTE = ["d1_involute", "d2", "d3_external", "d4_discrete"]
 TOL = 1e-4  # mm: outlines sampled at 0.1 um for these comparisons
@@ -23,11 +24,6 @@ MEAS_TOL = 2 * TOL
 @pytest.fixture(scope="module", params=INVOLUTE)
 def drive(request):
     return build_drive(load_design(TEMPLATES / f"{request.param}.toml"), tol=TOL)
-
-
-def test_inv_inverse():
-    for a in (1e-4, 0.1, 0.35, 0.8, 1.2):
-        assert inv_inverse(float(inv(a))) == pytest.approx(a, rel=1e-12)
 
 
 def test_span_closed_form_matches_a_caliper_on_the_outline(drive):
@@ -92,3 +88,52 @@ def test_data_lines_name_every_figure(drive):
         "outline tolerance = 1 um",
     ):
         assert word in text
+
+
+ALL = ["d1_involute", "d1_cycloidal", "d2", "d3_external", "d4_discrete"]
+
+
+@pytest.mark.parametrize("name", ALL)
+def test_parts_and_generate_state_one_inspection(name):
+    # issue 23: the part set's gear data and generate's report gave two specifications of one gear (D1
+    # flexspline: W27 = 66.5225 against W28 = 68.8842; no pins at all for cycloidal teeth in the part set)
+    from wgcad.profiles.measure import workshop_figures
+
+    d = build_drive(load_design(TEMPLATES / f"{name}.toml"))
+    for g in (d.flex, d.rigid):
+        gd, wf = gear_data(g, d.tol), workshop_figures(g)
+        if wf["span"] is None or wf["span"].get("k") is None:
+            assert gd["span"] is None
+        else:
+            assert (gd["span"]["k"], gd["span"]["W_mm"]) == (wf["span"]["k"], wf["span"]["w_k_mm"])
+            assert gd["span"]["rule"] == wf["span"]["k_rule"]
+        p = wf["pins"]
+        if not (p["pin_stands_out_of_the_teeth"] and p["pin_clear_of_the_root"]):
+            assert gd["pins"] is None  # neither states a pin that checks nothing
+            assert not [x for x in data_lines("g", gd) if x.startswith("dimension")]
+            continue
+        key = "between_pins_mm" if g.spec.internal else "over_pins_mm"
+        assert (gd["pins"]["pin_diameter_mm"], gd["pins"]["M_mm"]) == (p["pin_diameter_mm"], p[key])
+        # the printed pin is the pin the dimension uses (1 um steps: three decimals say it exactly)
+        line = [x for x in data_lines("g", gd) if x.startswith("dimension")][0]
+        assert (
+            f"pin {p['pin_diameter_mm']:.3f} mm" in line
+            and float(f"{p['pin_diameter_mm']:.3f}") == p["pin_diameter_mm"]
+        )
+
+
+@pytest.mark.parametrize("name", INVOLUTE)
+def test_sensitivities_to_tooth_thickness_match_the_closed_forms(name):
+    # span: W_k = ... - thinning cos(a) (the textbook form above), so dW/ds = cos(a) exactly; pins: a thicker tooth
+    # moves the pin centre along the flank normal: dM/ds = cos(a) / sin(a_M) over pins, minus that between pins (the
+    # centre's pressure angle a_M from R_M = r_b / cos(a_M)); the code takes central differences of 1 um
+    d = build_drive(load_design(TEMPLATES / f"{name}.toml"))
+    for g in (d.flex, d.rigid):
+        gd = gear_data(g, d.tol)
+        if gd["span"] is not None:
+            assert gd["span"]["dW_per_thickness"] == pytest.approx(math.cos(g.spec.alpha), rel=1e-6)
+        p = gd["pins"]
+        a_m = math.acos(g.r_base / p["pin_centre_radius_mm"])
+        c = 1.0 if g.spec.z % 2 == 0 else math.cos(math.pi / (2 * g.spec.z))
+        sign = -1.0 if g.spec.internal else 1.0  # a thicker internal tooth narrows the space: the pins sit further in
+        assert p["dM_per_thickness"] == pytest.approx(sign * c * math.cos(g.spec.alpha) / math.sin(a_m), rel=1e-4)

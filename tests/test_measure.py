@@ -141,6 +141,11 @@ def test_pins_odd_tooth_count_uses_the_half_angle():
 @pytest.mark.parametrize("gear", gears())
 def test_default_pin_stands_out_and_clears_the_root(gear):
     p = workshop_figures(gear)["pins"]
+    if gear.spec.form == "cycloidal" and not gear.spec.internal and not p["pin_clear_of_the_root"]:
+        # D1 cycloidal's flexspline: its spaces do not narrow toward the root, every pin the rule tries sinks onto
+        # the root land (centre at r_f + D/2) and checks no flank; the rule gives none and says so (the span checks it)
+        assert p["pin_centre_diameter_mm"] / 2 - p["pin_diameter_mm"] / 2 == pytest.approx(gear.r_f, abs=2 * gear.tol)
+        return
     assert p["pin_stands_out_of_the_teeth"] and p["pin_clear_of_the_root"]
     if "contact_diameter_mm" in p:  # involute: the contact is on the flank
         lo, hi = flank_zone(gear)
@@ -214,3 +219,28 @@ def test_concave_radii_against_the_curvature_of_the_outline(gear):
     # the circumradius of three points on a circle is exact; on the involute it is the curvature
     # radius to second order in the vertex spacing; 1 % covers both
     assert found == pytest.approx(smallest, rel=1e-2)
+
+
+@pytest.mark.parametrize("name", ["d1_involute", "d1_cycloidal", "d2", "d3_external", "d4_discrete"])
+def test_a_pin_that_fits_checks_the_tooth_thickness(name):
+    # issue 23: D1 cycloidal's flexspline pin (0.720 mm) rested on the root circle (centre at r_f + D/2 =
+    # 79.96 mm) and read 160.6400 mm whatever the thinning: a dimension that checks nothing. A pin the rule
+    # accepts must touch the flanks: 20 um of tooth thickness moves its dimension by more than 1 um
+    from dataclasses import replace
+
+    from wgcad.design import load_design
+    from wgcad.drive import build_drive
+    from wgcad.profiles.gear import make_gear
+    from wgcad.profiles.measure import pin_check, pins_closed_form, pins_numerical
+
+    d = build_drive(load_design(TEMPLATES / f"{name}.toml"))
+    for g in (d.flex, d.rigid):
+        p = pin_check(g)
+        if not (p["pin_stands_out_of_the_teeth"] and p["pin_clear_of_the_root"]):
+            continue
+        measure = pins_closed_form if g.spec.form == "involute" else pins_numerical
+        thinner = make_gear(replace(g.spec, thinning=g.spec.thinning + 0.02), g.tol)
+        moved = abs(
+            measure(thinner, p["pin_diameter_mm"])["dimension_mm"] - measure(g, p["pin_diameter_mm"])["dimension_mm"]
+        )
+        assert moved > 1e-3, (name, g.spec.internal, moved)

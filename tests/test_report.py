@@ -122,6 +122,8 @@ def test_summary_shows_no_negative_thickness_and_leads_with_workshop_figures(nam
     rep = drive_report(drive(name))
     text = format_summary(rep)
     for line in text.splitlines():
+        if line.strip().startswith("change per mm of tooth thickness"):
+            continue  # a derivative, not a size: between pins it is negative by nature (tests/test_gear_data.py)
         if "thickness" in line or "space width" in line or "span" in line or "pins" in line:
             assert not re.search(r"\s-\d", line), line
     for label in (

@@ -2,97 +2,53 @@
 
 from __future__ import annotations
 
-import math
-
 import numpy as np
 
-__all__ = ["inv", "inv_inverse", "span_measurement", "pin_dimension", "gear_data", "data_lines"]
-
-
-def inv(a):
-    """Involute function ``tan a - a``."""
-    return np.tan(a) - a
-
-
-def inv_inverse(y: float) -> float:
-    """The angle ``a`` in ``[0, pi/2)`` with ``inv(a) = y`` (Newton, to 1e-15)."""
-    if y <= 0:
-        return 0.0
-    a = (3.0 * y) ** (1.0 / 3.0)  # inv(a) ~ a^3 / 3
-    a = min(a, 1.5)
-    for _ in range(60):
-        f = math.tan(a) - a - y
-        fp = math.tan(a) ** 2
-        step = f / fp
-        a = min(max(a - step, 1e-12), 1.5707)
-        if abs(step) < 1e-15:
-            break
-    return a
-
-
-def _flank_radii(gear) -> tuple[float, float] | None:
-    """Radius range covered by the involute pieces of a gear (None if it has none)."""
-    rs = []
-    for p in gear.pieces:
-        if p.kind == "involute":
-            rb = p.params[1]
-            rs += [rb * math.hypot(1.0, p.t0), rb * math.hypot(1.0, p.t1)]
-    return (min(rs), max(rs)) if rs else None
+__all__ = ["span_measurement", "pin_dimension", "gear_data", "data_lines"]
 
 
 def span_measurement(gear) -> dict | None:
-    """Span ``W_k`` over ``k`` teeth of an external involute gear (docs/models.md 2.1).
+    """Span ``W_k`` over ``k`` teeth (external teeth) by the rule of :func:`wgcad.profiles.measure.span_check`, the
+    one ``generate``'s report states: the same ``k`` and ``W_k`` in both (issue 23), with the rule, the method
+    and the sensitivity to tooth thickness. None for internal teeth or where no ``k`` puts the jaws on the flanks."""
+    from ..profiles.measure import span_check
 
-    ``W_k = r_b (2 psi_b + (k - 1) 2 pi / z)`` with ``psi_b`` the half tooth
-    angle on the base circle (``s/(2r) + inv(alpha)``, shift and thinning
-    included) -- i.e. ``m cos(a) ((k - 0.5) pi + z inv(a)) + 2 x m sin(a)
-    - thinning cos(a)``. ``k`` is the count whose caliper contact radius
-    ``sqrt(r_b^2 + (W/2)^2)`` lies nearest the middle of the involute flank;
-    None when no ``k`` puts it on the flank.
-    """
-    sp = gear.spec
-    if sp.form != "involute" or sp.internal or gear.r_base is None:
+    sp = span_check(gear)
+    if sp is None or sp.get("k") is None:
         return None
-    rng = _flank_radii(gear)
-    if rng is None:
-        return None
-    r_b = gear.r_base
-    psi_b = float(gear.half_angle(r_b))  # half tooth angle on the base circle
-    best = None
-    target = 0.5 * (rng[0] + rng[1])
-    for k in range(1, sp.z):
-        w = r_b * (2.0 * psi_b + (k - 1) * 2.0 * math.pi / sp.z)
-        rc = math.hypot(r_b, 0.5 * w)
-        if rng[0] < rc < rng[1] and (best is None or abs(rc - target) < abs(best[2] - target)):
-            best = (k, w, rc)
-        if rc > rng[1]:
-            break
-    if best is None:
-        return None
-    return {"k": best[0], "W_mm": best[1], "contact_radius_mm": best[2]}
+    return {
+        "k": sp["k"],
+        "W_mm": sp["w_k_mm"],
+        "contact_radius_mm": 0.5 * sp["contact_diameter_mm"],
+        "rule": sp["k_rule"],
+        "method": sp["method"],
+        "dW_per_thickness": sp["dW_per_thickness"],
+    }
 
 
 def pin_dimension(gear, pin_diameter: float | None = None) -> dict | None:
-    """Dimension between (internal) or over (external) two pins of an involute gear, by the rule the generate report
-    states (:func:`wgcad.profiles.measure._pins`: contact nearest mid-flank with the pin standing out of the teeth
-    and clear of the root, gauge pins in 1 um steps), docs/models.md 2.1. None for other forms."""
-    from ..profiles.measure import _pins
+    """Dimension between (internal) or over (external) two pins by the rule of
+    :func:`wgcad.profiles.measure.pin_check` (contact nearest mid-flank with the pin standing out of the teeth
+    and clear of the root, gauge pins in 1 um steps), the one ``generate``'s report states, for every tooth form;
+    with the sensitivity to tooth thickness. None where no pin fits by that rule."""
+    from ..profiles.measure import pin_check
 
-    sp = gear.spec
-    if sp.form != "involute" or gear.r_base is None:
-        return None
-    p = _pins(gear, pin_diameter)
+    p = pin_check(gear, pin_diameter)
     if not (p["pin_stands_out_of_the_teeth"] and p["pin_clear_of_the_root"]):
         return None
-    M = p["between_pins_mm" if sp.internal else "over_pins_mm"]
-    return {
+    internal = gear.spec.internal
+    out = {
         "pin_diameter_mm": p["pin_diameter_mm"],
-        "M_mm": M,
+        "M_mm": p["between_pins_mm" if internal else "over_pins_mm"],
         "pin_centre_radius_mm": 0.5 * p["pin_centre_diameter_mm"],
-        "contact_radius_mm": 0.5 * p["contact_diameter_mm"],
-        "kind": "between pins" if sp.internal else "over pins",
+        "kind": "between pins" if internal else "over pins",
         "rule": p["pin_diameter_source"],
+        "method": p["method"],
+        "dM_per_thickness": p["dM_per_thickness"],
     }
+    if "contact_diameter_mm" in p:
+        out["contact_radius_mm"] = 0.5 * p["contact_diameter_mm"]
+    return out
 
 
 def gear_data(gear, tol: float) -> dict:
@@ -133,11 +89,21 @@ def data_lines(name: str, data: dict) -> list[str]:
     ]
     s = data.get("span")
     if s:
-        lines.append(f"span W{s['k']} over {s['k']} teeth = {s['W_mm']:.4f} mm")
+        rate = (
+            ""
+            if s["dW_per_thickness"] is None
+            else f" (changes {s['dW_per_thickness']:.3f} mm per mm of tooth thickness)"
+        )
+        lines.append(f"span W{s['k']} over {s['k']} teeth = {s['W_mm']:.4f} mm{rate}")
     p = data.get("pins")
     if p:
-        lines.append(f"dimension {p['kind']} (pin {p['pin_diameter_mm']:.3f} mm) = {p['M_mm']:.4f} mm")
+        rate = (
+            ""
+            if p["dM_per_thickness"] is None
+            else f" (changes {p['dM_per_thickness']:.3f} mm per mm of tooth thickness)"
+        )
+        lines.append(f"dimension {p['kind']} (pin {p['pin_diameter_mm']:.3f} mm) = {p['M_mm']:.4f} mm{rate}")
     if not s and not p:
-        lines.append("span / pins: not defined for this tooth form")
+        lines.append("span / pins: no caliper or pin position on the flanks")
     lines.append(f"outline tolerance = {data['chord_tolerance_mm'] * 1e3:g} um")
     return lines

@@ -65,8 +65,14 @@ __all__ = [
     "pin_diameter_for_contact",
     "pins_numerical",
     "concave_radii",
+    "span_check",
+    "pin_check",
+    "SENSITIVITY_STEP",
     "workshop_figures",
 ]
+
+#: change of tooth thickness (mm) for the measurements' sensitivities (central differences): 1 um
+SENSITIVITY_STEP = 1e-3
 
 
 def flank_zone(gear: Gear) -> tuple[float, float]:
@@ -276,12 +282,17 @@ def _pins(gear: Gear, d_pin: float | None) -> dict:
     chosen = d_pin is not None
     measure = pins_closed_form if closed else pins_numerical
 
+    # clear of the root by more than the outline's own error: a pin that rests on the root land touches no flank,
+    # and its dimension does not change with the tooth thickness it is there to check (D1 cycloidal's flexspline
+    # pin sat on the root circle: 79.96 - 0.36 = 79.6 mm = r_f, and read the same for 100 um of thinning)
+    clear_by = 2.0 * gear.tol
+
     def fits(d):
         # the pin must stand out of the teeth (for the caliper) and stay clear of the root
         R_m = measure(gear, d)["centre_radius_mm"]
         if sp.internal:
-            return R_m - 0.5 * d < gear.r_a, R_m + 0.5 * d < gear.r_f
-        return R_m + 0.5 * d > gear.r_a, R_m - 0.5 * d > gear.r_f
+            return R_m - 0.5 * d < gear.r_a, R_m + 0.5 * d < gear.r_f - clear_by
+        return R_m + 0.5 * d > gear.r_a, R_m - 0.5 * d > gear.r_f + clear_by
 
     if d_pin is None:
         u = np.array([np.cos(pi / sp.z), np.sin(pi / sp.z)])
@@ -358,10 +369,67 @@ def workshop_figures(gear: Gear, measure_diameter: float | None = None, pin_diam
         }
     if measure_diameter is not None:
         out["at_chosen_diameter"] = thickness_at(gear, 0.5 * measure_diameter)
-    out["span"] = _span(gear)
-    out["pins"] = _pins(gear, pin_diameter)
+    out["span"] = span_check(gear)
+    out["pins"] = pin_check(gear, pin_diameter)
     radii = concave_radii(gear)
     out["concave_radii_mm"] = radii
     out["smallest_concave_radius_mm"] = min(radii.values())
     out["thickness_method"] = "closed form"
     return out
+
+
+def _thicker(gear: Gear, ds: float) -> Gear:
+    """The same gear with every tooth ``ds`` thicker at the pitch circle (``thinning`` less by ``ds``)."""
+    from dataclasses import replace
+
+    from .gear import make_gear
+
+    return make_gear(replace(gear.spec, thinning=gear.spec.thinning - ds), gear.tol)
+
+
+def span_check(gear: Gear) -> dict | None:
+    """Span over ``k`` teeth by the one rule both ``generate``'s report and the part set's gear data state
+    (module docstring), with its sensitivity to tooth thickness: ``dW_per_thickness`` is the change of ``W_k``
+    per mm of tooth thickness at the pitch circle (central differences of +-:data:`SENSITIVITY_STEP` at the
+    same ``k``; the closed form gives ``cos(alpha)`` for involute teeth), so a shop can turn a thickness
+    tolerance into a span tolerance. None for internal teeth (no caliper spans them)."""
+    out = _span(gear)
+    if out is None or out.get("k") is None:
+        return out
+    fn = span_closed_form if gear.spec.form == "involute" else span_numerical
+    return {**out, "dW_per_thickness": _per_thickness(gear, lambda g: fn(g, out["k"])[0], out["w_k_mm"])}
+
+
+def pin_check(gear: Gear, pin_diameter: float | None = None) -> dict:
+    """Dimension over (external) or between (internal) two pins by the one rule of every command (module
+    docstring), with ``dM_per_thickness``: the change of the dimension per mm of tooth thickness at the pitch
+    circle (central differences of +-:data:`SENSITIVITY_STEP`, the same pin; None where it is not smooth,
+    :func:`_per_thickness`)."""
+    out = _pins(gear, pin_diameter)
+    measure = pins_closed_form if gear.spec.form == "involute" else pins_numerical
+    key = "between_pins_mm" if gear.spec.internal else "over_pins_mm"
+    d = out["pin_diameter_mm"]
+    return {**out, "dM_per_thickness": _per_thickness(gear, lambda g: measure(g, d)["dimension_mm"], out[key])}
+
+
+def _per_thickness(gear: Gear, figure, at: float) -> float | None:
+    """d figure / d tooth thickness (mm/mm), or None where it is not a derivative one can use.
+
+    Central differences of +-:data:`SENSITIVITY_STEP` (one-sided where a
+    tooth that much thicker cannot be built: no thinning left), checked
+    against the same at 4 times the step: where the two differ by more than
+    5 % the figure is not smooth in the thickness (a pin whose seat jumps
+    between features of a cycloidal space) and no sensitivity is given.
+    """
+    from ..errors import DesignError
+
+    def diff(h):
+        lo = figure(_thicker(gear, -h))
+        try:
+            hi = figure(_thicker(gear, h))
+        except DesignError:
+            return (at - lo) / h
+        return (hi - lo) / (2.0 * h)
+
+    d1, d4 = diff(SENSITIVITY_STEP), diff(4.0 * SENSITIVITY_STEP)
+    return d1 if abs(d1 - d4) <= 0.05 * max(abs(d1), abs(d4)) else None

@@ -255,16 +255,36 @@ def format_summary(rep: dict) -> str:
             return "internal teeth"
         return "none fits" if sp.get("k") is None else f"{sp['w_k_mm']:.4f} (k={sp['k']})"
 
+    def span_rate(w):
+        sp = w["span"]
+        if sp is None or sp.get("k") is None or sp["dW_per_thickness"] is None:
+            return "-"
+        return f"{sp['dW_per_thickness']:.3f}"
+
+    def fits(w):
+        p = w["pins"]
+        return p["pin_stands_out_of_the_teeth"] and p["pin_clear_of_the_root"]
+
+    def pin(w, key):
+        # a pin that does not stand out of the teeth or rests on the root checks no tooth thickness: not given
+        if not fits(w):
+            return "none fits"
+        p = w["pins"]
+        if key == "dimension":
+            return f"{p.get('over_pins_mm', p.get('between_pins_mm')):.4f}"
+        if key == "diameter":
+            return f"{p['pin_diameter_mm']:.3f}"
+        return "not smooth" if p["dM_per_thickness"] is None else f"{p['dM_per_thickness']:.3f}"
+
     row("span W_k over k teeth, mm", span(wf), span(wb))
-    row("pin (ball) diameter, mm", wf["pins"]["pin_diameter_mm"], wb["pins"]["pin_diameter_mm"])
-    row(
-        "dimension over / between pins, mm",
-        *(w["pins"].get("over_pins_mm", w["pins"].get("between_pins_mm")) for w in (wf, wb)),
-    )
+    row("  change per mm of tooth thickness", span_rate(wf), span_rate(wb))
+    row("pin (ball) diameter, mm", pin(wf, "diameter"), pin(wb, "diameter"))
+    row("dimension over / between pins, mm", pin(wf, "dimension"), pin(wb, "dimension"))
+    row("  change per mm of tooth thickness", pin(wf, "rate"), pin(wb, "rate"))
     row("smallest concave radius, mm", wf["smallest_concave_radius_mm"], wb["smallest_concave_radius_mm"])
     methods = sorted(
         {w["span"]["method"] for w in (wf, wb) if w["span"] and w["span"].get("method")}
-        | {w["pins"]["method"] for w in (wf, wb)}
+        | {w["pins"]["method"] for w in (wf, wb) if fits(w)}
     )
     lines.append(
         f"  (span and pins: {'; '.join(methods)}; thicknesses and concave radii: closed form;"
