@@ -95,14 +95,16 @@ def data_lines(name: str, data: dict) -> list[str]:
             else f" (changes {s['dW_per_thickness']:.3f} mm per mm of tooth thickness)"
         )
         lines.append(f"span W{s['k']} over {s['k']} teeth = {s['W_mm']:.4f} mm{rate}")
+        lines.append(f"  k: {s['rule']}; {s['method']}")
     p = data.get("pins")
     if p:
         rate = (
-            ""
+            " (its change with tooth thickness is not smooth: not given)"
             if p["dM_per_thickness"] is None
             else f" (changes {p['dM_per_thickness']:.3f} mm per mm of tooth thickness)"
         )
         lines.append(f"dimension {p['kind']} (pin {p['pin_diameter_mm']:.3f} mm) = {p['M_mm']:.4f} mm{rate}")
+        lines.append(f"  pin: {p['rule']}; {p['method']}")
     if not s and not p:
         lines.append("span / pins: no caliper or pin position on the flanks")
     lines.append(f"outline tolerance = {data['chord_tolerance_mm'] * 1e3:g} um")
