@@ -145,3 +145,6 @@ def test_generate_bar_moves_per_file(capsys, tmp_path, monkeypatch):
     assert len({p for p in seen if 0 < p < 100}) >= 3, seen
     pct = percentages(err)
     assert pct[0] == 0 and pct[-1] == 100 and pct == sorted(pct)
+    # the last state says "done" once (issue 23: it read "done       done")
+    last = err.replace("\r", "\n").strip().splitlines()[-1]
+    assert last.count("done") == 1, last

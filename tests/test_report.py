@@ -190,3 +190,20 @@ def test_measurement_choices_that_cannot_be_measured_are_refused(change, field, 
     with pytest.raises(DesignError) as e:
         drive_report(build_drive(with_changes(d, flexspline=change)))
     assert e.value.field == field and words in str(e.value), str(e.value)
+
+
+def test_fixed_never_prints_negative_zero():
+    # issue 23: "-0.0000 arcmin" of wind-up at no load
+    from wgcad.report.text import fixed
+
+    assert fixed(-1e-9, 4) == "0.0000" and fixed(-0.0, 3, 8) == "   0.000"
+    assert fixed(-0.00006, 4) == "-0.0001" and fixed(2.5, 1) == "2.5"
+
+
+def test_load_table_has_no_negative_zero(capsys):
+    from wgcad.cli import main
+
+    for name in ("d3_external", "d1_cycloidal"):  # these printed -0.000 N m and -0.0000 arcmin
+        main(["audit", str(TEMPLATES / f"{name}.toml"), "--torque-nm", "0", "--cam-offset-um", "20"])
+    out = capsys.readouterr().out
+    assert not re.search(r"-0\.0+\b", out), out

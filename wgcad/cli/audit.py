@@ -7,7 +7,7 @@ import os
 import sys
 from pathlib import Path
 
-from .common import EPILOG, EXIT_INTERFERENCE, EXIT_OK, add_memory_flag, angle_count, positive_float, whole_number
+from .common import EXIT_INTERFERENCE, EXIT_OK, add_memory_flag, angle_count, epilog, positive_float, whole_number
 
 __all__ = ["register", "cmd_audit"]
 
@@ -187,7 +187,10 @@ def register(sub) -> None:
             "sweeps more of the error cycle).",
             width=79,
         ),
-        epilog=EPILOG,
+        epilog=epilog(
+            one="interference found, or drift from --baseline; with --torque-nm: the entry gap closes under the load",
+            model="only with --torque-nm: the elastic model",
+        ),
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     a.add_argument("design", help="design file (TOML), e.g. templates/d1_involute.toml")

@@ -20,6 +20,7 @@ __all__ = [
     "EXIT_INTERNAL",
     "EXIT_MODEL",
     "EPILOG",
+    "epilog",
     "TRACEBACK_ENV",
     "Parser",
     "angles_deg",
@@ -45,16 +46,40 @@ EXIT_MODEL = 4  # valid input the model could not answer: it did not converge or
 #: set to 1 to get the Python traceback of an internal error (same as --traceback)
 TRACEBACK_ENV = "WGCAD_TRACEBACK"
 
-EPILOG = f"""exit codes:
-  0    success
-  1    interference found, or drift from --baseline (audit)
-  2    bad input: design file, flag, or output path (one-line message, nothing written)
-  3    internal error: a bug in wgcad (one-line message; --traceback or {TRACEBACK_ENV}=1 shows the traceback)
-  4    the model could not answer: it did not converge, or the drive lies outside what it represents (one
-       line saying what to change; the input itself is valid; nothing written)
-  130  interrupted (Ctrl-C); 143 SIGTERM; 129 SIGHUP: temporary files removed, nothing half-written
-  141  standard output closed by its reader (e.g. | head)
-"""
+_CODES = {
+    0: "success",
+    2: "bad input: design file, flag, or output path (one-line message, nothing written)",
+    3: f"internal error: a bug in wgcad (one-line message; --traceback or {TRACEBACK_ENV}=1 shows the traceback)",
+    4: "the model could not answer: it did not converge, or the drive lies outside what it represents (one\n"
+    "       line saying what to change; the input itself is valid; nothing written)",
+}
+_SIGNALS = (
+    "  130  interrupted (Ctrl-C); 143 SIGTERM; 129 SIGHUP: temporary files removed, nothing half-written\n"
+    "  141  standard output closed by its reader (e.g. | head)\n"
+)
+
+
+def epilog(one: str | None = None, model: str | None = None, four: str | None = None) -> str:
+    """The exit codes a command can return, for its ``--help``: 1 only where the command has a verdict (``one``
+    says what it means), 4 only where a model can fail to answer (``model`` says when) or, ``four``, what 4
+    means for this command instead."""
+    lines = ["exit codes:", f"  0    {_CODES[0]}"]
+    if one:
+        lines.append(f"  1    {one}")
+    lines += [f"  2    {_CODES[2]}", f"  3    {_CODES[3]}"]
+    if model:
+        lines.append(f"  4    {_CODES[4]} ({model})")
+    elif four:
+        lines.append(f"  4    {four}")
+    return "\n".join(lines) + "\n" + _SIGNALS
+
+
+#: every code of every command (the top-level help)
+EPILOG = epilog(
+    one="a verdict failed: interference or drift from --baseline (audit), the entry gap closes (audit --torque-nm), "
+    "teeth meet tip to tip (sector)",
+    model="the elastic model (--torque-nm), a KE of teeth that never touch",
+)
 
 
 class Parser(argparse.ArgumentParser):

@@ -8,7 +8,7 @@ import sys
 import time
 from pathlib import Path
 
-from .common import EPILOG, EXIT_OK, add_memory_flag, angle_tag, angles_deg, circle, out_dir, positive_float
+from .common import EXIT_OK, add_memory_flag, angle_tag, angles_deg, circle, epilog, out_dir, positive_float
 
 __all__ = ["register", "cmd_generate", "report_name"]
 
@@ -209,7 +209,7 @@ def register(sub) -> None:
             "and the temporary files a killed run left (.<file>.<pid>-<hex>.tmp).",
             width=79,
         ),
-        epilog=EPILOG,
+        epilog=epilog(),
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     g.add_argument("design", help="design file (TOML), e.g. templates/d1_involute.toml")

@@ -7,7 +7,7 @@ from pathlib import Path
 
 from wgcad.units import ARCSEC_PER_RAD
 
-from .common import EPILOG, EXIT_OK, whole_number
+from .common import EXIT_OK, epilog, whole_number
 
 __all__ = ["register", "cmd_ke"]
 
@@ -259,7 +259,7 @@ def register(sub) -> None:
     k = sub.add_parser(
         "ke",
         help="no-load kinematic error, lost motion and the installation-angle lever of an imperfect drive",
-        epilog=EPILOG,
+        epilog=epilog(model="teeth that never touch; with --torque-nm the elastic model"),
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     k.add_argument(

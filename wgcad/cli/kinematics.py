@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from .common import EPILOG, EXIT_OK, out_dir, positive_float
+from .common import EXIT_OK, epilog, out_dir, positive_float
 
 __all__ = ["register", "cmd_kinematics"]
 
@@ -78,7 +78,7 @@ def register(sub) -> None:
     k = sub.add_parser(
         "kinematics",
         help="gear ratios; velocities of the external ring generator (CSV + PNG)",
-        epilog=EPILOG,
+        epilog=epilog(),
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     k.add_argument("design", help="design file (TOML), e.g. templates/d3_external.toml")

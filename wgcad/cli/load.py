@@ -82,6 +82,8 @@ def _summary(name: str, res: dict) -> str:
             f"{mnt['largest_departure_from_law_um']:.1f} um of the law (largest at {mnt['departure_at_deg']:+.1f} deg), "
             f"held by {mnt['balls_in_contact']} balls of {mnt['ball_preload_n']:.0f} N"
         )
+    from ..report.text import fixed
+
     lines.append(
         "  torque N m | entry gap Delta um (where)           | tip crossing um | teeth in contact | max tooth force N | "
         "max ball load N | generator N m | wind-up arcmin | secant N m/rad | tangent N m/rad"
@@ -95,8 +97,8 @@ def _summary(name: str, res: dict) -> str:
         cr = "none" if lv.get("crossing_gap_um") is None else f"{lv['crossing_gap_um']:.3f}"
         lines.append(
             f"  {lv['torque_nm']:10g} | {eg:>9} {where:<25} | {cr:>15} | {lv['teeth_in_contact']:16d} | "
-            f"{lv['largest_tooth_force_n']:17.1f} | {lv['max_ball_load_n']:15.1f} | {lv['generator_torque_nm']:13.3f} | "
-            f"{lv['wind_up_arcmin']:14.4f} | "
+            f"{lv['largest_tooth_force_n']:17.1f} | {lv['max_ball_load_n']:15.1f} | {fixed(lv['generator_torque_nm'], 3, 13)} | "
+            f"{fixed(lv['wind_up_arcmin'], 4, 14)} | "
             + ("-" if sec is None else f"{sec:14.4g}")
             + " | "
             + ("-" if tan is None else f"{tan:.4g}")

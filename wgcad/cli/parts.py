@@ -7,7 +7,7 @@ import json
 import time
 from pathlib import Path
 
-from .common import EPILOG, EXIT_OK, angles_deg, out_dir, positive_float
+from .common import EXIT_OK, angles_deg, epilog, out_dir, positive_float
 
 __all__ = ["register", "cmd_parts", "FORMATS"]
 
@@ -132,7 +132,7 @@ def register(sub) -> None:
     g = sub.add_parser(
         "parts",
         help="write the parts a shop makes: cup flexspline, generator plug, rigid gear (DXF, SVG, STL, 3MF, STEP)",
-        epilog=EPILOG,
+        epilog=epilog(),
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     g.add_argument("design", help="design file (TOML); sizes of the parts from its optional [parts] table")

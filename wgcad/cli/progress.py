@@ -144,7 +144,9 @@ class Progress:
             df, dt = self.fraction - f_ref, now - t_ref
             if df >= 0.01 and dt >= 0.5:
                 eta = "ETA " + format_seconds(dt * (1.0 - self.fraction) / df)
-        return f"[{'#' * n}{'.' * (self.WIDTH - n)}] {100 * self.fraction:3.0f} %  {elapsed:5.1f}s  {eta:<10s} {self.stage}"
+        # at the end the ETA column says "done": a stage also named "done" is not said twice
+        stage = "" if (self.fraction >= 1.0 and self.stage == "done") else self.stage
+        return f"[{'#' * n}{'.' * (self.WIDTH - n)}] {100 * self.fraction:3.0f} %  {elapsed:5.1f}s  {eta:<10s} {stage}".rstrip()
 
     def _draw(self, force: bool = False) -> None:
         now = self.clock()

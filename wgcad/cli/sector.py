@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from .common import EPILOG, EXIT_INTERFERENCE, EXIT_OK, _UsageError, add_memory_flag, out_dir, positive_float
+from .common import EXIT_INTERFERENCE, EXIT_OK, _UsageError, add_memory_flag, epilog, out_dir, positive_float
 
 __all__ = ["register", "cmd_sector", "run_sector"]
 
@@ -381,10 +381,7 @@ def register(sub) -> None:
     s = sub.add_parser(
         "sector",
         help="discrete-motion drive: sectored rigid gear, variable tooth heights, motion law, audit",
-        epilog=EPILOG.replace(
-            "interference found (audit)",
-            "interference found (audit); tip-to-tip contact left with the built heights (sector)",
-        ),
+        epilog=epilog(one="teeth still meet tip to tip with the built heights"),
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     s.add_argument("design", help="design file (TOML) with a [sectors] table, e.g. templates/d4_sectored.toml")

@@ -5,7 +5,7 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
-from .common import EPILOG, EXIT_OK
+from .common import EXIT_OK, epilog
 
 __all__ = ["register", "cmd_sweep"]
 
@@ -95,8 +95,10 @@ def register(sub) -> None:
     s = sub.add_parser(
         "sweep",
         help="tolerance Monte Carlo or design study over a sweep spec, on Dask; resumable",
-        epilog=EPILOG
-        + "  4    the Dask cluster failed (a worker died, the scheduler went away): the chunks done are kept, run again to resume\n",
+        epilog=epilog(
+            four="the Dask cluster failed (a worker died, the scheduler went away): the chunks done are kept, "
+            "run again to resume"
+        ),
         formatter_class=argparse.RawDescriptionHelpFormatter,
         description="Runs every sample of SPEC not yet stored in --out (rerun after an interruption: only "
         "the missing samples are computed). Example spec: templates/sweeps/d2_tolerance_sweep.toml",

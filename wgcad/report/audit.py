@@ -157,7 +157,7 @@ def audit_summary(name: str, res: dict) -> str:
     if res["interference"]:
         lines.append(
             f"  INTERFERENCE: penetration {-res['min_clearance_um']:.3f} um deeper than the tolerance "
-            f"{res['interference_tol_um']:g} um (overlap area {w['overlap_area_um2']:.1f} um^2)"
+            f"{res['interference_tol_um']:g} um (overlap area {w['overlap_area_um2'] * 1e-6:.4g} mm^2)"
         )
     elif res["min_clearance_um"] < res["interference_tol_um"]:
         lines.append(f"  contact within the tolerance ({res['interference_tol_um']:g} um): no interference")
