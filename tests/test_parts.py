@@ -287,3 +287,26 @@ def test_cup_flexspline_step_solid_on_templates(name):
     pr = solid_props(flex.solid())
     assert pr["valid"], name
     assert pr["volume"] == pytest.approx(flex.volume_mm3, rel=1e-9), name
+
+
+def test_svg_keeps_the_gear_centre_at_the_origin(small_run):
+    # issue 23: the SVG mirrored y about the middle of its box, which put the gear's centre at (0, 3.3) mm in the
+    # file's coordinates; every centred circle (bores, rims, flange) must sit at (0, 0), and the bolt holes at
+    # their bolt circle's radius with y up turned into SVG's y down
+    import xml.etree.ElementTree as ET
+
+    out, parts, drive = small_run
+    ns = {"s": "http://www.w3.org/2000/svg"}
+    for name in ("flexspline", "rigid"):
+        root = ET.parse(out / f"small_{name}.svg").getroot()
+        centred = [
+            c
+            for g in root.iterfind("s:g", ns)
+            if not g.get("id").endswith("HOLES")  # every other layer's circles are centred on the gear
+            for c in g.iterfind("s:circle", ns)
+        ]
+        assert centred, name
+        for c in centred:
+            assert (c.get("cx"), c.get("cy")) == ("0", "0"), (name, c.attrib)
+        box = [float(v) for v in root.get("viewBox").split()]
+        assert box[0] < 0 < box[0] + box[2] and box[1] < 0 < box[1] + box[3]  # the origin inside the drawing

@@ -17,7 +17,8 @@ ACI = {1: "#c00000", 2: "#b08000", 3: "#008000", 5: "#0040c0", 7: "#000000", 8: 
 
 
 def _f(v: float) -> str:
-    return f"{v:.6f}".rstrip("0").rstrip(".")
+    t = f"{v:.6f}".rstrip("0").rstrip(".")
+    return "0" if t == "-0" else t
 
 
 def _poly(pts, flip) -> str:
@@ -50,13 +51,15 @@ def svg_text(layers, title: str) -> str:
     pad = 0.03 * float(np.max(hi - lo)) + 1.0
     lo, hi = lo - pad, hi + pad
     w, h = hi - lo
-    flip = lambda y: lo[1] + hi[1] - y  # noqa: E731  (mirror y so the drawing is not upside down)
+    # SVG's y runs down: y is negated, so the drawing is not upside down and the gear's centre stays at (0, 0) in
+    # the file's own coordinates (a reflection about the box's middle put it at (0, 3.3) mm on D1's drawing)
+    flip = lambda y: -y  # noqa: E731
     stroke = max(0.02, 0.0008 * float(max(w, h)))
     out = [
         f'<svg xmlns="http://www.w3.org/2000/svg" width="{_f(w)}mm" height="{_f(h)}mm" '
-        f'viewBox="{_f(lo[0])} {_f(lo[1])} {_f(w)} {_f(h)}">',
+        f'viewBox="{_f(lo[0])} {_f(-hi[1])} {_f(w)} {_f(h)}">',
         f"<title>{escape(title)}</title>",
-        f'<rect x="{_f(lo[0])}" y="{_f(lo[1])}" width="{_f(w)}" height="{_f(h)}" fill="white"/>',
+        f'<rect x="{_f(lo[0])}" y="{_f(-hi[1])}" width="{_f(w)}" height="{_f(h)}" fill="white"/>',
     ]
     for layer in layers:
         col = ACI.get(layer.color, "#000000")
