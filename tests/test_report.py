@@ -207,3 +207,25 @@ def test_load_table_has_no_negative_zero(capsys):
         main(["audit", str(TEMPLATES / f"{name}.toml"), "--torque-nm", "0", "--cam-offset-um", "20"])
     out = capsys.readouterr().out
     assert not re.search(r"-0\.0+\b", out), out
+
+
+def test_negative_radial_clearance_is_flagged():
+    # issue 23: a coning section with a tip clearance of -21.4 um went unflagged in generate's summary
+    from wgcad.design import load_design
+    from wgcad.design.schema import with_changes
+    from wgcad.drive import build_drive
+    from wgcad.report.drive import drive_report, format_summary
+
+    d = load_design(TEMPLATES / "d1_involute.toml")
+    w0 = d.generator.w0_coef
+    for coef, flagged in ((w0, False), (w0 * 1.5, True)):  # 1.5 W0 drives the tips into the rigid roots
+        rep = drive_report(build_drive(with_changes(d, generator={"w0_coef": coef})))
+        text = format_summary(rep)
+        negatives = [
+            v
+            for sec in [rep["mesh"], *rep.get("mesh_at_face_ends", {}).values()]
+            for k, v in sec.items()
+            if k in ("clearance_flex_tip_major_um", "clearance_rigid_tip_major_um", "tip_gap_minor_um") and v < 0
+        ]
+        assert bool(negatives) == flagged
+        assert ("WARNING" in text and "collide radially" in text) == flagged, text

@@ -313,4 +313,21 @@ def format_summary(rep: dict) -> str:
             f"  coning, section {key}: depth {sec['depth_of_engagement_mm']:.4f} mm, "
             f"flex tip clearance {sec['clearance_flex_tip_major_um']:.1f} um, minor tip gap {sec['tip_gap_minor_um']:.1f} um"
         )
+    # a negative radial figure is a collision of tips with roots (or tips with tips on the minor axis): said, not
+    # left to be read off a column (issue 23: a section at -21.4 um went unflagged)
+    sections = [("centre section", m)] + [(f"section {k}", sec) for k, sec in rep.get("mesh_at_face_ends", {}).items()]
+    for where, sec in sections:
+        bad = [
+            (label, sec[key])
+            for key, label in (
+                ("clearance_flex_tip_major_um", "flexspline tip against the rigid root, major axis"),
+                ("clearance_rigid_tip_major_um", "rigid tip against the flexspline root, major axis"),
+                ("tip_gap_minor_um", "tips on the minor axis"),
+            )
+            if sec.get(key) is not None and sec[key] < 0
+        ]
+        for label, v in bad:
+            lines.append(
+                f"  WARNING ({where}): {label}: {v:.1f} um, the teeth collide radially there (wgcad audit shows where)"
+            )
     return "\n".join(lines)
