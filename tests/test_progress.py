@@ -148,3 +148,36 @@ def test_generate_bar_moves_per_file(capsys, tmp_path, monkeypatch):
     # the last state says "done" once (issue 23: it read "done       done")
     last = err.replace("\r", "\n").strip().splitlines()[-1]
     assert last.count("done") == 1, last
+
+
+def test_parts_bar_moves_per_part(capsys, tmp_path, monkeypatch):
+    # issue 23: parts was silent for its whole run (30 s then, 6 s now on D1)
+    from test_parts import small_design
+
+    from wgcad.cli import main
+
+    seen = _record_fractions(monkeypatch)
+    design = small_design(tmp_path)
+    code = main(["parts", str(design), "--out", str(tmp_path / "out"), "--format", "stl,step", "--progress", "--quiet"])
+    err = capsys.readouterr().err
+    assert code == 0
+    assert seen[0] == 0 and seen[-1] == 100 and seen == sorted(seen)
+    assert len({p for p in seen if 0 < p < 100}) >= 5, seen
+    last = err.replace("\r", "\n").strip().splitlines()[-1]
+    assert last.count("done") == 1, last
+
+
+def test_sector_and_ke_bars_move(capsys, tmp_path, monkeypatch):
+    # issue 23: ke and sector had no progress (4 s and 2.5 s of silence)
+    from wgcad.cli import main
+
+    for cmd in (
+        ["sector", str(TEMPLATES / "d4_sectored.toml"), "--out", str(tmp_path / "s"), "--no-stl", "--json"],
+        ["ke", str(TEMPLATES / "d2_imperfect.toml"), "--per-mesh", "4"],
+    ):
+        seen = _record_fractions(monkeypatch)
+        main([*cmd, "--progress"])
+        err = capsys.readouterr().err
+        assert seen[0] == 0 and seen[-1] == 100 and seen == sorted(seen), (cmd[0], seen)
+        assert len({p for p in seen if 0 < p < 100}) >= 3, (cmd[0], seen)
+        assert err.replace("\r", "\n").strip().splitlines()[-1].count("done") == 1

@@ -85,6 +85,7 @@ def contact_table(
     sections=None,
     reach_pitches: float = 0.5,
     exhaustive: bool = False,
+    progress=None,
 ) -> ContactTable:
     """Tabulate every tooth's contact on both sides at the ``N z_g`` lattice angles (module docstring).
 
@@ -105,7 +106,11 @@ def contact_table(
         (the reference tests/test_ke.py compares with); by default only the
         pairs that can be first (:func:`_can_be_first`), each search started
         where the pair's own line puts the moved contact.
+    progress : callable, optional
+        ``progress(fraction)`` after each section and side of each stage
+        (fractions from the stages' times on D2).
     """
+    tick = progress or (lambda f: None)
     _check(drive)
     if not isinstance(n_per_mesh, int) or n_per_mesh < 1:
         raise DesignError("n_per_mesh", f"must be a positive whole number, got {n_per_mesh!r}")
@@ -173,12 +178,14 @@ def contact_table(
             rows = _rows(con, k, idx, rot, shift, drot, dshift, m_all, j, cz, side, np.zeros(len(k)))
             parts[side].append(rows)
             pending[side].append((rows, k, idx, rot, shift, drot, dshift, j, cz, rb))
+            tick(0.4 * (2 * si + (side < 0) + 1) / (2 * len(sections)))
     # the touching feature can change within the errors' radial reach (a tip reaching past the end of the
     # other's involute into its root fillet): each pair that can be first is solved again with its
     # flexspline tooth moved radially, and the contact found there, carried back to the perfect pose along
     # its own sensitivity, added as a further candidate (_second_features)
     if imp.cam_flex + imp.cam_fixed + imp.flex_ecc + imp.rigid_ecc > 0.0:
         for side in (1, -1):
+            tick(0.4 + 0.35 * (side < 0))
             keep = (
                 np.ones(sum(len(x[1]) for x in pending[side]), dtype=bool)
                 if exhaustive
@@ -213,8 +220,10 @@ def contact_table(
                         )
                     )
     for side in (1, -1):
+        tick(0.75 + 0.125 * (side < 0))
         tab.sides[side] = {key: np.concatenate([p[key] for p in parts[side]]) for key in parts[side][0]}
         _refine(tab, side, imp, flex, rigid, reach_pitches * 2 * pi / z_g)
+    tick(1.0)
     return tab
 
 

@@ -21,8 +21,13 @@ def run_sector(
     assign: str | None = None,
     step_deg: float | None = None,
     tip_clearance_um: float | None = None,
+    progress=None,
 ) -> dict:
-    """Everything ``wgcad sector`` computes, as data (no files): layout, heights both ways, built gear, motion law, audits."""
+    """Everything ``wgcad sector`` computes, as data (no files): layout, heights both ways, built gear, motion law, audits.
+
+    ``progress(fraction, stage)``, if given, is called before each step (fractions from the steps' times on D4).
+    """
+    tick = progress or (lambda f, stage: None)
     import numpy as np
 
     from ..drive import build_drive, tooth_spec
@@ -51,8 +56,10 @@ def run_sector(
     layout = sector_layout(sp, d.z_flex, d.z_rigid)
     teeth = TeethByHeight(tooth_spec(design, "rigid"), drive.rigid, drive.tol)
     H = teeth.height
+    tick(0.0, "closed-form heights")
     cf = closed_form_heights(drive, layout, teeth, assign=assign, step_deg=step)
     cf_b = closed_form_heights(drive, layout, teeth, assign="boundary") if assign != "boundary" else cf
+    tick(0.03, "simulated heights")
     sim = simulated_heights(drive, layout, teeth, c_req, step_deg=step)
     if mode == "closed_form":
         built = cf.heights
@@ -66,10 +73,14 @@ def run_sector(
         built = listed_heights(layout, sp.heights_mm, H)
     # the exported outline: every curve in a symmetric chord band (docs/models.md appendix A), as generate's
     outline = sectored_outline(layout, teeth, built, band=True)
+    tick(0.18, "motion law")
     law = motion_law(layout, d.z_flex)
+    tick(0.19, "audit, full-height teeth")
     scene_full = SectoredScene(drive, layout, teeth, np.full(layout.n_teeth, H))
     audit_full = sectored_audit(scene_full, step)
+    tick(0.53, "audit, built heights")
     audit_built = sectored_audit(SectoredScene(drive, layout, teeth, built), step)
+    tick(0.8, "files")
     return {
         "drive": drive,
         "layout": layout,
@@ -181,7 +192,13 @@ def cmd_sector(args) -> int:
     )
     out = out_dir(args, args.design)
     check_writable_dir(out)
-    res = run_sector(design, args.heights, args.assign, args.step_deg, args.tip_clearance_um)
+    from .common import Progress, want_progress
+
+    bar = Progress(want_progress(args.progress))
+    bar.start("heights")
+    res = run_sector(
+        design, args.heights, args.assign, args.step_deg, args.tip_clearance_um, progress=lambda f, st: bar.set(f, st)
+    )
     lay, cf, cfb, sim, built = (
         res["layout"],
         res["closed_form"],
@@ -316,6 +333,8 @@ def cmd_sector(args) -> int:
         Path(batch.temp_path(out / f"{stem}_sector.json")).write_text(
             json.dumps(summ, allow_nan=False, indent=2) + "\n"
         )
+    bar.set(1.0, "done")
+    bar.close()
     if args.json:
         print(json.dumps(summ, allow_nan=False, indent=2))
     else:
@@ -386,6 +405,7 @@ def register(sub) -> None:
     )
     s.add_argument("design", help="design file (TOML) with a [sectors] table, e.g. templates/d4_sectored.toml")
     s.add_argument("--out", help="output folder (default: output/<design name>)")
+    s.add_argument("--progress", action="store_true", help="show the progress bar even when stderr is not a terminal")
     s.add_argument(
         "--heights",
         choices=("closed_form", "simulated", "full", "list"),
