@@ -310,3 +310,37 @@ def test_svg_keeps_the_gear_centre_at_the_origin(small_run):
             assert (c.get("cx"), c.get("cy")) == ("0", "0"), (name, c.attrib)
         box = [float(v) for v in root.get("viewBox").split()]
         assert box[0] < 0 < box[0] + box[2] and box[1] < 0 < box[1] + box[3]  # the origin inside the drawing
+
+
+def test_parts_3mf_places_every_part_apart(small_run):
+    # issue 23: the part set's 3MF put every part at the origin, assembled and undeformed: flexspline and rigid gear
+    # shared 1234 mm^3, which a slicer takes for intersecting objects. Read here as a slicer does (the 3MF core
+    # spec: each build item's 3 x 4 transform applied to its object's vertices; parsed in this test, not with
+    # wgcad's reader): the parts' boxes must not overlap, each stands on z = 0
+    import xml.etree.ElementTree as ET
+    import zipfile
+
+    out, parts, drive = small_run
+    ns = "{http://schemas.microsoft.com/3dmanufacturing/core/2015/02}"
+    with zipfile.ZipFile(out / "small_parts.3mf") as z:
+        root = ET.fromstring(z.read("3D/3dmodel.model"))
+    verts = {
+        o.get("id"): (o.get("name"), np.array([[float(v.get(a)) for a in "xyz"] for v in o.iter(ns + "vertex")]))
+        for o in root.iter(ns + "object")
+    }
+    boxes = {}
+    for item in root.iter(ns + "item"):
+        name, v = verts[item.get("objectid")]
+        m = np.array([float(x) for x in (item.get("transform") or "1 0 0 0 1 0 0 0 1 0 0 0").split()]).reshape(4, 3)
+        w = v @ m[:3] + m[3]  # row vectors: [x y z 1] times the 4 x 3 matrix
+        boxes[name] = (w.min(axis=0), w.max(axis=0))
+        assert w.min(axis=0)[2] == pytest.approx(0.0, abs=1e-9), name
+    assert sorted(boxes) == ["flexspline", "plug", "rigid"]
+    names = sorted(boxes)
+    for i, a in enumerate(names):
+        for b in names[i + 1 :]:
+            (alo, ahi), (blo, bhi) = boxes[a], boxes[b]
+            assert np.any(ahi <= blo) or np.any(bhi <= alo), (a, b, boxes[a], boxes[b])
+    # each object keeps its own coordinates (the gear axis at x = y = 0); the placement is the item's
+    for name, v in verts.values():
+        assert np.allclose(0.5 * (v.min(axis=0) + v.max(axis=0))[:2], 0.0, atol=1e-6), name

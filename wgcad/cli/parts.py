@@ -120,12 +120,12 @@ def cmd_parts(args) -> int:
                 done += 4.0
             done += 0.5
         if "3mf" in fmts:
-            from ..export.threemf import write_3mf
+            from ..export.threemf import exploded, write_3mf
 
-            write_3mf(
-                target(f"{stem}_parts.3mf"),
-                {p.name: meshes[p.name] for p in parts if not p.name.startswith("assembly")},
-            )
+            # the parts side by side (issue 23: assembled at the origin they shared 1234 mm^3, which a slicer takes
+            # for intersecting objects); the deformed assemblies below stay assembled: that is what they show
+            own = {p.name: meshes[p.name] for p in parts if not p.name.startswith("assembly")}
+            write_3mf(target(f"{stem}_parts.3mf"), own, exploded(own))
             for p in parts:
                 if p.name.startswith("assembly"):
                     write_3mf(target(f"{stem}_{p.name}.3mf"), {f"{p.name}_{k}": m for k, m in p.info["meshes"].items()})

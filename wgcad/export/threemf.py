@@ -12,7 +12,7 @@ import numpy as np
 from wgcad.atomic import atomic_write
 from wgcad.errors import InputFileError
 
-__all__ = ["threemf_bytes", "write_3mf", "read_3mf"]
+__all__ = ["exploded", "threemf_bytes", "write_3mf", "read_3mf"]
 
 NS = "http://schemas.microsoft.com/3dmanufacturing/core/2015/02"
 CONTENT_TYPES = (
@@ -33,7 +33,21 @@ RELS = (
 ZIP_TIME = (1980, 1, 1, 0, 0, 0)
 
 
-def _model_xml(meshes: dict) -> str:
+def exploded(meshes: dict, gap_frac: float = 0.1) -> dict:
+    """Build-item offsets ``{name: (dx, dy, dz)}`` (mm) that set the parts side by side along +x, each on z = 0,
+    with a gap of ``gap_frac`` of the largest part (at least 5 mm): no two parts share space in a slicer, and each
+    object keeps its own coordinates (the offset is the item's transform, not a change of the mesh)."""
+    boxes = {n: np.array([np.min(m.vertices, axis=0), np.max(m.vertices, axis=0)]) for n, m in meshes.items()}
+    size = max(float(np.max(b[1] - b[0])) for b in boxes.values()) if boxes else 0.0
+    gap = max(5.0, gap_frac * size)
+    out, x = {}, 0.0
+    for n, b in boxes.items():
+        out[n] = (x - float(b[0, 0]), -0.5 * float(b[0, 1] + b[1, 1]), -float(b[0, 2]))
+        x += float(b[1, 0] - b[0, 0]) + gap
+    return out
+
+
+def _model_xml(meshes: dict, offsets: dict | None = None) -> str:
     out = [
         f'<?xml version="1.0" encoding="UTF-8"?>\n<model unit="millimeter" xml:lang="en-US" xmlns="{NS}">',
         '<metadata name="Application">wgcad</metadata>',
@@ -49,19 +63,25 @@ def _model_xml(meshes: dict) -> str:
         out.extend(f'<triangle v1="{a}" v2="{b}" v3="{c}"/>' for a, b, c in f.tolist())
         out.append("</triangles></mesh></object>")
     out.append("</resources><build>")
-    out.extend(f'<item objectid="{k}"/>' for k in range(1, len(meshes) + 1))
+    for k, name in enumerate(meshes, start=1):
+        if offsets and name in offsets:
+            dx, dy, dz = offsets[name]
+            out.append(f'<item objectid="{k}" transform="1 0 0 0 1 0 0 0 1 {dx!r} {dy!r} {dz!r}"/>')
+        else:
+            out.append(f'<item objectid="{k}"/>')
     out.append("</build></model>\n")
     return "\n".join(out)
 
 
-def threemf_bytes(meshes: dict) -> bytes:
-    """The 3MF package of named meshes ``{name: Mesh}`` (mm), one object and one build item each."""
+def threemf_bytes(meshes: dict, offsets: dict | None = None) -> bytes:
+    """The 3MF package of named meshes ``{name: Mesh}`` (mm), one object and one build item each; ``offsets``
+    (:func:`exploded`) moves each build item."""
     buf = io.BytesIO()
     with zipfile.ZipFile(buf, "w", zipfile.ZIP_DEFLATED) as z:
         for name, text in (
             ("[Content_Types].xml", CONTENT_TYPES),
             ("_rels/.rels", RELS),
-            ("3D/3dmodel.model", _model_xml(meshes)),
+            ("3D/3dmodel.model", _model_xml(meshes, offsets)),
         ):
             info = zipfile.ZipInfo(name, date_time=ZIP_TIME)
             info.compress_type = zipfile.ZIP_DEFLATED
@@ -69,9 +89,9 @@ def threemf_bytes(meshes: dict) -> bytes:
     return buf.getvalue()
 
 
-def write_3mf(path: str | os.PathLike, meshes: dict) -> None:
-    """Write named meshes to a 3MF file, atomically."""
-    atomic_write(path, threemf_bytes(meshes))
+def write_3mf(path: str | os.PathLike, meshes: dict, offsets: dict | None = None) -> None:
+    """Write named meshes to a 3MF file, atomically (``offsets``: see :func:`threemf_bytes`)."""
+    atomic_write(path, threemf_bytes(meshes, offsets))
 
 
 def read_3mf(path: str | os.PathLike) -> dict:
@@ -89,8 +109,15 @@ def read_3mf(path: str | os.PathLike) -> dict:
         raise InputFileError(f"{path}: not a readable 3MF file ({e})") from None
     q = f"{{{NS}}}"
     objects = {}
+    names = {}
     for obj in root.iter(q + "object"):
+        names[obj.get("id")] = obj.get("name") or obj.get("id")
         verts = np.array([[float(v.get(a)) for a in "xyz"] for v in obj.iter(q + "vertex")], dtype=np.float64)
         tris = np.array([[int(t.get(a)) for a in ("v1", "v2", "v3")] for t in obj.iter(q + "triangle")], dtype=np.int64)
         objects[obj.get("name") or obj.get("id")] = (verts.reshape(-1, 3), tris.reshape(-1, 3))
-    return {"unit": root.get("unit", "millimeter"), "objects": objects}
+    # each build item's translation (the last three numbers of its 3 x 4 transform; wgcad writes no rotation)
+    items = {}
+    for it in root.iter(q + "item"):
+        m = [float(x) for x in (it.get("transform") or "1 0 0 0 1 0 0 0 1 0 0 0").split()]
+        items[names.get(it.get("objectid"), it.get("objectid"))] = tuple(m[9:12])
+    return {"unit": root.get("unit", "millimeter"), "objects": objects, "items": items}
