@@ -52,11 +52,29 @@ def ke_png(title: str, res, orders, amp, expected: dict, intrinsic=None) -> byte
     low = {k: v for k, v in expected.items() if k != "mesh"}
     top = max(low.values()) * 1.6
     sel = (orders > 0) & (orders <= top)
-    ax[1 + 1].semilogy(orders[sel], np.maximum(amp[sel] * _AS, 1e-6), lw=0.8, color="k")
-    tr = ax[2].get_xaxis_transform()
-    for (name, o), c in zip(low.items(), ["tab:red", "tab:blue", "tab:red", "tab:blue"]):
-        ax[2].axvline(o, color=c, ls="--", lw=0.8, alpha=0.7)
-        ax[2].text(o, 0.97, f" {name} ({o:g})", rotation=90, va="top", fontsize=7, color=c, transform=tr)
+    a_sel = amp[sel] * _AS
+    a_max = float(a_sel.max()) if a_sel.size else 1.0
+    # four decades below the strongest order: what lies under that is noise of the sampling, not of the drive
+    # (issue 23: the axis ran over 8 decades down to a clamp at 1e-6)
+    floor = 1e-4 * a_max
+    ax[2].semilogy(orders[sel], np.maximum(a_sel, floor), lw=0.8, color="k", label="amplitude")
+    ax[2].set_ylim(floor, 2.0 * a_max)
+    # the expected orders in the legend, one entry per gear, not as text at the lines (close orders, e.g. the
+    # rigid gear's 100 and the flexspline's 101, printed over each other)
+    groups = {}
+    for name, o in low.items():
+        groups.setdefault("rigid" if name.startswith("rigid") else "flexspline", []).append(o)
+    for (gear, os_), c in zip(sorted(groups.items()), ["tab:blue", "tab:red"]):
+        for i, o in enumerate(os_):
+            ax[2].axvline(
+                o,
+                color=c,
+                ls="--",
+                lw=0.8,
+                alpha=0.7,
+                label=f"{gear} orders: {', '.join(f'{x:g}' for x in os_)}" if i == 0 else None,
+            )
+    ax[2].legend(fontsize=8, loc="upper right")
     label = "order, cycles per flexspline revolution"
     if "mesh" in expected:
         mo = expected["mesh"]
@@ -97,34 +115,50 @@ _ENGAGEMENT_NAMES = {
 
 
 def flank_png(title: str, turns, errors: dict, zones=("major axis", "second wave")) -> bytes:
-    """[S2]'s radial and tangential mesh errors (um) of both engagement types over generator turns, per zone.
+    """[S2]'s radial and tangential mesh errors (um) of both engagement types, per zone: the first two generator
+    turns in detail (left) and, over the whole error cycle, half the peak-to-peak of each turn (right).
 
     ``errors``: ``{(zone index, engagement): FlankErrors}`` with arrays over ``turns``
-    (:func:`wgcad.accuracy.drive_flank_errors`). The whole error cycle is drawn so that the beat of the
-    rigid gear's order against the flexspline's shows.
+    (:func:`wgcad.accuracy.drive_flank_errors`). The errors turn once or twice per generator turn: drawn raw over
+    the whole cycle (100 turns on D2) the six curves filled one band (issue 23); per turn, the beat of the rigid
+    gear's order against the flexspline's shows as the amplitude's slow swell.
     """
     plt = _plt()
-    fig, ax = plt.subplots(2, 1, figsize=(12, 7.5), dpi=110, sharex=True)
+    fig, ax = plt.subplots(2, 2, figsize=(13, 8.2), dpi=110, sharex="col", gridspec_kw={"width_ratios": [1, 2]})
     styles = {
         "double": dict(lw=1.1, color="k"),
-        "single_left": dict(lw=0.7, color="tab:red", alpha=0.8),
-        "single_right": dict(lw=0.7, color="tab:blue", alpha=0.8),
+        "single_left": dict(lw=0.9, color="tab:red", alpha=0.85),
+        "single_right": dict(lw=0.9, color="tab:blue", alpha=0.85),
     }
+    turns = np.asarray(turns, dtype=float)
+    detail = turns <= turns[0] + 2.0
+    whole = np.floor(turns - turns[0]).astype(int)
+    n_turns = int(whole.max()) if len(whole) else 0
     for (zi, eng), fe in errors.items():
         st = dict(styles[eng])
         if zi:
             st.update(ls="--")
         lab = f"{_ENGAGEMENT_NAMES[eng]}, {zones[zi]}"
-        ax[0].plot(turns, 1e3 * fe.dR, label=lab, **st)
-        ax[1].plot(turns, 1e3 * fe.dT, label=lab, **st)
-    ax[0].set_ylabel("radial mesh error dR, um")
-    ax[1].set_ylabel("tangential mesh error dT, um")
-    ax[1].set_xlabel("generator turns (the whole error cycle)")
-    for a in ax:
+        for row, val in ((0, 1e3 * np.asarray(fe.dR)), (1, 1e3 * np.asarray(fe.dT))):
+            ax[row, 0].plot(turns[detail], val[detail], label=lab if row == 0 else None, **st)
+            if n_turns >= 1:
+                k = np.arange(n_turns)
+                half_pp = np.array(
+                    [0.5 * (val[whole == i].max() - val[whole == i].min()) if np.any(whole == i) else np.nan for i in k]
+                )
+                ax[row, 1].plot(k + 0.5, half_pp, **st)
+    ax[0, 0].set_ylabel("radial mesh error dR, um")
+    ax[1, 0].set_ylabel("tangential mesh error dT, um")
+    ax[1, 0].set_xlabel("generator turns (the first two)")
+    ax[0, 1].set_ylabel("dR: half the peak-to-peak of each turn, um")
+    ax[1, 1].set_ylabel("dT: half the peak-to-peak of each turn, um")
+    ax[1, 1].set_xlabel("generator turns (the whole error cycle)")
+    for a in ax.ravel():
         a.grid(alpha=0.3)
-    ax[0].legend(fontsize=8, loc="upper left", bbox_to_anchor=(1.01, 1.0), borderaxespad=0.0)
+    fig.legend(fontsize=8, loc="lower center", ncol=3, frameon=False)
     fig.suptitle(title)
-    return _png(fig, plt)
+    fig.tight_layout(rect=(0, 0.09, 1, 0.96))
+    return png_bytes(fig)  # laid out above, with room for the legend below the panels
 
 
 def ke_load_png(title: str, res, loaded: list) -> bytes:
