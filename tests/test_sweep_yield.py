@@ -156,3 +156,25 @@ def test_samples_outside_the_ke_model_fail_with_the_reason_and_leave_the_yield(t
     assert "0 computed" in out and "2 failed in a model" in out
     assert "KE outside the linear error model" in out
     assert "YIELD not defined" in out and "YIELD 1" not in out and "YIELD 9" not in out
+
+
+def test_design_study_is_a_table_not_a_distribution(tmp_path):
+    # issue 23: the design study printed mean, sd, percentiles and a 54-100 % interval of six designs on a grid,
+    # and drew histograms of them; a grid prints one row per design and draws the surface only
+    from conftest import TEMPLATES
+
+    from wgcad.export.sweep_figures import sweep_pngs
+    from wgcad.sweep.spec import load_spec
+    from wgcad.sweep.summary import format_summary
+
+    spec = load_spec(TEMPLATES / "sweeps" / "d1_design_study.toml")
+    run_sweep(spec, tmp_path, workers=0)
+    pl = spec.payload()
+    cols = Store(tmp_path, pl["fingerprint"], columns_of(pl), spec.total).read()
+    summ = summarize(spec, cols)
+    assert summ["kind"] == "grid"
+    text = format_summary(summ)
+    assert "grid of 6 designs" in text and "mean" not in text and "interval" not in text, text
+    rows = [line for line in text.splitlines() if line.startswith("    ") and ("yes" in line or "NO" in line)]
+    assert len(rows) == 6
+    assert set(sweep_pngs(spec, cols, summ)) == {"sweep_surface.png"}

@@ -164,12 +164,13 @@ def surface_png(spec, summ: dict) -> bytes:
         yv = np.asarray([np.nan if y["fraction"] is None else 100 * y["fraction"] for y in g["yield"]], float).reshape(
             shape
         )
-        items.append(("yield %", yv, yv, yv))
+        # one draw per point (a design study): a point meets the limits or not, no yield to speak of
+        items.append(("meets the limits (100: yes)" if summ.get("kind") == "grid" else "yield %", yv, yv, yv))
     for k, (f, mean, lo, hi) in enumerate(items):
         ax = axes[k // ncol][k % ncol]
         if len(shape) == 1:
             xs = np.arange(shape[0]) if text_axis[0] else np.asarray(values[0], float)
-            if f == "yield %":
+            if f == "yield %" or f.startswith("meets the limits"):
                 ci = np.asarray([y["ci"] for y in g["yield"]], float) * 100.0
                 ax.errorbar(
                     xs,
@@ -183,7 +184,9 @@ def surface_png(spec, summ: dict) -> bytes:
                 ax.set_ylim(-3, 103)
             else:
                 ax.plot(xs, mean, "o-", color="k", label="mean over the draws")
-            if f != "yield %" and np.any(hi > lo):
+            if f == items[-1][0] and g["yield"]:
+                pass
+            elif np.any(hi > lo):
                 ax.fill_between(xs, lo, hi, color="0.8", label="range over the draws")
             if text_axis[0]:
                 ax.set_xticks(xs, values[0], fontsize=8)
@@ -196,7 +199,7 @@ def surface_png(spec, summ: dict) -> bytes:
             m = mean.reshape(shape[0], shape[1], -1)
             with np.errstate(invalid="ignore"):
                 m = np.nanmean(m, axis=2) if m.shape[2] > 1 else m[:, :, 0]
-            is_yield = f == "yield %"
+            is_yield = f == "yield %" or f.startswith("meets the limits")
             im = ax.imshow(
                 m.T,
                 origin="lower",
@@ -237,7 +240,8 @@ def surface_png(spec, summ: dict) -> bytes:
 
 def sweep_pngs(spec, cols: dict, summ: dict) -> dict:
     """``{file name: PNG bytes}``: histograms, and sensitivity (random parameters) and surfaces (grids) where they apply."""
-    out = {"sweep_histograms.png": histograms_png(spec, cols, summ)}
+    # a grid of designs is a table and a surface, not a distribution: no histograms of it (issue 23)
+    out = {} if summ.get("kind") == "grid" else {"sweep_histograms.png": histograms_png(spec, cols, summ)}
     if summ["sensitivity"]:
         out["sweep_sensitivity.png"] = sensitivity_png(spec, cols, summ)
     if summ["grid"] is not None:

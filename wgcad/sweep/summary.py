@@ -144,6 +144,12 @@ def _summarize(spec, cols: dict, conf: float) -> dict:
         "sensitivity": [],
         "grid": None,
         "confidence": conf,
+        # a grid of designs is a table, not a distribution: no mean, spread or yield interval over its points
+        "kind": (
+            "grid"
+            if not any(p.random for p in spec.parameters)
+            else ("monte carlo" if all(p.random for p in spec.parameters) else "grid with random draws")
+        ),
     }
     fail = None
     if spec.limits:
@@ -264,6 +270,10 @@ def format_summary(s: dict, info=None) -> str:
         )
     for r in s["reasons"][:4]:
         lines.append(f"  not computed ({r['samples']}): {r['reason']}")
+    if s.get("kind") == "grid" and s["grid"] is not None:
+        # a design study: every grid point as a row (issue 23: it printed mean, sd, percentiles and a 54-100 %
+        # "confidence interval" of six designs chosen on a grid)
+        return "\n".join(lines + _grid_table(s))
     for f, st in s["figures"].items():
         if st.get("n"):
             lines.append(
@@ -305,3 +315,32 @@ def format_summary(s: dict, info=None) -> str:
                 + ", ".join(f"{r['parameter']} {r['failure']:+.2f}" for r in top)
             )
     return "\n".join(lines)
+
+
+def _grid_table(s: dict) -> list[str]:
+    """The grid points of a design study, one row each: the parameters, every recorded figure, and the verdict."""
+    import itertools
+
+    g = s["grid"]
+    names, values, shape = g["parameters"], g["values"], tuple(g["shape"])
+    figs = list(g["surfaces"])
+    head = [*names, *figs] + (["meets the limits"] if g["yield"] else [])
+    rows = []
+    for flat, combo in enumerate(itertools.product(*[range(n) for n in shape])):
+        row = [f"{values[i][j]:g}" if not isinstance(values[i][j], str) else values[i][j] for i, j in enumerate(combo)]
+        for f in figs:
+            v = np.asarray(g["surfaces"][f]["mean"], dtype=object).reshape(shape)[combo]
+            row.append(_fmt(None if v is None else float(v), 4))
+        if g["yield"]:
+            y = g["yield"][flat]
+            row.append("-" if not y["of"] else ("yes" if y["pass"] == y["of"] else "NO"))
+        rows.append(row)
+    width = [max(len(h), *(len(r[k]) for r in rows)) for k, h in enumerate(head)]
+    out = [f"  grid of {len(rows)} designs (one sample each):"]
+    out.append("    " + "  ".join(h.rjust(w) for h, w in zip(head, width)))
+    out += ["    " + "  ".join(c.rjust(w) for c, w in zip(r, width)) for r in rows]
+    if g["yield"]:
+        good = sum(1 for y in g["yield"] if y["of"] and y["pass"] == y["of"])
+        lims = ", ".join(k for k in s["limits"])
+        out.append(f"  {good} of {len(rows)} designs meet the limits ({lims})")
+    return out
