@@ -5,6 +5,7 @@ import shutil
 import subprocess
 import sys
 
+import ezdxf
 import numpy as np
 import pytest
 import shapely
@@ -344,3 +345,33 @@ def test_parts_3mf_places_every_part_apart(small_run):
     # each object keeps its own coordinates (the gear axis at x = y = 0); the placement is the item's
     for name, v in verts.values():
         assert np.allclose(0.5 * (v.min(axis=0) + v.max(axis=0))[:2], 0.0, atol=1e-6), name
+
+
+@pytest.mark.parametrize("name", ["d1_involute", "d3_external"])
+def test_plug_drawing_is_arcs_with_its_data_and_a_construction_neutral_line(name, tmp_path):
+    # issue 23, item 4: the plug (generator ring) outline was 1440 straight segments where the README promises
+    # arcs, the neutral line a polyline on a cuttable layer, and no data block. Read back with ezdxf: the outline
+    # is tangent arcs within the chord tolerance of the exact outline (measured against it, 20,000 points), the
+    # neutral line on a non-plotting CENTER layer, the data block names law, W0, diameters and bearing
+    from wgcad.export.arcs import _dist_to_segments
+    from wgcad.export.parts.bodies import plug_outline
+
+    path = TEMPLATES / f"{name}.toml"
+    assert main(["parts", str(path), "--out", str(tmp_path), "--format", "dxf", "--quiet"]) == 0
+    part = "generator_ring" if name == "d3_external" else "plug"
+    doc = ezdxf.readfile(tmp_path / f"{name}_{part}.dxf")
+    assert not doc.audit().errors
+    layer = part.upper()
+    lw = [e for e in doc.modelspace().query("LWPOLYLINE") if e.dxf.layer == layer]
+    pts = np.array([(p[0], p[1], p[4]) for p in lw[0].get_points()])
+    v, b = pts[:, :2], pts[:, 2]
+    assert len(v) < 200 and np.count_nonzero(b) == len(b)  # arcs, not 1440 segments
+    drive = build_drive(load_design(path))
+    exact = plug_outline(drive, part_sizes(load_parts(path), drive), 20000)["outline"]
+    assert _dist_to_segments(exact, v, np.roll(v, -1, axis=0), b).max() <= drive.tol
+    neutral = doc.layers.get("NEUTRAL_LINE")
+    assert neutral.dxf.linetype == "CENTER" and neutral.dxf.plot == 0
+    assert doc.layers.get(layer).dxf.plot == 1
+    text = " ".join(t.dxf.text for t in doc.modelspace().query("TEXT"))
+    for word in ("law:", "W0 =", "major diameter", "minor diameter", "bearing:"):
+        assert word in text, word

@@ -27,6 +27,8 @@ __all__ = [
     "bulge_centres",
     "segment_tangents",
     "path_area",
+    "CurvePiece",
+    "fit_closed_curve",
 ]
 
 #: Curve points checked per biarc while fitting (the curve->arc distance).
@@ -404,3 +406,32 @@ def path_area(path_or_vertices, bulges=None) -> float:
         r = np.where(b != 0, c / (2.0 * np.abs(np.sin(theta / 2.0))), 0.0)
     seg = 0.5 * r * r * (theta - np.sin(theta))
     return shoelace + float(np.sum(np.where(b != 0, seg, 0.0)))
+
+
+class CurvePiece:
+    """A smooth curve given by a vectorised function ``f(t) -> (n, 2)`` on ``[t0, t1]``, as a piece :func:`fit_pieces`
+    takes: the derivatives by central differences of step ``h`` (the fit checks its arcs against ``f`` itself, so
+    the derivatives only steer where the arcs go)."""
+
+    kind = "curve"
+
+    def __init__(self, f, t0: float, t1: float, h: float = 1e-6):
+        self.f, self.t0, self.t1, self.h = f, float(t0), float(t1), float(h)
+
+    def point(self, t):
+        return self.f(np.asarray(t, dtype=float))
+
+    def deriv(self, t):
+        t = np.asarray(t, dtype=float)
+        return (self.f(t + self.h) - self.f(t - self.h)) / (2.0 * self.h)
+
+    def deriv2(self, t):
+        t = np.asarray(t, dtype=float)
+        return (self.f(t + self.h) - 2.0 * self.f(t) + self.f(t - self.h)) / (self.h * self.h)
+
+
+def fit_closed_curve(f, tol: float, period: float = 2.0 * np.pi, pieces: int = 8) -> ArcPath:
+    """Tangent arcs within ``tol`` of a smooth closed curve ``f(t)``, ``t`` in ``[0, period)`` (e.g. a wave-generator
+    plug's outline against its angle), as ``pieces`` pieces joined end to end."""
+    edges = np.linspace(0.0, period, pieces + 1)
+    return fit_pieces([CurvePiece(f, a, b) for a, b in zip(edges[:-1], edges[1:])], tol)

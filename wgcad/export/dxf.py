@@ -68,6 +68,10 @@ class DxfLayer:
         also works). Written as LWPOLYLINE with bulges.
     texts : tuple of (x, y, height, str)
         Single-line texts (lower-left corner, character height, mm).
+    construction : bool
+        Construction geometry, not to be cut: the layer gets the CENTER
+        linetype and is marked not to plot (a CAM program takes its cutting
+        contours from the other layers).
     """
 
     name: str
@@ -76,6 +80,7 @@ class DxfLayer:
     color: int = 7
     paths: tuple = field(default=())
     texts: tuple = field(default=())
+    construction: bool = False
 
     def __post_init__(self):
         if not isinstance(self.name, str) or not is_valid_layer_name(self.name):
@@ -160,6 +165,13 @@ def build_dxf(layers):
             doc.layers.add(layer.name, color=layer.color)
         else:
             doc.layers.get(layer.name).color = layer.color
+        if layer.construction:
+            if "CENTER" not in doc.linetypes:
+                # ISO-style centre line: long dash, gap, short dash, gap (mm)
+                doc.linetypes.add("CENTER", pattern=[20.0, 12.0, -3.0, 2.0, -3.0], description="Center ____ _ ____ _")
+            lay = doc.layers.get(layer.name)
+            lay.dxf.linetype = "CENTER"
+            lay.dxf.plot = 0  # construction: not plotted, not a contour to cut
         attribs = {"layer": layer.name}
         for k, outline in enumerate(layer.outlines):
             try:

@@ -63,7 +63,12 @@ def svg_text(layers, title: str) -> str:
     ]
     for layer in layers:
         col = ACI.get(layer.color, "#000000")
-        out.append(f'<g id="{escape(layer.name)}" fill="none" stroke="{col}" stroke-width="{_f(stroke)}">')
+        dash = (
+            f' stroke-dasharray="{_f(8 * stroke)} {_f(3 * stroke)} {_f(stroke)} {_f(3 * stroke)}"'
+            if layer.construction
+            else ""
+        )
+        out.append(f'<g id="{escape(layer.name)}" fill="none" stroke="{col}" stroke-width="{_f(stroke)}"{dash}>')
         out += [f'<path d="{_poly(o, flip)}"/>' for o in layer.outlines]
         out += [f'<path d="{_path(v, b, flip)}"/>' for v, b in layer.paths]
         out += [f'<circle cx="{_f(cx)}" cy="{_f(flip(cy))}" r="{_f(r)}"/>' for cx, cy, r in layer.circles]

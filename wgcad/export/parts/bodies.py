@@ -149,6 +149,36 @@ def plug_outline(drive, sizes, n: int | None = None) -> dict:
     return {"outline": outline, "neutral": neutral, "offset_mm": off, "z_mm": z_g, "phi": ph}
 
 
+def _plug_arcs(drive, po: dict, tol: float):
+    """The plug's (generator ring's) outline as tangent arcs within ``tol`` (issue 23: 1440 straight segments in the
+    DXF where the README promised arcs): the same offset of the law's neutral line, fitted against the law itself."""
+    from wgcad.export.arcs import fit_closed_curve
+    from wgcad.placement import deformed_curve
+
+    law = drive.law_at(po["z_mm"]) if drive.coned else drive.law
+    return fit_closed_curve(lambda t: deformed_curve(law, drive.r_m, po["offset_mm"], t), tol)
+
+
+def _plug_data(drive, sizes, info: dict, what: str, radii, tol: float) -> DxfLayer:
+    """The plug's data block: what a shop needs to make and check it (law, W0, diameters, the bearing it carries)."""
+    d = drive.design
+    z_g = info["generator_section_z_mm"]
+    w0 = (drive.law_at(z_g) if drive.coned else drive.law).w0  # the law of the section the plug sits at
+    r = float(np.max(radii))
+    h = max(0.5, round(0.02 * 2 * r, 1))
+    lines = [
+        f"{what.upper()} DATA",
+        f"{d.drive.name}",
+        f"law: {d.generator.law}, W0 = {w0:.4f} mm at the generator section z = {z_g:g} mm",
+        f"major diameter = {info['plug_major_diameter_mm']:.4f} mm, minor diameter = {info['plug_minor_diameter_mm']:.4f} mm",
+        f"bearing: ring section {sizes.bearing_thickness:g} mm, width {sizes.bearing_width:g} mm",
+        f"seat {info['seat_offset_from_neutral_mm']:+.4f} mm from the neutral line (CENTER line, not cut)",
+        f"outline: tangent arcs within {tol * 1e3:g} um of the exact curve",
+    ]
+    texts = tuple((1.15 * r, r - 1.6 * h * k, h, line) for k, line in enumerate(lines))
+    return DxfLayer(f"{what.upper().replace(' ', '_')}_DATA", texts=texts, color=7)
+
+
 def _min_curvature_radius(pts: np.ndarray) -> float:
     """Smallest radius of the circle through three consecutive vertices of a closed polygon, mm."""
     a, b, c = np.roll(pts, 1, axis=0), pts, np.roll(pts, -1, axis=0)
@@ -207,9 +237,10 @@ def plug(drive, sizes, tol: float) -> Part:
         vol = (area - PI * r_b**2) * width
         info["plug_bore_diameter_mm"] = bore_d
         layers = [
-            DxfLayer("PLUG", outlines=(outline,), color=2),
+            DxfLayer("PLUG", paths=(_plug_arcs(drive, po, tol),), color=2),
             DxfLayer("PLUG_BORE", circles=((0.0, 0.0, r_b),), color=2),
-            DxfLayer("NEUTRAL_LINE", outlines=(po["neutral"],), color=3),
+            DxfLayer("NEUTRAL_LINE", outlines=(po["neutral"],), color=3, construction=True),
+            _plug_data(drive, sizes, info, "plug", radii, tol),
         ]
         name = "plug"
 
@@ -225,8 +256,9 @@ def plug(drive, sizes, tol: float) -> Part:
         vol = (PI * R_out**2 - area) * width
         info["ring_outer_diameter_mm"] = 2 * R_out
         layers = [
-            DxfLayer("GENERATOR_RING", outlines=(outline,), circles=((0.0, 0.0, R_out),), color=2),
-            DxfLayer("NEUTRAL_LINE", outlines=(po["neutral"],), color=3),
+            DxfLayer("GENERATOR_RING", paths=(_plug_arcs(drive, po, tol),), circles=((0.0, 0.0, R_out),), color=2),
+            DxfLayer("NEUTRAL_LINE", outlines=(po["neutral"],), color=3, construction=True),
+            _plug_data(drive, sizes, info, "generator ring", radii, tol),
         ]
         name = "generator_ring"
 
