@@ -375,3 +375,29 @@ def test_plug_drawing_is_arcs_with_its_data_and_a_construction_neutral_line(name
     text = " ".join(t.dxf.text for t in doc.modelspace().query("TEXT"))
     for word in ("law:", "W0 =", "major diameter", "minor diameter", "bearing:"):
         assert word in text, word
+
+
+def test_sectored_design_gets_its_sectored_rigid_gear():
+    # issue 23, item 1: parts on templates/d4_sectored.toml wrote the plain 88-tooth rigid gear without a word
+    from wgcad.export.step import solid_props
+    from wgcad.sector.run import run_sector
+
+    path = TEMPLATES / "d4_sectored.toml"
+    drive = build_drive(load_design(path))
+    rigid = build_parts(drive, part_sizes(load_parts(path), drive))[2]
+    sec = run_sector(drive.design, audits=False)
+    assert "sectored" in rigid.info["kind"]
+    data = rigid.info["gear_data"]
+    assert data["sectors"]["teeth"] == sec["layout"].n_teeth == 86
+    assert data["sectors"]["tooth_heights_mm"] == [round(float(h), 6) for h in sec["built"]]
+    assert data["span"] is None and data["pins"] is None  # the plain gear's checks are not this gear's
+    text = " ".join(t[3] for layer in rigid.layers for t in layer.texts)
+    assert "SECTORED: 86 teeth" in text and "lowered teeth" in text and "teeth z = 88" not in text
+    outline = [layer for layer in rigid.layers if layer.name == "RIGID"][0].outlines[0]
+    np.testing.assert_array_equal(outline, sec["outline"])
+    # mesh and STEP solid of the sectored outline: the volume its 2D areas give
+    mesh = rigid.mesh()
+    # (the mesh's flange and rim circles are inscribed polygons at the chord tolerance: 1e-4 relative covers them)
+    assert mesh.is_volume and mesh.volume == pytest.approx(rigid.volume_mm3, rel=1e-4)
+    pr = solid_props(rigid.solid())
+    assert pr["valid"] and pr["volume"] == pytest.approx(rigid.volume_mm3, rel=1e-9)

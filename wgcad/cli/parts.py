@@ -139,6 +139,9 @@ def cmd_parts(args) -> int:
         print(json.dumps(report, allow_nan=False, indent=2))
     elif not args.quiet:
         print(f"{design.drive.name}: {len(parts)} parts ({', '.join(p.name for p in parts)})")
+        for p in parts:
+            if "kind" in p.info:
+                print(f"  {p.name}: {p.info['kind']}")
         for k in sizes.derived:
             print(f"  {k} = {sizes.values[k]:g} (derived from the gear size; set [parts].{k} to change)")
         print(f"\n  wrote {len(files) + 1} files to {out}/ in {time.perf_counter() - t0:.2f} s")

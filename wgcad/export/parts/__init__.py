@@ -35,10 +35,17 @@ def build_parts(drive, sizes, style: str = "arcs", tol: float | None = None, gen
     from . import assembly, bodies
 
     tol = drive.tol if tol is None else tol
+    sectored = None
+    if drive.design.sectors.active:
+        # a sectored design's rigid gear is the sectored one, teeth at the heights the design builds (issue 23:
+        # the part set wrote the plain gear of z_rigid teeth without a word)
+        from wgcad.sector.run import run_sector
+
+        sectored = run_sector(drive.design, audits=False)
     out = [
         bodies.flexspline(drive, sizes, style, tol),
         bodies.plug(drive, sizes, tol),
-        bodies.rigid(drive, sizes, style, tol),
+        bodies.rigid(drive, sizes, style, tol, sectored=sectored),
     ]
     for deg in generator_angles_deg:
         out.append(assembly.deformed_assembly(drive, sizes, deg, tol))

@@ -10,6 +10,7 @@ from wgcad.errors import DesignError
 from wgcad.export.arcs import fit_gear, path_area
 from wgcad.export.dxf import DxfLayer
 from wgcad.export.gear_data import data_lines, gear_data
+from wgcad.plane import signed_area
 
 from .part import Part
 from .solids import bolt_circle, circle_points, holes_m, n_segments, prism_m, revolve_m, to_mesh
@@ -19,10 +20,34 @@ __all__ = ["flexspline", "plug", "rigid", "plug_outline", "data_layer"]
 PI = math.pi
 
 
-def data_layer(name: str, gear, tol: float, x: float, y: float, height: float) -> tuple:
-    """The GEAR_DATA text layer (one TEXT per line, top line at ``y``) and the data dict."""
+def data_layer(name: str, gear, tol: float, x: float, y: float, height: float, sectored: dict | None = None) -> tuple:
+    """The GEAR_DATA text layer (one TEXT per line, top line at ``y``) and the data dict (with ``sectored``: the
+    sectors and every tooth's height, which the lines summarise per sector)."""
     data = gear_data(gear, tol)
     lines = data_lines(name, data)
+    if sectored is not None:
+        lay, built, full = sectored["layout"], np.asarray(sectored["built"], float), float(sectored["full"])
+        kind_of = [str(lay.kinds[int(s)]) for s in lay.sector]  # each tooth's sector kind
+        data["sectors"] = {
+            "teeth": int(lay.n_teeth),
+            "heights_mode": sectored["mode"],
+            "full_height_mm": full,
+            "tooth_heights_mm": [round(float(h), 6) for h in built],
+            "tooth_sector_kinds": kind_of,
+        }
+        # the plain gear's tooth count and its span or pin dimension are not this gear's: its teeth have other
+        # heights and pitches by sector (a pin dimension over lowered teeth checks nothing)
+        skip = ("teeth z =", "span ", "  k:", "dimension ", "  pin:", "span / pins")
+        lines = [line for line in lines if not line.startswith(skip)]
+        data["span"] = data["pins"] = None
+        lines.insert(-1, "span / pins: not given for a sectored gear (tooth heights differ by sector)")
+        lines.insert(1, f"base gear: z = {gear.spec.z} ({data['form']}), module and flanks as below")
+        lines.insert(2, f"SECTORED: {lay.n_teeth} teeth in sectors ({sectored['mode']} heights; full {full:.4f} mm)")
+        lowered = np.nonzero(built < full - 1e-6)[0]
+        lines.insert(3, f"lowered teeth: {len(lowered)} of {lay.n_teeth} (every height in the part set's JSON)")
+        for kind in dict.fromkeys(kind_of):
+            sel = np.array([k == kind for k in kind_of])
+            lines.insert(4, f"  {kind} teeth: heights {built[sel].min():.4f} .. {built[sel].max():.4f} mm")
     texts = tuple((x, y - 1.6 * height * k, height, line) for k, line in enumerate(lines))
     return DxfLayer("GEAR_DATA", texts=texts, color=7), data, lines
 
@@ -275,15 +300,39 @@ def plug(drive, sizes, tol: float) -> Part:
     return Part(name, layers, solid, mesh, vol, ((-rmax, -rmax, z0), (rmax, rmax, z1)), info)
 
 
-def rigid(drive, sizes, style: str, tol: float) -> Part:
-    """The rigid gear: internal teeth in a ring with a bolted mounting flange (internal deformation) or external teeth on a bolted hub."""
+def rigid(drive, sizes, style: str, tol: float, sectored: dict | None = None) -> Part:
+    """The rigid gear: internal teeth in a ring with a bolted mounting flange (internal deformation) or external teeth on a bolted hub.
+
+    ``sectored`` (:func:`wgcad.sector.run.run_sector` with ``audits=False``):
+    the sectored rigid gear of a design with ``[sectors]``, its teeth at the
+    heights built, its outline the symmetric chord band of its curves.
+    """
     from wgcad.export import step as S
 
     g = drive.rigid
     bw = drive.design.drive.face_width
-    path = fit_gear(g, tol)
-    band = _band(g)
-    area = abs(path_area(path))
+    if sectored is None:
+        path = fit_gear(g, tol)
+        band = _band(g)
+        area = abs(path_area(path))
+
+        def teeth_wire():
+            return S.wire_from_path(path.vertices, path.bulges)
+
+        def teeth_layer():
+            return _teeth_layer("RIGID", g, path, style, 1, band)
+    else:
+        if drive.external:
+            raise DesignError("sectors", "a sectored rigid gear is built for internal deformation only")
+        band = np.asarray(sectored["outline"], dtype=float)
+        area = abs(signed_area(band))
+
+        def teeth_wire():
+            return S.wire_from_polygon(band)
+
+        def teeth_layer():
+            return DxfLayer("RIGID", outlines=(band,), color=1)
+
     R = drive.rigid_rim_radius
     dh = sizes.flange_bolt_hole_diameter
     holes = bolt_circle(
@@ -301,22 +350,23 @@ def rigid(drive, sizes, style: str, tol: float) -> Part:
         Rf = 0.5 * sizes.flange_outer_diameter
         tip_r = Rf
         vol = (PI * R * R - area) * (bw - tf) + (PI * Rf * Rf - area - hole_area) * tf
-        gl, data, _ = data_layer("rigid", g, tol, 1.15 * Rf, Rf, max(0.5, round(0.02 * 2 * R, 1)))
+        gl, data, _ = data_layer("rigid", g, tol, 1.15 * Rf, Rf, max(0.5, round(0.02 * 2 * R, 1)), sectored=sectored)
         layers = [
-            _teeth_layer("RIGID", g, path, style, 1, band),
+            teeth_layer(),
             DxfLayer("RIGID_OUTER", circles=((0.0, 0.0, R),), color=1),
             DxfLayer("FLANGE", circles=((0.0, 0.0, Rf),), color=1),
             DxfLayer("FLANGE_BOLT_HOLES", circles=hole_circles, color=3),
             gl,
         ]
-        info.update(
-            {"kind": "rigid gear with mounting flange", "flange_outer_diameter_mm": 2 * Rf, "flange_thickness_mm": tf}
-        )
+        kind = "rigid gear with mounting flange"
+        if sectored is not None:
+            kind = f"sectored rigid gear with mounting flange ({sectored['mode']} tooth heights)"
+        info.update({"kind": kind, "flange_outer_diameter_mm": 2 * Rf, "flange_thickness_mm": tf})
 
         def solid():
             # the whole gear at flange size, then the flange's excess cut away below it: a fuse of two
             # prisms would share every tooth face (coincident faces are the slow case of OCCT booleans)
-            teeth = S.wire_from_path(path.vertices, path.bulges)
+            teeth = teeth_wire()
             body = S.prism(S.circle_wire(Rf), [teeth] + [S.circle_wire(0.5 * h, x, y) for x, y, h in holes], bw)
             if tf >= bw:
                 return body
@@ -334,7 +384,7 @@ def rigid(drive, sizes, style: str, tol: float) -> Part:
         vol = (area - PI * R * R - hole_area) * bw
         gl, data, _ = data_layer("rigid", g, tol, 1.15 * tip_r, tip_r, max(0.5, round(0.02 * 2 * tip_r, 1)))
         layers = [
-            _teeth_layer("RIGID", g, path, style, 1, band),
+            teeth_layer(),
             DxfLayer("RIGID_BORE", circles=((0.0, 0.0, R),), color=1),
             DxfLayer("BOLT_HOLES", circles=hole_circles, color=3),
             gl,
