@@ -85,8 +85,11 @@ def cmd_parts(args) -> int:
         "chord_tol_mm": tol,
         "dxf_style": args.dxf_style,
         "formats": fmts,
-        "sizes_mm": _jsonable(sizes.values),
+        # only the sizes of parts this drive has (an external drive has no cup and no flange)
+        "sizes_mm": _jsonable({k: sizes.values[k] for k in sizes.used if sizes.values.get(k) is not None}),
         "derived_from_gear_size": list(sizes.derived),
+        "size_rules": dict(sizes.rules),
+        "warnings": list(sizes.notes),
         "parts": {},
     }
     with atomic_batch() as batch:
@@ -142,8 +145,20 @@ def cmd_parts(args) -> int:
         for p in parts:
             if "kind" in p.info:
                 print(f"  {p.name}: {p.info['kind']}")
-        for k in sizes.derived:
-            print(f"  {k} = {sizes.values[k]:g} (derived from the gear size; set [parts].{k} to change)")
+        if sizes.derived:
+            print("  derived sizes (set them in [parts] to change them):")
+            print("    " + ", ".join(f"{k} = {sizes.values[k]:g}" for k in sizes.derived))
+        by_rule = {}
+        for k, rule in sizes.rules.items():
+            by_rule.setdefault(rule, []).append(k.split("_")[0])
+        for rule, keys in by_rule.items():
+            print(f"  {' and '.join(dict.fromkeys(keys))} bolts: {rule}")
+        if any(r[:1].isdigit() for r in sizes.rules.values()):
+            from ..design.bolting import RULE
+
+            print(f"    ({RULE})")
+        for n in sizes.notes:
+            print(f"  WARNING: {n}")
         print(f"\n  wrote {len(files) + 1} files to {out}/ in {time.perf_counter() - t0:.2f} s")
     return EXIT_OK
 

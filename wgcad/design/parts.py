@@ -63,10 +63,14 @@ PARTS_DOC = {
 
 @dataclass(frozen=True)
 class PartSizes:
-    """The resolved sizes (mm): every field of :class:`PartsSpec` with a value, and which were derived."""
+    """The resolved sizes (mm): every field of :class:`PartsSpec` with a value, which were derived, the rule each
+    derived size follows, the keys the drive's parts use, and warnings on given sizes that break a rule."""
 
     values: dict
     derived: tuple
+    rules: dict = None
+    used: tuple = ()
+    notes: tuple = ()
 
     def __getattr__(self, name):
         try:
@@ -154,6 +158,18 @@ def part_sizes(spec: PartsSpec, drive) -> PartSizes:
     default("shell_thickness", _r(0.7 * h1, 0.05))
     default("diaphragm_thickness", _r(1.5 * v["shell_thickness"], 0.05))
     default("hub_bore_diameter", _r(0.5 * r_in))
+    from .bolting import RULE, carry, choose_bolts
+
+    torque = d.load.rated_torque_nm
+    rules = {}
+    notes = []
+    cup_keys = ("cup_bolt_circle_diameter", "cup_bolt_count", "cup_bolt_hole_diameter")
+    if not ext and torque and all(v[k] is None for k in cup_keys):
+        # the cup's bolts carry the output torque into the output shaft (wgcad.design.bolting)
+        c = choose_bolts(torque, 0.5 * v["hub_bore_diameter"], r_in, "cup")
+        for k, val in zip(cup_keys, (_floor(2.0 * c.radius_mm), c.count, c.hole_mm)):
+            default(k, val)
+            rules[k] = c.text(torque)
     default("cup_bolt_circle_diameter", _r(0.5 * v["hub_bore_diameter"] + r_in))
     default("cup_bolt_count", 8)
     annulus = r_in - 0.5 * v["hub_bore_diameter"]
@@ -161,10 +177,31 @@ def part_sizes(spec: PartsSpec, drive) -> PartSizes:
         "cup_bolt_hole_diameter",
         _r(min(annulus / 3.0, 0.5 * math.pi * v["cup_bolt_circle_diameter"] / v["cup_bolt_count"])),
     )
+    for k in (k for k in cup_keys if k in derived):
+        rules.setdefault(
+            k,
+            "by geometry: in the middle of the diaphragm, holes a third of its width"
+            + ("" if torque else " (no [load] rated_torque_nm: not sized for a torque)"),
+        )
     default("bearing_thickness", _r(0.06 * 2.0 * (r_in if not ext else drive.r_m)))
     default("bearing_width", _r(0.8 * bw))
     R_rim = drive.rigid_rim_radius
-    default("flange_bolt_hole_diameter", _r(max(2.0, 0.025 * 2.0 * R_rim)))
+    fl_keys = ("flange_bolt_hole_diameter", "flange_bolt_count", "flange_bolt_circle_diameter", "flange_outer_diameter")
+    if torque and all(v[k] is None for k in fl_keys):
+        # the rigid gear's bolts carry the reaction torque into the housing (wgcad.design.bolting)
+        if not ext:  # a flange around the gear: its rim follows the hole (bolt circle 1.5 holes out, rim 3)
+            c = choose_bolts(torque, R_rim, None, "flange", place=lambda hole: R_rim + 1.5 * hole)
+            outer = _r(2.0 * (R_rim + 3.0 * c.hole_mm))
+        else:  # holes in the body between the bore and the root circle
+            c = choose_bolts(torque, R_rim, min(drive.rigid.r_f, drive.rigid.r_a), "flange")
+            outer = _r(2.0 * min(drive.rigid.r_f, drive.rigid.r_a))
+        for k, val in zip(fl_keys, (c.hole_mm, c.count, _floor(2.0 * c.radius_mm), outer)):
+            default(k, val)
+            rules[k] = c.text(torque)
+    hole = max(2.0, 0.025 * 2.0 * R_rim)
+    if ext:  # holes between the bore and the root: ligaments of half a hole either side (wgcad.design.bolting)
+        hole = min(hole, 0.45 * (min(drive.rigid.r_f, drive.rigid.r_a) - R_rim))  # 0.45: room for the 0.1 mm rounding
+    default("flange_bolt_hole_diameter", _r(hole))
     dh = v["flange_bolt_hole_diameter"]
     if not ext:
         default("flange_outer_diameter", _r(2.0 * (R_rim + 3.0 * dh)))
@@ -173,6 +210,15 @@ def part_sizes(spec: PartsSpec, drive) -> PartSizes:
         default("flange_outer_diameter", _r(2.0 * min(drive.rigid.r_f, drive.rigid.r_a)))
         default("flange_bolt_circle_diameter", _r(R_rim + min(drive.rigid.r_f, drive.rigid.r_a)))
     default("flange_bolt_count", 12)
+    geometry = (
+        "by geometry: 12 holes of 0.025 x the gear's outer diameter (at least 2 mm"
+        + (", at most 0.45 of the body between bore and root" if ext else "")
+        + "), on a circle "
+        + ("midway between bore and root" if ext else "1.5 holes outside the gear, the flange rim 3 holes out")
+        + ("" if torque else " (no [load] rated_torque_nm: not sized for a torque)")
+    )
+    for k in (k for k in fl_keys if k in derived):
+        rules.setdefault(k, geometry)
     default("flange_thickness", _r(min(bw, max(0.3 * bw, 1.5 * dh))))
 
     # --- rules (each names the key the user sets) ---
@@ -240,7 +286,52 @@ def part_sizes(spec: PartsSpec, drive) -> PartSizes:
         )
     if v["bearing_width"] > (v["cup_length"] if not ext else bw):
         raise DesignError("parts.bearing_width", f"{v['bearing_width']:g} mm is longer than the cup")
-    return PartSizes(v, tuple(derived))
+    # given bolt circles: whether they carry the rated torque, and their ligaments (warnings: the user chose them)
+    from .bolting import METRIC, SLIP_SAFETY
+
+    for prefix, lo, hi in (
+        ("cup", 0.5 * v["hub_bore_diameter"], r_in),
+        ("flange", R_rim, (0.5 * v["flange_outer_diameter"]) if not ext else min(drive.rigid.r_f, drive.rigid.r_a)),
+    ):
+        if prefix == "cup" and ext:
+            continue
+        bc, n, hole = (v[f"{prefix}_bolt_{k}"] for k in ("circle_diameter", "count", "hole_diameter"))
+        r = 0.5 * bc
+        lig = min(r - 0.5 * hole - lo, hi - r - 0.5 * hole)
+        if lig < 0.5 * hole - 1e-6:
+            notes.append(
+                f"{prefix} bolt holes ({hole:g} mm on {bc:g} mm): a ligament of {lig:.2f} mm, less than half a hole"
+            )
+        sized = rules.get(f"{prefix}_bolt_count", "")[:1].isdigit()  # chosen for the torque above
+        fits = [area for name, area, h in METRIC if h <= hole + 1e-9]
+        if torque and not sized and fits:
+            cap = carry(fits[-1], n, r)
+            if cap < SLIP_SAFETY * torque:
+                notes.append(
+                    f"{prefix} bolts ({n} of the largest metric bolt a {hole:g} mm hole takes) slip at "
+                    f"{cap:.0f} N m, less than {SLIP_SAFETY:g} x the rated {torque:g} N m ({RULE})"
+                )
+    used = _used_keys(ext)
+    rules = {k: t for k, t in rules.items() if k in derived and k in used}
+    return PartSizes(v, tuple(k for k in derived if k in used), rules, used, tuple(notes))
+
+
+def _floor(x: float, step: float = 0.05) -> float:
+    """A bolt circle's diameter rounded down to a workshop step: down keeps the outer ligament the rule gave."""
+    return round(math.floor(x / step + 1e-9) * step, 6)
+
+
+def _used_keys(external: bool) -> tuple:
+    """The [parts] keys the drive's parts use (external deformation: no cup, no plug bore, no flange)."""
+    if not external:
+        return tuple(f.name for f in fields(PartsSpec))
+    return (
+        "bearing_thickness",
+        "bearing_width",
+        "flange_bolt_circle_diameter",
+        "flange_bolt_count",
+        "flange_bolt_hole_diameter",
+    )
 
 
 def _bolts(prefix, bc_d, hole_d, count, r_lo, r_hi, inner, outer):
