@@ -416,20 +416,31 @@ def _per_thickness(gear: Gear, figure, at: float) -> float | None:
     """d figure / d tooth thickness (mm/mm), or None where it is not a derivative one can use.
 
     Central differences of +-:data:`SENSITIVITY_STEP` (one-sided where a
-    tooth that much thicker cannot be built: no thinning left), checked
+    tooth that much thicker or thinner cannot be built: no thinning left, or
+    a tooth at the minimum tip thickness), checked
     against the same at 4 times the step: where the two differ by more than
     5 % the figure is not smooth in the thickness (a pin whose seat jumps
     between features of a cycloidal space) and no sensitivity is given.
     """
     from ..errors import DesignError
 
-    def diff(h):
-        lo = figure(_thicker(gear, -h))
+    def side(ds):
         try:
-            hi = figure(_thicker(gear, h))
-        except DesignError:
+            return figure(_thicker(gear, ds))
+        except DesignError:  # no thinning left (the space closes) or a pointed tooth (at the minimum tip): not built
+            return None
+
+    def diff(h):
+        hi, lo = side(h), side(-h)
+        if hi is not None and lo is not None:
+            return (hi - lo) / (2.0 * h)
+        if hi is not None:
+            return (hi - at) / h
+        if lo is not None:
             return (at - lo) / h
-        return (hi - lo) / (2.0 * h)
+        return None
 
     d1, d4 = diff(SENSITIVITY_STEP), diff(4.0 * SENSITIVITY_STEP)
+    if d1 is None or d4 is None:
+        return None
     return d1 if abs(d1 - d4) <= 0.05 * max(abs(d1), abs(d4)) else None
