@@ -128,3 +128,17 @@ def test_no_modules_import_each_other_in_a_loop():
         if v not in index:
             strong(v)
     assert not loops, "modules that import each other in a loop: " + "; ".join(" <-> ".join(c) for c in loops)
+
+
+def test_top_level_entry_points_are_lazy_and_real():
+    # issue 20: the pipeline's entry points from `import wgcad`, loaded on first use
+    import subprocess
+    import sys
+
+    code = (
+        "import sys, wgcad; light = not any(m.startswith(('wgcad.', 'numpy', 'shapely')) for m in sys.modules); "
+        "names = [n for n in wgcad.__all__ if n != '__version__']; "
+        "ok = all(callable(getattr(wgcad, n)) for n in names); print(light, ok, len(names))"
+    )
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=300)
+    assert out.stdout.split() == ["True", "True", "14"], out.stdout + out.stderr
