@@ -61,3 +61,19 @@ def test_settings_errors_name_the_field_in_the_library_and_the_flag_in_the_cli(c
     assert main(["audit", str(D4), "--step-deg", "0.00001"]) == 2  # argparse takes it; the settings do not
     err = capsys.readouterr().err
     assert "--step-deg" in err and "step_deg" not in err
+
+
+def test_ke_as_a_library_call_gives_the_cli_document(tmp_path):
+    # issue 20: the KE's document and summary were built inside cmd_ke; wgcad.report.ke_run is the library call
+    from wgcad.design import load_design
+    from wgcad.drive import build_drive
+    from wgcad.placement.imperfect import Imperfections
+    from wgcad.report.ke_run import no_load
+
+    path = TEMPLATES / "d2_imperfect.toml"
+    out = tmp_path / "ke.json"
+    assert main(["ke", str(path), "--per-mesh", "4", "--json", str(out)]) == 0
+    design = load_design(path)
+    run, lines = no_load(build_drive(design), Imperfections.from_spec(design.imperfections), 4, str(path))
+    assert run.doc == json.loads(out.read_text())
+    assert lines[0].startswith(design.drive.name) and "largest KE" in lines[2]

@@ -198,3 +198,38 @@ def ke_load_png(title: str, res, loaded: list) -> bytes:
     ax.grid(alpha=0.3)
     ax.set_title(title + "\n(samples at whole mesh periods: a stroboscopic view of the cam-order content)", fontsize=10)
     return _png(fig, plt)
+
+
+def ke_pngs(run) -> dict:
+    """The pictures of a KE run (:class:`wgcad.report.ke_run.KERun`) as ``{suffix: PNG bytes}``: ``_ke``, ``_flank``
+    and, where computed, ``_ke_load`` and ``_install``."""
+    from wgcad.accuracy.flank_errors import ENGAGEMENTS, drive_flank_errors
+    from wgcad.placement.imperfect import full_cycle_turns
+
+    drive, imp = run.drive, run.imp
+    d = drive.design.drive
+    out = {"_ke": ke_png(f"{d.name}: kinematic error, no load", run.res, run.orders, run.amp, run.expected, run.intr)}
+    if run.loaded:
+        out["_ke_load"] = ke_load_png(
+            f"{d.name}: kinematic error under load (elastic model at whole mesh periods) and at no load",
+            run.res,
+            run.loaded,
+        )
+    if run.scan is not None:
+        s = run.scan
+        out["_install"] = install_png(
+            f"{d.name}: largest KE against installation angle", s[0], s[1], s[2], s[3], s[0], s[4]
+        )
+    # [S2]'s model on the drive's own errors (docs/models.md 6.1) over the whole error cycle
+    cyc = full_cycle_turns(d.z_flex, d.z_rigid)
+    sgn = 1.0 if d.rotation == "ccw" else -1.0
+    turns = np.linspace(0.0, cyc, 200 * cyc + 1)
+    errs = {
+        (zi, eng): drive_flank_errors(drive, imp, sgn * 2 * np.pi * turns, eng, zone=zone)
+        for zi, zone in enumerate((0.0, np.pi))
+        for eng in ENGAGEMENTS
+    }
+    out["_flank"] = flank_png(
+        f"{d.name}: mesh errors of [S2]'s model, from the design's errors (docs/models.md 6.1)", turns, errs
+    )
+    return out
