@@ -9,7 +9,7 @@ import pytest
 from conftest import TEMPLATES, edit_toml
 
 from wgcad.cli import main
-from wgcad.design import _TABLES, load_design, parse_design
+from wgcad.design import TABLES, load_design, parse_design
 from wgcad.design.files import MAX_DESIGN_BYTES
 from wgcad.design.rules import Rel, context, key_meta
 from wgcad.drive import build_drive
@@ -35,7 +35,7 @@ def one_line(err: str) -> str:
 
 # ----------------------------------------------------------------------------- declared bounds
 def bounded_keys():
-    for table, cls in _TABLES.items():
+    for table, cls in TABLES.items():
         for f in fields(cls):
             meta = key_meta(f)
             if meta.get("lo") is not None or meta.get("hi") is not None:

@@ -4,7 +4,7 @@ from dataclasses import fields
 
 from conftest import ROOT
 
-from wgcad.design import _TABLES
+from wgcad.design import TABLES
 from wgcad.design.reference import design_keys_markdown
 
 
@@ -15,7 +15,7 @@ def test_reference_document_equals_the_schema():
 
 def test_every_key_of_every_table_is_documented_with_a_meaning():
     text = design_keys_markdown()
-    for table, cls in _TABLES.items():
+    for table, cls in TABLES.items():
         assert f"## [{table}]" in text
         for f in fields(cls):
             row = [line for line in text.splitlines() if line.startswith(f"| `{f.name}` |")]

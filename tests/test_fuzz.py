@@ -22,7 +22,7 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from wgcad.cli import main
-from wgcad.design import _TABLES, load_design
+from wgcad.design import TABLES, load_design
 from wgcad.drive import build_drive
 from wgcad.errors import DesignError, InputFileError, WgcadError
 
@@ -34,7 +34,7 @@ BUDGET_MB = 400.0
 CHORD_TOL_UM = 10.0
 #: names a refusal may carry besides design fields: run settings and flags
 FLAGS = {"--max-memory-mb", "chord_tol", "--step-deg", "--sections", "--chord-tol-um", "--interference-tol-um"}
-REAL_FIELDS = {f"{t}.{f.name}" for t, cls in _TABLES.items() for f in fields(cls)} | set(_TABLES)
+REAL_FIELDS = {f"{t}.{f.name}" for t, cls in TABLES.items() for f in fields(cls)} | set(TABLES)
 
 
 # ----------------------------------------------------------------------------- a TOML writer for the mutants
@@ -142,7 +142,7 @@ def mutants(draw):
         elif kind == "table_value":
             data[t] = draw(st.one_of(_numbers, _others))
         elif kind == "schema_key":  # a key the template leaves at its default
-            cls = _TABLES.get(t)
+            cls = TABLES.get(t)
             if cls is not None:
                 data[t][draw(st.sampled_from([f.name for f in fields(cls)]))] = draw(st.one_of(_numbers, _others))
     return name, data
@@ -158,7 +158,7 @@ def check_refusal(e: WgcadError) -> None:
         assert real or unknown, f"names no real field: {msg!r}"
         table = e.field.split(".")[0]
         if unknown and "." in e.field:
-            assert table in _TABLES, msg
+            assert table in TABLES, msg
     else:
         assert isinstance(e, InputFileError), type(e)
 

@@ -30,7 +30,7 @@ import wgcad.report.drive as report_mod
 from wgcad import constants
 from wgcad.clearance.distance import Template, signed_clearance
 from wgcad.clearance.engine import AuditSettings, Scene, audit
-from wgcad.design import _TABLES, parse_design
+from wgcad.design import TABLES, parse_design
 from wgcad.drive import build_drive, tooth_spec
 from wgcad.errors import DesignError
 from wgcad.laws import _FF_BETA_HI, _FF_BETA_LO
@@ -182,7 +182,7 @@ def check_design_error(e: DesignError) -> None:
     m = _FIELD.match(msg)
     assert m, f"message does not start with 'table.key: ': {msg!r}"
     table, key = m.groups()
-    assert key in {f.name for f in fields(_TABLES[table])}, f"message names no real field: {msg!r}"
+    assert key in {f.name for f in fields(TABLES[table])}, f"message names no real field: {msg!r}"
     assert msg == f"{e.field}: {e.rule}" and "\n" not in msg
     assert not re.search(r"\b(nan|inf)\b", msg, re.IGNORECASE), msg
 

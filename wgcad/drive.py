@@ -12,7 +12,7 @@ from .design import Design
 from .design.budget import DEFAULT_MAX_MEMORY_MB, check_budget, estimate_run
 from .errors import DesignError
 from .laws import Law, coned_w0, make_law
-from .profiles.gear import Gear, ToothSpec, _radii, make_gear
+from .profiles.gear import Gear, ToothSpec, make_gear, tooth_radii
 
 __all__ = ["Drive", "build_drive", "tooth_spec"]
 
@@ -99,7 +99,7 @@ class Drive:
 
 def _check_teeth_meet(design: Design) -> None:
     """Refuse a drive whose teeth never meet: on the major axis the flexspline tips must reach past the rigid tips (docs/models.md 2.1, 3)."""
-    f, b = _radii(tooth_spec(design, "flexspline")), _radii(tooth_spec(design, "rigid"))
+    f, b = tooth_radii(tooth_spec(design, "flexspline")), tooth_radii(tooth_spec(design, "rigid"))
     w0 = design.w0
     g = design.generator
     if g.cone_length is not None:  # the largest W0 over the face is at the open end (docs/models.md 3.1, coning)

@@ -196,7 +196,7 @@ def key_float(table: str, key: str):
         from dataclasses import fields
 
         from ..design.rules import key_meta
-        from ..design.schema import _TABLES as TABLES
+        from ..design.schema import TABLES
 
         meta = key_meta(next(f for f in fields(TABLES[table]) if f.name == key))
         lo, hi, unit = float(meta["lo"]), float(meta["hi"]), meta.get("unit") or ""

@@ -13,7 +13,7 @@ from dataclasses import MISSING, fields
 
 from .files import MAX_DESIGN_BYTES
 from .rules import bound_text, key_meta
-from .schema import _OPTIONAL_TABLES, _TABLES
+from .schema import OPTIONAL_TABLES, TABLES
 
 __all__ = ["design_keys_markdown"]
 
@@ -69,8 +69,8 @@ def design_keys_markdown() -> str:
     """The key reference as Markdown, one section per table, one row per key."""
     out = [_HEAD.format(max_bytes=MAX_DESIGN_BYTES)]
     seen: dict[type, str] = {}
-    for table, cls in _TABLES.items():
-        opt = " (optional table)" if table in _OPTIONAL_TABLES else ""
+    for table, cls in TABLES.items():
+        opt = " (optional table)" if table in OPTIONAL_TABLES else ""
         out.append(f"\n## [{table}]{opt}\n")
         if cls in seen:
             out.append(f"Same keys as [{seen[cls]}]" + (", for the rigid gear.\n" if table == "rigid" else ".\n"))

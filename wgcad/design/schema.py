@@ -314,7 +314,7 @@ class Design:
         return self.drive.deformation == "external"
 
 
-_TABLES: dict[str, type] = {
+TABLES: dict[str, type] = {
     "drive": DriveSpec,
     "tooth": ToothFormSpec,
     "flexspline": GearSpec,
@@ -326,12 +326,12 @@ _TABLES: dict[str, type] = {
     "load": LoadSpec,
     "imperfections": ImperfectionsSpec,
 }
-_OPTIONAL_TABLES = ("tooth", "sectors", "material", "bearing", "load", "imperfections")
+OPTIONAL_TABLES = ("tooth", "sectors", "material", "bearing", "load", "imperfections")
 #: tables validated by other modules (``[parts]``: wgcad.design.parts), passed over here
 _OTHER_TABLES = ("parts",)
 
 
-def _base_type(tp) -> tuple[type, bool]:
+def base_type(tp) -> tuple[type, bool]:
     """(type, optional) from an annotation string/typing object."""
     if isinstance(tp, str):
         tp = eval(tp, {"float": float, "int": int, "str": str, "None": type(None)})  # noqa: S307 - own annotations
@@ -343,7 +343,7 @@ def _base_type(tp) -> tuple[type, bool]:
 
 
 def _coerce(table: str, key: str, value, tp):
-    base, optional = _base_type(tp)
+    base, optional = base_type(tp)
     where = f"{table}.{key}"
     if base is float:
         return read_float(where, value)
@@ -405,7 +405,7 @@ def validate(d: Design) -> Design:
         # one wave only shifts the rim off-centre; it does not deform it
         raise DesignError("drive.waves", f"must be >= 2, got {dr.waves}")
     # every absolute bound before any rule that combines fields (docs/design-keys.md)
-    check_bounds(d, _TABLES, passes=(0,))
+    check_bounds(d, TABLES, passes=(0,))
     _positive("drive.face_width", dr.face_width)
     _choice("drive.deformation", dr.deformation, ("internal", "external"))
     _choice("drive.fixed", dr.fixed, ("rigid", "flexspline"))
@@ -467,7 +467,7 @@ def validate(d: Design) -> Design:
                 f"face width {dr.face_width:g} mm exceeds generator.cone_length {g.cone_length:g} mm",
             )
     # the bounds relative to the design's own sizes (docs/design-keys.md)
-    check_bounds(d, _TABLES, passes=(1,))
+    check_bounds(d, TABLES, passes=(1,))
     validate_sectors(d.sectors, dr.z_flex, dr.z_rigid, dr.waves)
     # [material], [bearing], [load] and [imperfections] have no rule beyond their keys' bounds (checked above)
     return d
@@ -478,14 +478,14 @@ def parse_design(data: dict, source: str = "<memory>") -> Design:
     if not isinstance(data, dict):
         raise DesignError("<file>", "must be a TOML document with tables")
     for key in data:
-        if key not in _TABLES and key not in _OTHER_TABLES:
-            near = difflib.get_close_matches(key, _TABLES, n=1)
-            hint = f"; did you mean [{near[0]}]?" if near else f"; valid tables: {', '.join(_TABLES)}"
+        if key not in TABLES and key not in _OTHER_TABLES:
+            near = difflib.get_close_matches(key, TABLES, n=1)
+            hint = f"; did you mean [{near[0]}]?" if near else f"; valid tables: {', '.join(TABLES)}"
             raise DesignError(key, f"unknown table{hint}")
     parts = {}
-    for name, cls in _TABLES.items():
+    for name, cls in TABLES.items():
         if name not in data:
-            if name in _OPTIONAL_TABLES:
+            if name in OPTIONAL_TABLES:
                 parts[name] = cls()
                 continue
             raise DesignError(name, f"table [{name}] is required")

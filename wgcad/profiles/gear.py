@@ -160,7 +160,7 @@ def _involute_base_angle(sp: ToothSpec) -> float:
     return width / (2.0 * r) + float(iv.inv(sp.alpha))
 
 
-def _radii(sp: ToothSpec) -> tuple[float, float]:
+def tooth_radii(sp: ToothSpec) -> tuple[float, float]:
     m, r = sp.module, sp.module * sp.z / 2.0
     if sp.form == "involute":
         if sp.internal:
@@ -194,7 +194,7 @@ def make_gear(sp: ToothSpec, tol: float = constants.CHORD_TOL) -> Gear:
     """
     f = sp.field
     r = sp.module * sp.z / 2.0
-    r_a, r_f = _radii(sp)
+    r_a, r_f = tooth_radii(sp)
     if sp.internal and not r_a < r_f:
         raise DesignError(
             f"{f}.tip_radius", f"tip radius {r_a:.4f} mm must be inside the root radius {r_f:.4f} mm for internal teeth"
@@ -243,7 +243,7 @@ def make_gear(sp: ToothSpec, tol: float = constants.CHORD_TOL) -> Gear:
 def _fillet_fits(sp: ToothSpec, rho: float) -> bool:
     """Whether a root fillet of radius ``rho`` fits (closed form, no sampling)."""
     r = sp.module * sp.z / 2.0
-    r_a, r_f = _radii(sp)
+    r_a, r_f = tooth_radii(sp)
     r_b = r * np.cos(sp.alpha)
     base = _involute_base_angle(sp)
     gamma2 = pi / sp.z

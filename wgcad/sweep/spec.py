@@ -184,13 +184,13 @@ def _whole(where: str, v, lo: int, hi: int) -> int:
 def _field_types() -> dict:
     """``{table: {key: (base type, choices)}}`` of every design key (from the design schema)."""
     from ..design.rules import key_meta
-    from ..design.schema import _TABLES, _base_type
+    from ..design.schema import TABLES, base_type
 
     out = {}
-    for t, cls in _TABLES.items():
+    for t, cls in TABLES.items():
         if hasattr(cls, "from_table"):  # tables with lists (sectors) cannot be swept key by key
             continue
-        out[t] = {f.name: (_base_type(f.type)[0], key_meta(f).get("choices")) for f in fields(cls)}
+        out[t] = {f.name: (base_type(f.type)[0], key_meta(f).get("choices")) for f in fields(cls)}
     return out
 
 
