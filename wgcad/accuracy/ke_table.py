@@ -122,7 +122,6 @@ def contact_table(
     sigma = 1 if d.rotation == "ccw" else -1
     side_w = 1 if sigma / u < 0 else -1  # the flank facing against the relative motion carries the load
     flex, rigid = Template(drive.flex.tooth_polygon()), Template(drive.rigid.tooth_polygon())
-    gamma_b = 2 * pi / z_b
     M = z_g * n_per_mesh
     m_all = np.arange(M)
     phi = _fold(2 * pi * m_all / M)
@@ -140,44 +139,15 @@ def contact_table(
         drive.rigid.r,
         (imp.cam_cam, imp.cam_cam_phase),
     )
+    lat = _Lattice(drive, flex, rigid, m_all, phi, fa, margin, reach_pitches * 2 * pi / z_g)
     parts = {s: [] for s in (1, -1)}
     pending = {s: [] for s in (1, -1)}  # each section's solved pairs, for the second features
-    h = 1e-6
     for si, z in enumerate(sections):
-        law = drive.law if z is None else drive.law_at(z)
-        cz = coning_factor(drive, z)
-        off = cz * cam_offset(imp, fa, 0.0, parts=("cam",))
-        rot, shift = tooth_pose(law, phi, drive.r_m, frame_angle=fa)
-        shift = shift + off
-        # radially engaged (plus the errors' reach): the others cannot touch by turning
-        c, s = np.cos(rot), np.sin(rot)
-        xs = flex.local[:, 0][None, :] * c[:, None] - flex.local[:, 1][None, :] * s[:, None] + shift[:, :1]
-        ys = flex.local[:, 0][None, :] * s[:, None] + flex.local[:, 1][None, :] * c[:, None] + shift[:, 1:]
-        R = np.hypot(xs, ys)
-        # radially engaged, or within the errors' radial reach of it. A tooth that barely reaches past
-        # the rigid tip circle touches with a tip corner, and there a few micrometres of radial error
-        # decide whether it touches at all: the linear model holds only for errors well below that
-        # overlap (tests/test_ke.py, benchmarks/ke.py measure it against the direct computation)
-        over = (drive.rigid.r_a - R.min(axis=1)) if drive.external else (R.max(axis=1) - drive.rigid.r_a)
-        eng = over >= -margin
-        idx = np.nonzero(eng)[0]
-        a = np.arctan2(shift[idx, 1] + drive.r_m * s[idx], shift[idx, 0] + drive.r_m * c[idx])
-        lo = np.floor(a / gamma_b - 0.5).astype(int)
-        # derivative of the pose along the rim (tooth angle phi, frame fixed): for the along-rim shifts
-        rp, sp = tooth_pose(law, phi[idx] + h, drive.r_m, frame_angle=fa[idx])
-        rm_, sm = tooth_pose(law, phi[idx] - h, drive.r_m, frame_angle=fa[idx])
-        drot, dshift = (rp - rm_) / (2 * h), (sp - sm) / (2 * h)
+        engaged = _engaged(lat, imp, z)
         for side in (1, -1):
-            j = (lo + (1 if side > 0 else 0)) % z_b
-            rb = (j + 0.5) * gamma_b
-            con = closing_rotation(
-                flex, rot[idx], shift[idx], rigid, rb, np.zeros((len(idx), 2)), side, reach_pitches * 2 * pi / z_g
-            )
-            good = con.ok & (np.hypot(con.nt[:, 0], con.nt[:, 1]) * drive.rigid.r <= NT_MAX)
-            k = np.nonzero(good)[0]
-            rows = _rows(con, k, idx, rot, shift, drot, dshift, m_all, j, cz, side, np.zeros(len(k)))
+            rows, item = _first_contacts(lat, engaged, side)
             parts[side].append(rows)
-            pending[side].append((rows, k, idx, rot, shift, drot, dshift, j, cz, rb))
+            pending[side].append(item)
             tick(0.4 * (2 * si + (side < 0) + 1) / (2 * len(sections)))
     # the touching feature can change within the errors' radial reach (a tip reaching past the end of the
     # other's involute into its root fillet): each pair that can be first is solved again with its
@@ -186,45 +156,111 @@ def contact_table(
     if imp.cam_flex + imp.cam_fixed + imp.flex_ecc + imp.rigid_ecc > 0.0:
         for side in (1, -1):
             tick(0.4 + 0.35 * (side < 0))
-            keep = (
-                np.ones(sum(len(x[1]) for x in pending[side]), dtype=bool)
-                if exhaustive
-                else _can_be_first(tab, side, imp, pending[side], flex, rigid)
-            )
-            at = 0
-            for rows, k, idx, rot, shift, drot, dshift, j, cz, rb in pending[side]:
-                sub = np.nonzero(keep[at : at + len(k)])[0]
-                at += len(k)
-                rho = cz * (imp.cam_flex + imp.cam_fixed) + imp.flex_ecc + imp.rigid_ecc
-                if rho > 0.0 and sub.size:
-                    parts[side].extend(
-                        _second_features(
-                            flex,
-                            rigid,
-                            {key: v[sub] for key, v in rows.items()},
-                            k[sub],
-                            idx,
-                            rot,
-                            shift,
-                            drot,
-                            dshift,
-                            m_all,
-                            j,
-                            cz,
-                            side,
-                            rb,
-                            rho,
-                            reach_pitches * 2 * pi / z_g,
-                            drive.rigid.r,
-                            warm=not exhaustive,
-                        )
-                    )
+            parts[side].extend(_more_features(lat, tab, imp, side, pending[side], exhaustive))
     for side in (1, -1):
         tick(0.75 + 0.125 * (side < 0))
         tab.sides[side] = {key: np.concatenate([p[key] for p in parts[side]]) for key in parts[side][0]}
-        _refine(tab, side, imp, flex, rigid, reach_pitches * 2 * pi / z_g)
+        _refine(tab, side, imp, flex, rigid, lat.reach)
     tick(1.0)
     return tab
+
+
+@dataclass
+class _Lattice:
+    """What every stage of the table shares: the drive, the teeth's outlines, the lattice of tooth angles."""
+
+    drive: object
+    flex: Template
+    rigid: Template
+    m_all: np.ndarray
+    phi: np.ndarray  # tooth angle of each lattice point
+    fa: np.ndarray  # generator angle that puts a tooth there
+    margin: float  # radial reach of the linear errors, mm
+    reach: float  # largest closing rotation looked at, rad
+
+
+def _engaged(lat: _Lattice, imp: Imperfections, z):
+    """The lattice points of section ``z`` whose tooth reaches the rigid tip circle (within the errors' reach): their
+    indices, poses, pose derivatives along the rim, lower rigid tooth and coning factor."""
+    drive, flex = lat.drive, lat.flex
+    law = drive.law if z is None else drive.law_at(z)
+    cz = coning_factor(drive, z)
+    off = cz * cam_offset(imp, lat.fa, 0.0, parts=("cam",))
+    rot, shift = tooth_pose(law, lat.phi, drive.r_m, frame_angle=lat.fa)
+    shift = shift + off
+    # radially engaged (plus the errors' reach): the others cannot touch by turning
+    c, s = np.cos(rot), np.sin(rot)
+    xs = flex.local[:, 0][None, :] * c[:, None] - flex.local[:, 1][None, :] * s[:, None] + shift[:, :1]
+    ys = flex.local[:, 0][None, :] * s[:, None] + flex.local[:, 1][None, :] * c[:, None] + shift[:, 1:]
+    R = np.hypot(xs, ys)
+    # radially engaged, or within the errors' radial reach of it. A tooth that barely reaches past
+    # the rigid tip circle touches with a tip corner, and there a few micrometres of radial error
+    # decide whether it touches at all: the linear model holds only for errors well below that
+    # overlap (tests/test_ke.py, benchmarks/ke.py measure it against the direct computation)
+    over = (drive.rigid.r_a - R.min(axis=1)) if drive.external else (R.max(axis=1) - drive.rigid.r_a)
+    idx = np.nonzero(over >= -lat.margin)[0]
+    gamma_b = 2 * pi / drive.design.drive.z_rigid
+    a = np.arctan2(shift[idx, 1] + drive.r_m * s[idx], shift[idx, 0] + drive.r_m * c[idx])
+    lo = np.floor(a / gamma_b - 0.5).astype(int)
+    # derivative of the pose along the rim (tooth angle phi, frame fixed): for the along-rim shifts
+    h = 1e-6
+    rp, sp = tooth_pose(law, lat.phi[idx] + h, drive.r_m, frame_angle=lat.fa[idx])
+    rm_, sm = tooth_pose(law, lat.phi[idx] - h, drive.r_m, frame_angle=lat.fa[idx])
+    drot, dshift = (rp - rm_) / (2 * h), (sp - sm) / (2 * h)
+    return idx, rot, shift, drot, dshift, lo, cz
+
+
+def _first_contacts(lat: _Lattice, engaged, side: int):
+    """The contacts of the engaged teeth turned towards ``side``: the table rows, and what the second features need."""
+    idx, rot, shift, drot, dshift, lo, cz = engaged
+    drive = lat.drive
+    z_b = drive.design.drive.z_rigid
+    j = (lo + (1 if side > 0 else 0)) % z_b
+    rb = (j + 0.5) * 2 * pi / z_b
+    con = closing_rotation(lat.flex, rot[idx], shift[idx], lat.rigid, rb, np.zeros((len(idx), 2)), side, lat.reach)
+    good = con.ok & (np.hypot(con.nt[:, 0], con.nt[:, 1]) * drive.rigid.r <= NT_MAX)
+    k = np.nonzero(good)[0]
+    rows = _rows(con, k, idx, rot, shift, drot, dshift, lat.m_all, j, cz, side, np.zeros(len(k)))
+    return rows, (rows, k, idx, rot, shift, drot, dshift, j, cz, rb)
+
+
+def _more_features(lat: _Lattice, tab: ContactTable, imp: Imperfections, side: int, pending: list, exhaustive: bool):
+    """The second features of the pairs of one side that can be first (:func:`_second_features`), as table rows."""
+    out = []
+    keep = (
+        np.ones(sum(len(x[1]) for x in pending), dtype=bool)
+        if exhaustive
+        else _can_be_first(tab, side, imp, pending, lat.flex, lat.rigid)
+    )
+    at = 0
+    for rows, k, idx, rot, shift, drot, dshift, j, cz, rb in pending:
+        sub = np.nonzero(keep[at : at + len(k)])[0]
+        at += len(k)
+        rho = cz * (imp.cam_flex + imp.cam_fixed) + imp.flex_ecc + imp.rigid_ecc
+        if rho > 0.0 and sub.size:
+            out.extend(
+                _second_features(
+                    lat.flex,
+                    lat.rigid,
+                    {key: v[sub] for key, v in rows.items()},
+                    k[sub],
+                    idx,
+                    rot,
+                    shift,
+                    drot,
+                    dshift,
+                    lat.m_all,
+                    j,
+                    cz,
+                    side,
+                    rb,
+                    rho,
+                    lat.reach,
+                    lat.drive.rigid.r,
+                    warm=not exhaustive,
+                )
+            )
+    return out
 
 
 def _rows(con, k, idx, rot, shift, drot, dshift, m_all, j, cz, side, extra):
