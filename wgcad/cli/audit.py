@@ -37,6 +37,10 @@ def _check_outputs(args) -> None:
         if args.plot == STDOUT:
             raise OutputError("--plot: writes three PNG files, so it needs a path, not - (standard output)")
         targets += [("--plot", p) for _, p in _plot_paths(args.plot)]
+    if args.html:
+        if args.html == STDOUT:
+            raise OutputError("--html: writes a page, so it needs a path, not - (standard output)")
+        targets.append(("--html", args.html))
     for flag, path in targets:
         if not path or path == STDOUT:
             continue
@@ -44,11 +48,15 @@ def _check_outputs(args) -> None:
         if key in seen:
             raise OutputError(f"{flag}: {path} is also the file of {seen[key]}")
         seen[key] = flag
-        check_output_file(path, flag=flag, inputs=inputs, stdout_ok=flag != "--plot")
+        check_output_file(path, flag=flag, inputs=inputs, stdout_ok=flag not in ("--plot", "--html"))
 
 
 def cmd_audit(args) -> int:
     if args.torque_nm is not None:  # under load: cli/load.py
+        if args.html:
+            from ..errors import OutputError
+
+            raise OutputError("--html: the load audit has no page yet (its figures: --plot)")
         from .load import run_load
 
         return run_load(args)
@@ -132,20 +140,26 @@ def cmd_audit(args) -> int:
         )
         base_text = json.dumps(doc, allow_nan=False, indent=2) + "\n"
     files = [(args.json, res_text), (args.write_baseline, base_text)]
-    if any(p and p != STDOUT for p, _ in files) or args.plot:
+    if any(p and p != STDOUT for p, _ in files) or args.plot or args.html:
         from ..atomic import atomic_batch
 
         with atomic_batch() as batch:
             for path, text in files:
                 if path and path != STDOUT:
                     Path(batch.temp_path(path)).write_text(text)
-            if args.plot:
+            if args.plot or args.html:
                 bar.set(0.9 if args.engine == "2d" else 0.95, "pictures")
-                from ..export.audit_figures import audit_pngs
+                from ..export.audit_figures import audit_plot_data, audit_pngs
 
-                pngs = dict(audit_pngs(drive, result))
+                data = audit_plot_data(drive, result)
+            if args.plot:
+                pngs = dict(audit_pngs(drive, result, data))
                 for suffix, path in _plot_paths(args.plot):
                     Path(batch.temp_path(path)).write_bytes(pngs[suffix])
+            if args.html:
+                from ..export.html import audit_html
+
+                Path(batch.temp_path(args.html)).write_text(audit_html(drive, result, res, data), encoding="utf-8")
     bar.set(1.0, "done")
     bar.close()
     for path, text in files:
@@ -242,6 +256,11 @@ def register(sub) -> None:
         "--plot",
         metavar="PATH",
         help="write PNGs PATH_profile.png, PATH_vs_angle.png, PATH_tightest.png (PATH without .png)",
+    )
+    a.add_argument(
+        "--html",
+        metavar="PATH",
+        help="write one self-contained interactive page (zoomable figures, the tables; nothing fetched when viewed)",
     )
     a.add_argument(
         "--write-baseline",

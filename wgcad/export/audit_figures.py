@@ -2,18 +2,37 @@
 
 from __future__ import annotations
 
-__all__ = ["audit_pngs"]
+__all__ = ["audit_plot_data", "audit_pngs"]
 
 
-def audit_pngs(drive, result):
+def audit_pngs(drive, result, data: dict | None = None):
     """The audit's pictures as ``(suffix, PNG bytes)``: the clearance profile of a passage, the clearance against
     generator angle (every passage's entry gap for an imperfect drive), the teeth around the tightest spot."""
+    from .figures import clearance_profile_png, clearance_vs_angle_png, tightest_spot_png
+
+    data = audit_plot_data(drive, result) if data is None else data
+    yield "profile", clearance_profile_png(*data["profile"])
+    kind, args = data["vs_angle"]
+    if kind == "passages":
+        from .imperfect_figures import entry_passages_png
+
+        yield "vs_angle", entry_passages_png(*args)
+    else:
+        yield "vs_angle", clearance_vs_angle_png(*args)
+    yield "tightest", tightest_spot_png(*data["tightest"])
+
+
+def audit_plot_data(drive, result) -> dict:
+    """What the audit's pictures show, computed once for every renderer (PNG, the interactive page): ``profile``
+    (data, title), ``vs_angle`` ("passages" or "curve", the arguments of its figure), ``tightest`` (teeth, labels,
+    rigid teeth, overlaps, title), all in um and degrees."""
     import numpy as np
     import shapely
 
     from ..clearance.engine import Scene, clearance_profile, clearance_vs_angle
     from ..placement import tooth_pose, transform
-    from .figures import clearance_profile_png, clearance_vs_angle_png, tightest_spot_png
+
+    out = {}
 
     scene = Scene(drive)
     imperfect = bool(result.settings.get("imperfections"))
@@ -60,21 +79,17 @@ def audit_pngs(drive, result):
         "worst_um": w["clearance_um"],
         "tol_um": 1e3 * result.interference_tol,
     }
-    yield (
-        "profile",
-        clearance_profile_png(
-            data, f"{name}: clearance of a flexspline tooth along its passage (every tooth follows it){perfect_note}"
-        ),
+    out["profile"] = (
+        data,
+        f"{name}: clearance of a flexspline tooth along its passage (every tooth follows it){perfect_note}",
     )
     mesh = 360.0 / drive.design.drive.z_rigid
     if imperfect and "all_passages" in ent:
         # the errors break the mesh period: every passage of a tooth through the entry has its own gap
-        from .imperfect_figures import entry_passages_png
-
         a = ent["all_passages"]
-        yield (
-            "vs_angle",
-            entry_passages_png(
+        out["vs_angle"] = (
+            "passages",
+            (
                 np.rad2deg(a["phi_h"]),
                 1e3 * a["gap"],
                 a["section"],
@@ -88,9 +103,9 @@ def audit_pngs(drive, result):
     else:
         ang = np.deg2rad(np.linspace(0.0, 3 * mesh, 601))
         wv, nv = clearance_vs_angle(scene, prof, ang)
-        yield (
-            "vs_angle",
-            clearance_vs_angle_png(
+        out["vs_angle"] = (
+            "curve",
+            (
                 np.rad2deg(ang),
                 1e3 * wv,
                 1e3 * nv,
@@ -128,14 +143,12 @@ def audit_pngs(drive, result):
                     overlaps.append(np.asarray(g.exterior.coords))
     labels = [f"{np.rad2deg(((p + np.pi) % (2 * np.pi)) - np.pi):.1f} deg" for p in (mat - phi_h)]
     sec = "" if z is None else f", section z = {z:g} mm"
-    yield (
-        "tightest",
-        tightest_spot_png(
-            teeth,
-            labels,
-            rig,
-            overlaps,
-            f"{name}{' (imperfect parts)' if imperfect else ''}: tightest spot, tooth {w['tooth']} at generator angle {w['generator_angle_deg']:g} deg{sec}: "
-            f"{w['clearance_um']:.2f} um ({w['location']})",
-        ),
+    out["tightest"] = (
+        teeth,
+        labels,
+        rig,
+        overlaps,
+        f"{name}{' (imperfect parts)' if imperfect else ''}: tightest spot, tooth {w['tooth']} at generator angle {w['generator_angle_deg']:g} deg{sec}: "
+        f"{w['clearance_um']:.2f} um ({w['location']})",
     )
+    return out

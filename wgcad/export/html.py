@@ -1,0 +1,193 @@
+"""The audit as one self-contained, interactive page: zoomable figures (plotly, its script embedded) and the tables.
+
+``wgcad audit --html PATH`` writes it. Nothing is fetched when the page is
+viewed (plotly.js is inlined once, about 4.8 MB): it opens from a disk, a
+mail or an archive. The figures are those of the PNGs
+(:func:`wgcad.export.audit_figures.audit_plot_data`, computed once for
+both) plus the whole drive at the tightest spot's generator angle, from
+which a designer zooms down to the tooth pair and its microns.
+"""
+
+from __future__ import annotations
+
+import html
+
+import numpy as np
+
+__all__ = ["audit_html"]
+
+_CSS = """
+body { font-family: system-ui, sans-serif; margin: 1.5em; color: #222; max-width: 1200px; }
+h1 { font-size: 1.4em; } h2 { font-size: 1.15em; margin-top: 1.6em; }
+table { border-collapse: collapse; margin: 0.5em 0; } td, th { border: 1px solid #ccc; padding: 0.25em 0.6em; text-align: left; }
+th { background: #f3f3f3; } .bad { color: #b00; font-weight: bold; } .ok { color: #070; font-weight: bold; }
+.note { color: #555; font-size: 0.92em; } .fig { margin: 0.5em 0 1.5em 0; }
+"""
+
+
+def _fmt(v, nd: int = 3) -> str:
+    if v is None:
+        return "-"
+    if isinstance(v, float):
+        return "-" if not np.isfinite(v) else f"{v:.{nd}f}"
+    return html.escape(str(v))
+
+
+def _figure(fig, div_id: str) -> str:
+    html_div = fig.to_html(full_html=False, include_plotlyjs=False, div_id=div_id, config={"displaylogo": False})
+    return '<div class="fig">' + html_div + "</div>"
+
+
+def _lines(go, fig, polys, name, color, width=1.0, show=True):
+    """Closed outlines ``(n, 2)`` as one trace (None between them)."""
+    xs, ys = [], []
+    for p in polys:
+        p = np.asarray(p, dtype=float)
+        xs += [*p[:, 0], p[0, 0], None]
+        ys += [*p[:, 1], p[0, 1], None]
+    fig.add_trace(go.Scatter(x=xs, y=ys, mode="lines", name=name, line=dict(color=color, width=width), showlegend=show))
+
+
+def _equal(fig, title):
+    fig.update_layout(title=title, height=640, template="plotly_white", legend=dict(orientation="h"))
+    fig.update_yaxes(scaleanchor="x", scaleratio=1.0, title="y, mm")
+    fig.update_xaxes(title="x, mm")
+
+
+def audit_html(drive, result, doc: dict, data: dict) -> str:
+    """The page: verdict and figures of the audit (``doc``: :func:`wgcad.report.audit_run.audit_document`'s document;
+    ``data``: :func:`wgcad.export.audit_figures.audit_plot_data`)."""
+    import plotly.graph_objects as go
+    from plotly.offline import get_plotlyjs
+
+    from ..placement.deformed import deformed_state
+
+    name = drive.design.drive.name
+    w, e = doc["worst"], doc["entry"]
+    figs = []
+    # 1. the whole drive at the tightest spot's generator angle and section, the tightest teeth drawn over it
+    z = w.get("section_z_mm")
+    st = deformed_state(drive, np.deg2rad(w["generator_angle_deg"]), drive.tol, z=z)
+    fig = go.Figure()
+    _lines(go, fig, [st.rigid_outline], "rigid gear", "#b00000")
+    _lines(go, fig, [st.flex_outline], "flexspline (deformed)", "#0040c0")
+    _lines(go, fig, [st.neutral], "neutral line", "#008000", width=0.8)
+    teeth, labels, rig, overlaps, t_title = data["tightest"]
+    if overlaps:
+        _lines(go, fig, overlaps, "overlap", "#ff8000", width=2.0)
+    fig.add_trace(
+        go.Scatter(
+            x=[float(np.mean(teeth[3][:, 0]))],
+            y=[float(np.mean(teeth[3][:, 1]))],
+            mode="markers+text",
+            marker=dict(size=10, color="#ff8000", symbol="x"),
+            text=[f"tightest: {w['clearance_um']:.2f} um"],
+            textposition="top center",
+            name="tightest spot",
+        )
+    )
+    _equal(
+        fig,
+        f"{name}: the drive at generator angle {w['generator_angle_deg']:g} deg"
+        + ("" if z is None else f", section z = {z:g} mm")
+        + " (zoom in on the cross to the tooth pair)",
+    )
+    figs.append(("The whole drive", _figure(fig, "drive")))
+    # 2. the tightest spot, close up (the teeth around it in their own frame, as the PNG)
+    fig = go.Figure()
+    _lines(go, fig, list(rig), "rigid teeth", "#b00000")
+    _lines(go, fig, list(teeth), "flexspline teeth", "#0040c0")
+    if overlaps:
+        _lines(go, fig, overlaps, "overlap", "#ff8000", width=2.0)
+    _equal(fig, t_title)
+    figs.append(("The tightest spot", _figure(fig, "tightest")))
+    # 3. clearance along a tooth's passage
+    prof, p_title = data["profile"]
+    fig = go.Figure()
+    for sec in prof["sections"]:
+        tag = "" if sec["z"] is None else f", z = {sec['z']:g} mm"
+        fig.add_trace(go.Scatter(x=prof["phi_deg"], y=sec["working_um"], mode="lines", name=f"working edge{tag}"))
+        fig.add_trace(
+            go.Scatter(x=prof["phi_deg"], y=sec["nonworking_um"], mode="lines", name=f"non-working edge{tag}")
+        )
+    fig.add_trace(
+        go.Scatter(
+            x=[prof["worst_deg"], prof["entry_deg"]],
+            y=[prof["worst_um"], prof["entry_um"]],
+            mode="markers+text",
+            text=[prof["worst_label"], prof["entry_label"]],
+            textposition="top center",
+            marker=dict(size=9, color="black"),
+            name="the audit's figures",
+        )
+    )
+    fig.add_hrect(y0=-prof["tol_um"], y1=prof["tol_um"], fillcolor="gray", opacity=0.2, line_width=0)
+    fig.update_layout(title=p_title, height=520, template="plotly_white")
+    fig.update_xaxes(title="tooth angle from the major axis, deg")
+    fig.update_yaxes(title="clearance, um (negative: overlap)")
+    figs.append(("Clearance along a tooth's passage", _figure(fig, "profile")))
+    # 4. against generator angle (or every passage's entry gap)
+    kind, args = data["vs_angle"]
+    fig = go.Figure()
+    if kind == "curve":
+        ang, wv, nv, tol, v_title = args
+        fig.add_trace(go.Scatter(x=ang, y=wv, mode="lines", name="working flanks"))
+        fig.add_trace(go.Scatter(x=ang, y=nv, mode="lines", name="non-working flanks"))
+        fig.update_xaxes(title="generator angle, deg")
+    else:
+        phi_h, gap, section, secs, perfect, tol, v_title = args
+        fig.add_trace(go.Scatter(x=phi_h, y=gap, mode="markers", marker=dict(size=4), name="every passage's entry gap"))
+        fig.update_xaxes(title="generator angle of the passage, deg")
+    fig.add_hrect(y0=-tol, y1=tol, fillcolor="gray", opacity=0.2, line_width=0)
+    fig.update_layout(title=v_title, height=520, template="plotly_white")
+    fig.update_yaxes(title="clearance, um")
+    figs.append(("Against generator angle", _figure(fig, "vs_angle")))
+
+    rows = [
+        (
+            "minimum clearance",
+            f"{_fmt(w['clearance_um'])} um",
+            f"{w['location']} at tooth angle {_fmt(w['tooth_angle_deg'])} deg",
+        ),
+        (
+            "entry gap Delta [S1]",
+            f"{_fmt(doc.get('entry_gap_um'))} um",
+            f"{html.escape(str(e.get('kind') or '-'))}, {html.escape(str(e.get('edge') or '-'))} edge "
+            f"at tooth angle {_fmt(e.get('tooth_angle_deg'))} deg",
+        ),
+        (
+            "tip crossing",
+            f"{_fmt(e.get('crossing_um'))} um",
+            f"tooth angle {_fmt(e.get('crossing_tooth_angle_deg'))} deg",
+        ),
+        ("entry pinch", f"{_fmt(e.get('pinch_um'))} um", f"tooth angle {_fmt(e.get('pinch_tooth_angle_deg'))} deg"),
+        (
+            "backlash",
+            f"{_fmt(doc.get('backlash_arcmin'), 4)} arcmin",
+            f"{_fmt(doc.get('backlash_um_at_pitch'), 2)} um at the rigid pitch circle",
+        ),
+    ]
+    verdict = (
+        '<span class="bad">INTERFERENCE</span>' if doc["interference"] else '<span class="ok">no interference</span>'
+    )
+    table = "".join(f"<tr><th>{a}</th><td>{b}</td><td>{c}</td></tr>" for a, b, c in rows)
+    notes = "".join(f"<li>{html.escape(n)}</li>" for n in doc.get("not_checked", []))
+    st = doc["settings"]
+    body = [
+        f"<h1>{html.escape(name)}: clearance audit</h1>",
+        f"<p>{verdict} (tolerance {_fmt(doc.get('interference_tol_um'), 3)} um); "
+        f"{'figures on the exact tooth curves' if st.get('refined') else 'polygon figures'}; "
+        f"{st.get('angles')} generator angles, sections {html.escape(str(st.get('sections_z_mm')))} mm.</p>",
+        f"<table>{table}</table>",
+        f"<p class='note'>NOT CHECKED:</p><ul class='note'>{notes}</ul>" if notes else "",
+    ]
+    for title, div in figs:
+        body += [f"<h2>{html.escape(title)}</h2>", div]
+    return (
+        "<!DOCTYPE html>\n<html lang='en'><head><meta charset='utf-8'>"
+        f"<title>{html.escape(name)}: wgcad audit</title><style>{_CSS}</style>"
+        f"<script type='text/javascript'>{get_plotlyjs()}</script></head><body>\n"
+        + "\n".join(body)
+        + "\n<p class='note'>wgcad: every figure here is also in the audit's JSON; the page loads nothing from the network.</p>"
+        + "\n</body></html>\n"
+    )
