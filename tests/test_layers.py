@@ -141,4 +141,4 @@ def test_top_level_entry_points_are_lazy_and_real():
         "ok = all(callable(getattr(wgcad, n)) for n in names); print(light, ok, len(names))"
     )
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=300)
-    assert out.stdout.split() == ["True", "True", "14"], out.stdout + out.stderr
+    assert out.stdout.split() == ["True", "True", "15"], out.stdout + out.stderr

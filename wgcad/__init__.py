@@ -27,6 +27,7 @@ _ENTRY = {
     "build_model": "wgcad.elastic",
     "solve_load": "wgcad.elastic",
     "build_parts": "wgcad.export.parts",
+    "write_drive_files": "wgcad.export.drive_files",
     "run_sector": "wgcad.sector.run",
     "load_spec": "wgcad.sweep.spec",
     "run_sweep": "wgcad.sweep.runner",

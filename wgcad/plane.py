@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["signed_area"]
+__all__ = ["signed_area", "circle_polygon"]
 
 
 def signed_area(pts) -> float:
@@ -12,3 +12,12 @@ def signed_area(pts) -> float:
     p = np.asarray(pts, dtype=float)
     x, y = p[:, 0], p[:, 1]
     return 0.5 * float(np.dot(x, np.roll(y, -1)) - np.dot(np.roll(x, -1), y))
+
+
+def circle_polygon(radius: float, tol: float) -> np.ndarray:
+    """``(N, 2)`` points of the circle of ``radius`` (mm) about the origin, counter-clockwise from +x, its chords
+    within ``tol`` (mm) of the arc (at least 64 points)."""
+    step = 2.0 * np.arccos(max(-1.0, 1.0 - tol / radius))
+    n = max(64, int(np.ceil(2 * np.pi / step)))
+    t = np.linspace(0.0, 2 * np.pi, n, endpoint=False)
+    return np.stack([radius * np.cos(t), radius * np.sin(t)], axis=1)

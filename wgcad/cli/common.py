@@ -27,7 +27,6 @@ __all__ = [
     "positive_float",
     "angle_count",
     "out_dir",
-    "angle_tag",
     "circle",
     "Progress",
     "Terminated",
@@ -253,18 +252,8 @@ def out_dir(args, design_path: str) -> Path:
     return Path(args.out) if args.out else Path("output") / Path(design_path).stem
 
 
-def angle_tag(deg: float) -> str:
-    # angles closer than the tag's 1e-3 deg resolution share a file name: keep 6 decimals then
-    tag = f"{deg:+08.3f}"
-    if abs(round(deg, 3) - deg) > 1e-9:
-        tag = f"{deg:+011.6f}"
-    return tag.replace("+", "p").replace("-", "m").replace(".", "_")
-
-
 def circle(radius: float, tol: float):
-    import numpy as np
+    """The rim circle as a polygon within ``tol`` (mm): :func:`wgcad.plane.circle_polygon`."""
+    from ..plane import circle_polygon
 
-    step = 2.0 * np.arccos(max(-1.0, 1.0 - tol / radius))
-    n = max(64, int(np.ceil(2 * np.pi / step)))
-    t = np.linspace(0.0, 2 * np.pi, n, endpoint=False)
-    return np.stack([radius * np.cos(t), radius * np.sin(t)], axis=1)
+    return circle_polygon(radius, tol)
