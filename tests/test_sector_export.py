@@ -133,3 +133,23 @@ def test_full_heights_exit_1(tmp_path, capsys):
     so = capsys.readouterr().out
     assert code == 1 and "TIP-TO-TIP" in so
     assert not (tmp_path / "d4_sectored_sector_rigid.stl").exists()
+
+
+def test_library_call_writes_what_the_cli_wrote(run_sim, tmp_path):
+    # issue 20: the CLI only parses, calls and prints; a library user gets the same files
+    from wgcad.design import load_design
+    from wgcad.export.sector_files import write_sector_files
+    from wgcad.sector.run import run_sector
+
+    _, cli_out = run_sim
+    res = run_sector(load_design(D4), "simulated", None, 1.0, None)
+    summ, files = write_sector_files(res, D4, tmp_path, stl=False)
+    assert sorted(p.name for p in tmp_path.iterdir()) == sorted(p.name for p in files)
+    assert "d4_sectored_sector_rigid.stl" not in {p.name for p in files}
+    for p in files:
+        if p.suffix in (".csv", ".dxf"):
+            assert p.read_bytes() == (cli_out / p.name).read_bytes(), p.name
+    cli_summ = json.loads((cli_out / "d4_sectored_sector.json").read_text())
+    drop = ("timing_s", "audit_full_height", "audit_built")  # their run times differ
+    assert {k: v for k, v in summ.items() if k not in drop} == {k: v for k, v in cli_summ.items() if k not in drop}
+    assert summ["audit_built"]["min_tip_clearance_um"] == cli_summ["audit_built"]["min_tip_clearance_um"]
