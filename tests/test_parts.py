@@ -1,5 +1,6 @@
 """Tests of the part set (wgcad parts): every export read back and checked against the 2D areas, the plug against the law's neutral line, bad sizes refused with nothing written."""
 
+import json
 import re
 import shutil
 import subprocess
@@ -401,3 +402,20 @@ def test_sectored_design_gets_its_sectored_rigid_gear():
     assert mesh.is_volume and mesh.volume == pytest.approx(rigid.volume_mm3, rel=1e-4)
     pr = solid_props(rigid.solid())
     assert pr["valid"] and pr["volume"] == pytest.approx(rigid.volume_mm3, rel=1e-9)
+
+
+def test_library_call_writes_what_the_cli_wrote(small_run, tmp_path):
+    # issue 20: the CLI only parses, calls and prints; a library user gets the same files and report
+    from wgcad.export.part_files import write_part_files
+
+    out, _, drive = small_run
+    design = out.parent / "small.toml"
+    sizes = part_sizes(load_parts(design), drive)
+    res = write_part_files(drive, sizes, design, tmp_path, formats=("dxf", "stl"), generator_angles_deg=[30.0])
+    assert sorted(p.name for p in tmp_path.iterdir()) == sorted(p.name for p in res.files)
+    assert not any(p.suffix in (".step", ".svg", ".3mf") for p in res.files)
+    for p in res.files:
+        if p.suffix in (".dxf", ".stl"):
+            assert p.read_bytes() == (out / p.name).read_bytes(), p.name
+    cli = json.loads((out / "small_parts.json").read_text())
+    assert res.report["parts"] == cli["parts"] and res.report["sizes_mm"] == cli["sizes_mm"]
