@@ -106,6 +106,25 @@ def test_refused_samples_are_recorded_not_fatal(reference):
     assert np.isnan(reference["ke_pp_arcsec"][refused]).all() and np.isfinite(reference["ke_pp_arcsec"][~refused]).all()
 
 
+def test_shared_data_is_scattered_under_fresh_keys(client, tmp_path, monkeypatch):
+    # a dict scattered as is keeps its own keys as the futures' names ('design', 'ke_table', ...): a second run
+    # on the same client then asks for keys the scheduler is still releasing from the first ('lost dependencies',
+    # seen once in CI on the resume below). One future per run, under a key no run shares.
+    keys = []
+    scatter = client.scatter
+
+    def spy(data, **kw):
+        futs = scatter(data, **kw)
+        keys.extend([f.key for f in futs] if isinstance(futs, list) else [futs])
+        return futs
+
+    monkeypatch.setattr(client, "scatter", spy)
+    for k in range(2):
+        run_sweep(_spec(), tmp_path / str(k), client=client, batch=3, max_chunks=1)
+    assert len(keys) == 2 and all(isinstance(k, str) for k in keys) and keys[0] != keys[1], keys
+    assert not set(keys) & set(_spec().payload()), keys
+
+
 def test_resume_computes_only_the_missing_chunks(client, reference, tmp_path):
     first = run_sweep(_spec(), tmp_path, client=client, batch=2, max_chunks=2)
     assert first.stopped_early and first.computed == 4

@@ -180,7 +180,10 @@ def run_sweep(
         else:
             info.executor = f"Dask client {getattr(client.scheduler, 'address', '')}"
         info.workers = max(1, len(client.scheduler_info(n_workers=-1)["workers"]))
-        pf = client.scatter(payload, broadcast=True, hash=False)
+        # one future under a fresh key: scattering the dict itself would name each value by its dict key
+        # ('design', 'ke_table', ...), and a second run on the same client (a resume) would then ask for keys
+        # the scheduler is still releasing from the first: 'lost dependencies'
+        [pf] = client.scatter([payload], broadcast=True, hash=False)
         gaps = list(gaps)
         if not batch:
             # Dask's round trip: empty tasks, after one to warm the connection
