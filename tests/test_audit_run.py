@@ -77,3 +77,32 @@ def test_ke_as_a_library_call_gives_the_cli_document(tmp_path):
     run, lines = no_load(build_drive(design), Imperfections.from_spec(design.imperfections), 4, str(path))
     assert run.doc == json.loads(out.read_text())
     assert lines[0].startswith(design.drive.name) and "largest KE" in lines[2]
+
+
+def test_library_files_equal_the_clis(tmp_path):
+    # the files of `wgcad audit` from a library call: the baseline and the pictures byte-identical to the CLI's
+    from wgcad.export.audit_files import plot_paths, write_audit_files
+    from wgcad.report.audit_run import baseline_document
+
+    cli = tmp_path / "cli"
+    cli.mkdir()
+    args = ["audit", str(D4), "--step-deg", "2", "--quiet"]
+    code = main(
+        args + ["--write-baseline", str(cli / "b.json"), "--plot", str(cli / "p.png"), "--json", str(cli / "a.json")]
+    )
+    rs = RunSettings(step_deg=2.0)
+    run = audit_document(D4, rs, plot=True)
+    lib = tmp_path / "lib"
+    files = write_audit_files(
+        run,
+        json_path=lib / "a.json",
+        baseline=baseline_document(run, rs, str(D4)),
+        baseline_path=lib / "b.json",
+        plot=lib / "p.png",
+    )
+    names = ["a.json", "b.json"] + [p.name for _, p in plot_paths(lib / "p.png")]
+    assert [p.name for p in files] == names and sorted(p.name for p in lib.iterdir()) == sorted(names)
+    for name in names[1:]:
+        assert (lib / name).read_bytes() == (cli / name).read_bytes(), name
+    assert _strip(json.loads((lib / "a.json").read_text())) == _strip(json.loads((cli / "a.json").read_text()))
+    assert run.failed == (code == 1)

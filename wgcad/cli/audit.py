@@ -5,7 +5,6 @@ from __future__ import annotations
 import json
 import os
 import sys
-from pathlib import Path
 
 from .common import EXIT_INTERFERENCE, EXIT_OK, add_memory_flag, angle_count, epilog, positive_float, whole_number
 
@@ -16,11 +15,6 @@ def _audit_summary(name: str, res: dict) -> str:
     from ..report.audit import audit_summary  # shaped in the report layer (issue 8)
 
     return audit_summary(name, res)
-
-
-def _plot_paths(plot) -> list[tuple[str, Path]]:
-    p = Path(plot)
-    return [(suffix, p.with_name(f"{p.stem}_{suffix}.png")) for suffix in ("profile", "vs_angle", "tightest")]
 
 
 def _check_outputs(args) -> None:
@@ -36,7 +30,9 @@ def _check_outputs(args) -> None:
     if args.plot:
         if args.plot == STDOUT:
             raise OutputError("--plot: writes three PNG files, so it needs a path, not - (standard output)")
-        targets += [("--plot", p) for _, p in _plot_paths(args.plot)]
+        from ..export.audit_files import plot_paths
+
+        targets += [("--plot", p) for _, p in plot_paths(args.plot)]
     if args.html:
         if args.html == STDOUT:
             raise OutputError("--html: writes a page, so it needs a path, not - (standard output)")
@@ -105,7 +101,8 @@ def cmd_audit(args) -> int:
     rs.check(FLAGS)
     # the engine reports (done, total, stage); it fills the bar up to 90 % (95 % without pictures)
     work_end = 0.6 if args.plot else (0.9 if args.engine == "2d" else 0.8)
-    from ..report.audit_run import audit_document
+    from ..export.audit_files import write_audit_files
+    from ..report.audit_run import audit_document, baseline_document
 
     try:
         run = audit_document(
@@ -122,49 +119,23 @@ def cmd_audit(args) -> int:
         if exc.field in FLAGS:
             raise DesignError(FLAGS[exc.field], exc.rule) from None
         raise
-    drive, result, res, drifts = run.drive, run.result, run.doc, run.drifts
-    res_text = json.dumps(res, allow_nan=False, indent=2) + "\n"
-    base_text = None
-    if args.write_baseline:
-        from ..regression import make_baseline
-
-        doc = make_baseline(
-            str(args.design),
-            {
-                k: v
-                for k, v in rs.as_dict().items()
-                if k in ("step_deg", "sections", "chord_tol_um", "interference_tol_um")
-            },
-            drive,
-            res,
-        )
-        base_text = json.dumps(doc, allow_nan=False, indent=2) + "\n"
-    files = [(args.json, res_text), (args.write_baseline, base_text)]
-    if any(p and p != STDOUT for p, _ in files) or args.plot or args.html:
-        from ..atomic import atomic_batch
-
-        with atomic_batch() as batch:
-            for path, text in files:
-                if path and path != STDOUT:
-                    Path(batch.temp_path(path)).write_text(text)
-            if args.plot or args.html:
-                bar.set(0.9 if args.engine == "2d" else 0.95, "pictures")
-                from ..export.audit_figures import audit_plot_data, audit_pngs
-
-                data = audit_plot_data(drive, result)
-            if args.plot:
-                pngs = dict(audit_pngs(drive, result, data))
-                for suffix, path in _plot_paths(args.plot):
-                    Path(batch.temp_path(path)).write_bytes(pngs[suffix])
-            if args.html:
-                from ..export.html import audit_html
-
-                Path(batch.temp_path(args.html)).write_text(audit_html(drive, result, res, data), encoding="utf-8")
+    res, drifts = run.doc, run.drifts
+    base_doc = baseline_document(run, rs, args.design) if args.write_baseline else None
+    write_audit_files(
+        run,
+        json_path=args.json if args.json != STDOUT else None,
+        baseline=base_doc,
+        baseline_path=args.write_baseline if args.write_baseline != STDOUT else None,
+        plot=args.plot,
+        html=args.html,
+        on_pictures=lambda: bar.set(0.9 if args.engine == "2d" else 0.95, "pictures"),
+    )
     bar.set(1.0, "done")
     bar.close()
-    for path, text in files:
-        if path == STDOUT:
-            write_stdout(text)
+    if args.json == STDOUT:
+        write_stdout(json.dumps(res, allow_nan=False, indent=2) + "\n")
+    if args.write_baseline == STDOUT:
+        write_stdout(json.dumps(base_doc, allow_nan=False, indent=2) + "\n")
     if not args.quiet:
         # with a JSON document on stdout, the summary for people goes to stderr
         stream = sys.stderr if STDOUT in (args.json, args.write_baseline) else sys.stdout

@@ -13,7 +13,7 @@ from ..audit import RunSettings, run_audit
 from .audit import audit_json
 from .notes import not_modelled
 
-__all__ = ["AuditRun", "audit_document", "imperfect_not_checked"]
+__all__ = ["AuditRun", "audit_document", "baseline_document", "imperfect_not_checked"]
 
 
 @dataclass
@@ -108,3 +108,14 @@ def audit_document(
         drifts = compare(baseline, baseline_figures(drive, doc))
         doc["baseline"] = {"path": str(baseline_path), "drifts": [d.__dict__ for d in drifts]}
     return AuditRun(drive, result, doc, drifts)
+
+
+def baseline_document(run: AuditRun, settings, design_source: str) -> dict:
+    """The geometry regression baseline of the audit ``run`` (what ``wgcad audit --write-baseline`` writes): its
+    figures with the run settings a later comparison must repeat (:class:`wgcad.audit.RunSettings` ``settings``)."""
+    from ..regression import make_baseline
+
+    kept = ("step_deg", "sections", "chord_tol_um", "interference_tol_um")
+    return make_baseline(
+        str(design_source), {k: v for k, v in settings.as_dict().items() if k in kept}, run.drive, run.doc
+    )
