@@ -53,6 +53,84 @@ class DriveFiles:
     kept: list
 
 
+def _judge_targets(out: Path, source: Path, angles, stl: bool, force: bool):
+    """The folder's manifest for the design, once every file the run writes is judged writable."""
+    from ..atomic import check_target
+    from ..errors import OutputError
+    from .manifest import Manifest
+
+    manifest = Manifest(out, source.stem, source)
+    manifest.check_collision(force)
+    # every file this run will write is judged before any work: a device, FIFO, folder or link in the way stops
+    # the run now, not after minutes of computing
+    for name in planned_names(source.stem, angles, stl):
+        check_target(out / name)
+        if (out / name).exists() and os.path.samefile(out / name, source):
+            raise OutputError(f"{out / name}: is the design file itself; it would be overwritten (give another --out)")
+    return manifest
+
+
+def _report(drive) -> tuple[dict, object]:
+    """The drive's report document and the errors its deformed assembly is drawn with (None: perfect parts)."""
+    from ..report import drive_report
+    from ..report.notes import not_modelled
+
+    design = drive.design
+    rep = drive_report(drive)
+    # the deformed assembly places the parts with their errors (rigid gear fixed: docs/models.md 6.2); the gears'
+    # own DXF and STL stay nominal, the part a shop makes
+    imp = None
+    if design.imperfections.any and design.drive.fixed == "rigid":
+        from ..placement.imperfect import Imperfections
+
+        imp = Imperfections.from_spec(design.imperfections)
+    rep["not_modelled"] = not_modelled(design, "generate", imperfections=imp is not None)
+    if imp is not None:
+        rep["imperfections"] = (
+            "the deformed-assembly DXF/PNG (--generator-angle) place every tooth with its [imperfections]; "
+            "the gears' DXF and STL are the nominal parts"
+        )
+    return rep, imp
+
+
+def _gear_solid(drive, gear, outline, rim: float):
+    """The gear's solid over the face width: its exported outline and its rim circle, whichever is inside."""
+    from .stl import ring_solid
+
+    rim_circle = circle_polygon(rim, drive.tol)
+    if rim < min(gear.r_a, gear.r_f):  # bore inside the teeth
+        return ring_solid(outline, [rim_circle], drive.design.drive.face_width)
+    return ring_solid(rim_circle, [outline], drive.design.drive.face_width)  # teeth inside a ring
+
+
+def _deformed_layers(drive, scene) -> list:
+    """The deformed assembly's DXF layers at one generator angle."""
+    from .dxf import DxfLayer
+
+    return [
+        DxfLayer("RIGID", outlines=(scene["rigid_outline"],), color=1),
+        DxfLayer("RIGID_RIM", circles=((0.0, 0.0, drive.rigid_rim_radius),), color=1),
+        DxfLayer("FLEXSPLINE_DEFORMED", outlines=(scene["flex_outline"],), color=5),
+        DxfLayer("FLEXSPLINE_RIM_DEFORMED", outlines=(scene["flex_rim"],), color=5),
+        DxfLayer("NEUTRAL_LINE", outlines=(scene["neutral"],), color=3),
+    ]
+
+
+def _deformed_png(drive, scene, deg: float, imperfect: bool) -> bytes:
+    """The deformed assembly's picture at the generator angle ``deg``."""
+    from .figures import assembly_png
+
+    d = drive.design
+    return assembly_png(
+        scene,
+        f"{d.drive.name}: generator at {deg:g} deg counter-clockwise from +x "
+        f"({d.generator.law} law, W0 = {d.w0:.3f} mm"
+        + (", generator's centre section" if drive.coned else "")
+        + (", parts with their [imperfections])" if imperfect else ")"),
+        entry_deg=scene["entry_deg"],
+    )
+
+
 def write_drive_files(
     drive, source, out, *, angles_deg=(), stl: bool = True, force: bool = False, progress=None
 ) -> DriveFiles:
@@ -64,15 +142,12 @@ def write_drive_files(
     run's files this run does not write again. ``progress(fraction, stage)`` follows the work."""
     import numpy as np
 
-    from ..atomic import atomic_batch, check_target
-    from ..errors import OutputError
-    from ..report import drive_report
-    from ..report.notes import not_modelled
+    from ..atomic import atomic_batch
+    from ..profiles.band import gear_band_outline
     from .dxf import DxfLayer, write_dxf
-    from .manifest import Manifest, manifest_name
+    from .manifest import manifest_name
 
     tick = progress or (lambda f, stage: None)
-    design = drive.design
     out, source = Path(out), Path(source)
     angles = [float(a) for a in angles_deg]
     stem = source.stem
@@ -90,42 +165,19 @@ def write_drive_files(
         done += cost
         tick(done / total, next_stage)
 
-    manifest = Manifest(out, stem, source)
-    manifest.check_collision(force)
-    # every file this run will write is judged before any work: a device, FIFO, folder or link in the way stops
-    # the run now, not after minutes of computing
-    for name in planned_names(stem, angles, stl):
-        check_target(out / name)
-        if (out / name).exists() and os.path.samefile(out / name, source):
-            raise OutputError(f"{out / name}: is the design file itself; it would be overwritten (give another --out)")
-
+    manifest = _judge_targets(out, source, angles, stl, force)
     step(_COST["design"], "DXF")
-    f, b = drive.flex, drive.rigid
-    from ..profiles.band import gear_band_outline
-
+    gears = {"flexspline": (drive.flex, drive.flex_rim_radius), "rigid": (drive.rigid, drive.rigid_rim_radius)}
     # the exported outlines run in a symmetric band around the exact curves (docs/models.md, appendix A): chords
     # through curve points would make every convex flank thin, every space narrow
-    band = {"flexspline": gear_band_outline(f), "rigid": gear_band_outline(b)}
+    band = {name: gear_band_outline(gear) for name, (gear, _) in gears.items()}
     layers = [
         DxfLayer("FLEXSPLINE", outlines=(band["flexspline"],), color=5),
         DxfLayer("FLEXSPLINE_RIM", circles=((0.0, 0.0, drive.flex_rim_radius),), color=5),
         DxfLayer("RIGID", outlines=(band["rigid"],), color=1),
         DxfLayer("RIGID_RIM", circles=((0.0, 0.0, drive.rigid_rim_radius),), color=1),
     ]
-    rep = drive_report(drive)
-    # the deformed assembly places the parts with their errors (rigid gear fixed: docs/models.md 6.2); the gears'
-    # own DXF and STL stay nominal, the part a shop makes
-    imp = None
-    if design.imperfections.any and design.drive.fixed == "rigid":
-        from ..placement.imperfect import Imperfections
-
-        imp = Imperfections.from_spec(design.imperfections)
-    rep["not_modelled"] = not_modelled(design, "generate", imperfections=imp is not None)
-    if imp is not None:
-        rep["imperfections"] = (
-            "the deformed-assembly DXF/PNG (--generator-angle) place every tooth with its [imperfections]; "
-            "the gears' DXF and STL are the nominal parts"
-        )
+    rep, imp = _report(drive)
     files = []
     with atomic_batch() as batch:
         path = out / f"{stem}.dxf"
@@ -133,16 +185,11 @@ def write_drive_files(
         files.append(path)
         step(_COST["dxf"], "STL")
         if stl:
-            from .stl import ring_solid, write_stl
+            from .stl import write_stl
 
-            bw = design.drive.face_width
-            for name, gear, rim in (("flexspline", f, drive.flex_rim_radius), ("rigid", b, drive.rigid_rim_radius)):
+            for name, (gear, rim) in gears.items():
                 tick(done / total, f"STL {name}")
-                rim_circle = circle_polygon(rim, drive.tol)
-                if rim < min(gear.r_a, gear.r_f):  # bore inside the teeth
-                    mesh = ring_solid(band[name], [rim_circle], bw)
-                else:  # teeth inside a ring
-                    mesh = ring_solid(rim_circle, [band[name]], bw)
+                mesh = _gear_solid(drive, gear, band[name], rim)
                 rep[name]["solid_volume_mm3"] = round(float(mesh.volume), 4)
                 path = out / f"{stem}_{name}.stl"
                 write_stl(batch.temp_path(path), mesh)
@@ -150,32 +197,15 @@ def write_drive_files(
                 step(_COST["stl"], f"STL {name}")
         if angles:
             from ..report.deformed import deformed_scene
-            from .figures import assembly_png
         for deg in angles:
             tick(done / total, f"{deg:g} deg: DXF")
             scene = deformed_scene(drive, np.deg2rad(deg), imp)
-            tag = angle_tag(deg)
-            dl = [
-                DxfLayer("RIGID", outlines=(scene["rigid_outline"],), color=1),
-                DxfLayer("RIGID_RIM", circles=((0.0, 0.0, drive.rigid_rim_radius),), color=1),
-                DxfLayer("FLEXSPLINE_DEFORMED", outlines=(scene["flex_outline"],), color=5),
-                DxfLayer("FLEXSPLINE_RIM_DEFORMED", outlines=(scene["flex_rim"],), color=5),
-                DxfLayer("NEUTRAL_LINE", outlines=(scene["neutral"],), color=3),
-            ]
-            path = out / f"{stem}_phi{tag}.dxf"
-            write_dxf(batch.temp_path(path), dl)
+            path = out / f"{stem}_phi{angle_tag(deg)}.dxf"
+            write_dxf(batch.temp_path(path), _deformed_layers(drive, scene))
             files.append(path)
             step(_COST["angle_dxf"], f"{deg:g} deg: picture")
-            png = assembly_png(
-                scene,
-                f"{design.drive.name}: generator at {deg:g} deg counter-clockwise from +x "
-                f"({design.generator.law} law, W0 = {design.w0:.3f} mm"
-                + (", generator's centre section" if drive.coned else "")
-                + (", parts with their [imperfections])" if imp is not None else ")"),
-                entry_deg=scene["entry_deg"],
-            )
-            path = out / f"{stem}_phi{tag}.png"
-            Path(batch.temp_path(path)).write_bytes(png)
+            path = out / f"{stem}_phi{angle_tag(deg)}.png"
+            Path(batch.temp_path(path)).write_bytes(_deformed_png(drive, scene, deg, imp is not None))
             files.append(path)
             step(_COST["angle_png"], f"{deg:g} deg: picture")
         tick(done / total, "report")
@@ -183,9 +213,7 @@ def write_drive_files(
         report_path = out / report_name(stem)
         rep["files"] = [p.name for p in files] + [report_path.name]
         # no timings in the report: the same design must give byte-identical files
-        Path(batch.temp_path(report_path)).write_text(
-            json.dumps(rep, allow_nan=False, indent=2, sort_keys=False) + "\n"
-        )
+        Path(batch.temp_path(report_path)).write_text(json.dumps(rep, allow_nan=False, indent=2) + "\n")
         files.append(report_path)
         # the previous run's files for this design that this run does not write again go with the commit
         stale, kept = manifest.stale_files(p.name for p in files)
