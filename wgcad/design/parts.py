@@ -139,6 +139,18 @@ def part_sizes(spec: PartsSpec, drive) -> PartSizes:
         thicker than the rim, a bearing that does not fit the plug (or a
         plug bore larger than the plug).
     """
+    v, derived, rules = _derive(spec, drive)
+    _check_fits(v, drive)
+    notes = _bolt_notes(v, drive, rules)
+    ext = drive.external
+    used = _used_keys(ext)
+    rules = {k: t for k, t in rules.items() if k in derived and k in used}
+    return PartSizes(v, tuple(k for k in derived if k in used), rules, used, tuple(notes))
+
+
+def _derive(spec: PartsSpec, drive) -> tuple[dict, list, dict]:
+    """Every size: given in ``[parts]`` or derived (see :func:`part_sizes`); with the derived keys in order and the
+    rule each bolt size was chosen by."""
     d = drive.design
     bw = d.drive.face_width
     h1 = d.flexspline.rim_thickness
@@ -158,11 +170,10 @@ def part_sizes(spec: PartsSpec, drive) -> PartSizes:
     default("shell_thickness", _r(0.7 * h1, 0.05))
     default("diaphragm_thickness", _r(1.5 * v["shell_thickness"], 0.05))
     default("hub_bore_diameter", _r(0.5 * r_in))
-    from .bolting import RULE, carry, choose_bolts
+    from .bolting import choose_bolts
 
     torque = d.load.rated_torque_nm
     rules = {}
-    notes = []
     cup_keys = ("cup_bolt_circle_diameter", "cup_bolt_count", "cup_bolt_hole_diameter")
     if not ext and torque and all(v[k] is None for k in cup_keys):
         # the cup's bolts carry the output torque into the output shaft (wgcad.design.bolting)
@@ -220,8 +231,18 @@ def part_sizes(spec: PartsSpec, drive) -> PartSizes:
     for k in (k for k in fl_keys if k in derived):
         rules.setdefault(k, geometry)
     default("flange_thickness", _r(min(bw, max(0.3 * bw, 1.5 * dh))))
+    return v, derived, rules
 
-    # --- rules (each names the key the user sets) ---
+
+def _check_fits(v: dict, drive) -> None:
+    """The fit rules of the sizes ``v``, each error naming the key the user sets."""
+    d = drive.design
+    bw = d.drive.face_width
+    h1 = d.flexspline.rim_thickness
+    ext = drive.external
+    r_in = drive.flex_rim_radius
+    R_rim = drive.rigid_rim_radius
+    dh = v["flange_bolt_hole_diameter"]
     if v["shell_thickness"] > h1:
         raise DesignError(
             "parts.shell_thickness",
@@ -286,6 +307,17 @@ def part_sizes(spec: PartsSpec, drive) -> PartSizes:
         )
     if v["bearing_width"] > (v["cup_length"] if not ext else bw):
         raise DesignError("parts.bearing_width", f"{v['bearing_width']:g} mm is longer than the cup")
+
+
+def _bolt_notes(v: dict, drive, rules: dict) -> list[str]:
+    """Warnings on bolt circles the user gave: a ligament under half a hole, bolts that slip under the rated torque."""
+    from .bolting import RULE, carry
+
+    ext = drive.external
+    r_in = drive.flex_rim_radius
+    R_rim = drive.rigid_rim_radius
+    torque = drive.design.load.rated_torque_nm
+    notes = []
     # given bolt circles: whether they carry the rated torque, and their ligaments (warnings: the user chose them)
     from .bolting import METRIC, SLIP_SAFETY
 
@@ -311,9 +343,7 @@ def part_sizes(spec: PartsSpec, drive) -> PartSizes:
                     f"{prefix} bolts ({n} of the largest metric bolt a {hole:g} mm hole takes) slip at "
                     f"{cap:.0f} N m, less than {SLIP_SAFETY:g} x the rated {torque:g} N m ({RULE})"
                 )
-    used = _used_keys(ext)
-    rules = {k: t for k, t in rules.items() if k in derived and k in used}
-    return PartSizes(v, tuple(k for k in derived if k in used), rules, used, tuple(notes))
+    return notes
 
 
 def _floor(x: float, step: float = 0.05) -> float:
