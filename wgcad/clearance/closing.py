@@ -70,6 +70,133 @@ def _turn(rot, shift, t):
     return rot + t, np.stack([c * shift[:, 0] - s * shift[:, 1], s * shift[:, 0] + c * shift[:, 1]], axis=-1)
 
 
+class _Pairs:
+    """K tooth pairs: the rigid teeth fixed, the flexspline teeth turned about the axis in direction ``side``."""
+
+    def __init__(self, flex: Template, rot, shift, rigid: Template, rot_b, shift_b, side: float):
+        self.flex, self.rigid, self.side = flex, rigid, side
+        self.rot = np.asarray(rot, dtype=float)
+        K = len(self.rot)
+        self.shift = np.asarray(shift, dtype=float).reshape(K, 2)
+        self.rot_b = np.broadcast_to(np.asarray(rot_b, dtype=float), (K,))
+        self.shift_b = np.asarray(shift_b, dtype=float).reshape(K, 2)
+        self.rigid_g = shapely.polygons(transform(rigid.local, self.rot_b, self.shift_b))
+        #: the largest distance of a flexspline outline point from the axis, mm
+        self.lever = (
+            float(np.hypot(self.shift[:, 0], self.shift[:, 1]).max() + np.hypot(*flex.local.T).max()) if K else 1.0
+        )
+
+    def measure(self, t, idx):
+        """Signed gap at rotation t of pairs idx, and nearest points where apart."""
+        r, sh = _turn(self.rot[idx], self.shift[idx], self.side * t)
+        geo = shapely.polygons(transform(self.flex.local, r, sh))
+        line = shapely.get_coordinates(shapely.shortest_line(geo, self.rigid_g[idx])).reshape(-1, 2, 2)
+        d = np.hypot(*(line[:, 1] - line[:, 0]).T)
+        over = np.nonzero(d == 0.0)[0]
+        if over.size:
+            d[over] = signed_clearance(
+                self.flex,
+                r[over],
+                sh[over],
+                self.rigid,
+                self.rot_b[idx][over],
+                self.shift_b[idx][over],
+                b_geoms=self.rigid_g[idx][over],
+                a_geoms=geo[over],
+            )
+            d[over] = np.minimum(d[over], -1e-15)
+        return d, line
+
+    def closing_rate(self, pp, qq, dd):
+        """Unit normals ``n`` from ``pp`` to ``qq`` (gap ``dd``) and the rate ``s (z x p) . n`` the gap falls at."""
+        n = (qq - pp) / dd[:, None]
+        return n, self.side * (-pp[:, 1] * n[:, 0] + pp[:, 0] * n[:, 1])
+
+
+class _Bracket:
+    """The safeguarded Newton search's state per pair: the largest rotation known apart and the smallest known
+    overlapping (with their gaps), the side of the last update (Illinois), the contact data of the last apart
+    iterate, and whether a pair is done and found."""
+
+    def __init__(self, K: int):
+        self.lo_t = np.full(K, -np.inf)
+        self.lo_d = np.full(K, np.nan)
+        self.hi_t = np.full(K, np.inf)
+        self.hi_d = np.full(K, np.nan)
+        self.last = np.zeros(K, dtype=int)
+        self.ok = np.ones(K, dtype=bool)
+        self.done = np.zeros(K, dtype=bool)
+        self.p = np.full((K, 2), np.nan)
+        self.q = np.full((K, 2), np.nan)
+        self.nt = np.full((K, 2), np.nan)
+
+    def overlapping(self, ia, t, d):
+        """Pairs ``ia`` overlap at ``t``: a new upper end of their bracket."""
+        self.hi_t[ia], self.hi_d[ia] = t[ia], d
+        self.lo_d[ia[self.last[ia] == -1]] *= 0.5
+        self.last[ia] = -1
+
+    def apart(self, ib, t, d, line, pairs: _Pairs):
+        """Pairs ``ib`` apart at ``t`` with gaps ``d``: a new lower end, their contact data; the Newton steps."""
+        pp, qq = line[:, 0], line[:, 1]
+        n, rate = pairs.closing_rate(pp, qq, d)
+        self.lo_t[ib], self.lo_d[ib] = t[ib], d
+        self.hi_d[ib[self.last[ib] == 1]] *= 0.5
+        self.last[ib] = 1
+        self.p[ib], self.q[ib] = pp, qq
+        with np.errstate(divide="ignore", invalid="ignore"):
+            self.nt[ib] = n / rate[:, None]
+        fin = d < GAP_TOL
+        self.done[ib[fin]] = True
+        stuck = (rate <= 1e-6 * pairs.lever) & ~fin & ~np.isfinite(self.hi_t[ib])
+        self.ok[ib[stuck]] = False
+        self.done[ib[stuck]] = True
+        return np.where(rate > 1e-6 * pairs.lever, d / np.maximum(rate, 1e-300), np.inf)
+
+    def next_rotation(self, t, ia, ib, step_n, lever: float, reach: float):
+        """The next rotation of every pair still going (regula falsi where Newton leaves the bracket)."""
+        nxt = t.copy()
+        if ib.size:
+            nxt[ib] = t[ib] + step_n
+        if ia.size:
+            no_lo = ~np.isfinite(self.lo_t[ia])
+            # overlapping from the start: turn back by twice the depth over the lever arm
+            nxt[ia[no_lo]] = t[ia[no_lo]] + 4.0 * self.hi_d[ia[no_lo]] / lever - 1e-7
+        lo_t, hi_t = self.lo_t, self.hi_t
+        br = np.isfinite(lo_t) & np.isfinite(hi_t)
+        rf = lo_t + self.lo_d * (hi_t - lo_t) / (self.lo_d - self.hi_d)
+        use_rf = br & ((nxt >= hi_t) | (nxt <= lo_t) | (self.last == -1))
+        nxt = np.where(use_rf, rf, nxt)
+        tight = br & ((hi_t - lo_t) * lever < 0.1 * GAP_TOL)
+        self.done |= tight & np.isfinite(self.lo_d)
+        far = np.abs(nxt) > reach  # beyond reach either way (turned back past a neighbour: a jam)
+        self.ok[far & ~self.done] = False
+        self.done |= far
+        return np.where(self.done, t, nxt)
+
+
+def _backed_off_contacts(pairs: _Pairs, br: _Bracket, delta) -> None:
+    """Read each found contact's nearest points and ``nt`` at the gap BACKOFF before it touches.
+
+    Rather than at the iterate the search happened to end on: where a corner meets the other outline (or a
+    vertex a vertex) the nearest-point direction at a vanishing gap depends on the path the search took (two
+    searches of one contact from different starts gave normals up to 90 % apart; on D2 [S4] 11 % of the KE
+    samples were up to 35 arcsec off the direct computation); at a fixed gap just before touching it is the
+    direction the contact closes along."""
+    back = np.nonzero(br.ok & np.all(np.isfinite(br.nt), axis=1))[0]
+    if not back.size:
+        return
+    tb = delta[back] - BACKOFF * np.hypot(br.nt[back, 0], br.nt[back, 1])
+    d, line = pairs.measure(tb, back)
+    good = d > 0.25 * BACKOFF
+    b = back[good]
+    pp, qq, dd = line[good, 0], line[good, 1], d[good]
+    n, rate = pairs.closing_rate(pp, qq, dd)
+    fine = rate > 1e-6 * pairs.lever
+    b, pp, qq, n, rate = b[fine], pp[fine], qq[fine], n[fine], rate[fine]
+    br.p[b], br.q[b], br.nt[b] = pp, qq, n / rate[:, None]
+
+
 def closing_rotation(
     flex: Template,
     rot,
@@ -116,117 +243,27 @@ def closing_rotation(
     -------
     Contact
     """
-    rot = np.asarray(rot, dtype=float)
-    K = len(rot)
-    shift = np.asarray(shift, dtype=float).reshape(K, 2)
-    rot_b = np.broadcast_to(np.asarray(rot_b, dtype=float), (K,))
-    shift_b = np.asarray(shift_b, dtype=float).reshape(K, 2)
-    rigid_g = shapely.polygons(transform(rigid.local, rot_b, shift_b))
-    lever = float(np.hypot(shift[:, 0], shift[:, 1]).max() + np.hypot(*flex.local.T).max()) if K else 1.0
-
-    def measure(t, idx):
-        """Signed gap at rotation t of pairs idx, and nearest points where apart."""
-        r, sh = _turn(rot[idx], shift[idx], side * t)
-        geo = shapely.polygons(transform(flex.local, r, sh))
-        line = shapely.get_coordinates(shapely.shortest_line(geo, rigid_g[idx])).reshape(-1, 2, 2)
-        d = np.hypot(*(line[:, 1] - line[:, 0]).T)
-        over = np.nonzero(d == 0.0)[0]
-        if over.size:
-            d[over] = signed_clearance(
-                flex,
-                r[over],
-                sh[over],
-                rigid,
-                rot_b[idx][over],
-                shift_b[idx][over],
-                b_geoms=rigid_g[idx][over],
-                a_geoms=geo[over],
-            )
-            d[over] = np.minimum(d[over], -1e-15)
-        return d, line
-
+    pairs = _Pairs(flex, rot, shift, rigid, rot_b, shift_b, side)
+    K = len(pairs.rot)
     t = np.zeros(K) if start is None else np.array(np.broadcast_to(np.asarray(start, dtype=float), (K,)))
-    lo_t = np.full(K, -np.inf)  # largest rotation known apart, and its gap
-    lo_d = np.full(K, np.nan)
-    hi_t = np.full(K, np.inf)  # smallest rotation known overlapping, and its (negative) gap
-    hi_d = np.full(K, np.nan)
-    last = np.zeros(K, dtype=int)  # side of the previous bracket update (Illinois)
-    ok = np.ones(K, dtype=bool)
-    done = np.zeros(K, dtype=bool)
-    p = np.full((K, 2), np.nan)
-    q = np.full((K, 2), np.nan)
-    nt = np.full((K, 2), np.nan)
+    br = _Bracket(K)
     active = np.arange(K)
     for _ in range(MAX_ITER):
         if active.size == 0:
             break
-        d, line = measure(t[active], active)
+        d, line = pairs.measure(t[active], active)
         apart = d > 0.0
-        # overlapping: new upper end of the bracket
-        ia = active[~apart]
+        ia, ib = active[~apart], active[apart]
         if ia.size:
-            hi_t[ia], hi_d[ia] = t[ia], d[~apart]
-            lo_d[ia[last[ia] == -1]] *= 0.5
-            last[ia] = -1
-        ib = active[apart]
-        rate = np.zeros(0)
-        if ib.size:
-            dd = d[apart]
-            pp, qq = line[apart, 0], line[apart, 1]
-            n = (qq - pp) / dd[:, None]
-            rate = side * (-pp[:, 1] * n[:, 0] + pp[:, 0] * n[:, 1])  # s (z x p) . n
-            lo_t[ib], lo_d[ib] = t[ib], dd
-            hi_d[ib[last[ib] == 1]] *= 0.5
-            last[ib] = 1
-            p[ib], q[ib] = pp, qq
-            with np.errstate(divide="ignore", invalid="ignore"):
-                nt[ib] = n / rate[:, None]
-            fin = dd < GAP_TOL
-            done[ib[fin]] = True
-            stuck = (rate <= 1e-6 * lever) & ~fin & ~np.isfinite(hi_t[ib])
-            ok[ib[stuck]] = False
-            done[ib[stuck]] = True
-            step_n = np.where(rate > 1e-6 * lever, dd / np.maximum(rate, 1e-300), np.inf)
-        # next rotation of every pair still going
-        nxt = t.copy()
-        if ib.size:
-            nxt[ib] = t[ib] + step_n
-        if ia.size:
-            no_lo = ~np.isfinite(lo_t[ia])
-            # overlapping from the start: turn back by twice the depth over the lever arm
-            nxt[ia[no_lo]] = t[ia[no_lo]] + 4.0 * hi_d[ia[no_lo]] / lever - 1e-7
-        br = np.isfinite(lo_t) & np.isfinite(hi_t)
-        rf = lo_t + lo_d * (hi_t - lo_t) / (lo_d - hi_d)
-        use_rf = br & ((nxt >= hi_t) | (nxt <= lo_t) | (last == -1))
-        nxt = np.where(use_rf, rf, nxt)
-        tight = br & ((hi_t - lo_t) * lever < 0.1 * GAP_TOL)
-        done |= tight & np.isfinite(lo_d)
-        far = np.abs(nxt) > reach  # beyond reach either way (turned back past a neighbour: a jam)
-        ok[far & ~done] = False
-        done |= far
-        t = np.where(done, t, nxt)
-        active = np.nonzero(~done)[0]
-    ok[active] = False  # not converged
-    delta = np.where(ok, lo_t, np.inf)
-    # The contact's data from the nearest points at a fixed small gap, BACKOFF, rather than at the
-    # iterate the search happened to end on: where a corner meets the other outline (or a vertex a
-    # vertex) the nearest-point direction at a vanishing gap depends on the path the search took
-    # (two searches of one contact from different starts gave normals up to 90 % apart; on D2 [S4]
-    # 11 % of the KE samples were up to 35 arcsec off the direct computation);
-    # at a fixed gap just before touching it is the direction the contact closes along.
-    back = np.nonzero(ok & np.all(np.isfinite(nt), axis=1))[0]
-    if back.size and contact_data:
-        tb = delta[back] - BACKOFF * np.hypot(nt[back, 0], nt[back, 1])
-        d, line = measure(tb, back)
-        good = d > 0.25 * BACKOFF
-        b = back[good]
-        pp, qq, dd = line[good, 0], line[good, 1], d[good]
-        n = (qq - pp) / dd[:, None]
-        rate = side * (-pp[:, 1] * n[:, 0] + pp[:, 0] * n[:, 1])
-        fine = rate > 1e-6 * lever
-        b, pp, qq, n, rate = b[fine], pp[fine], qq[fine], n[fine], rate[fine]
-        p[b], q[b], nt[b] = pp, qq, n / rate[:, None]
-    return Contact(delta, p, q, nt, ok)
+            br.overlapping(ia, t, d[~apart])
+        step_n = br.apart(ib, t, d[apart], line[apart], pairs) if ib.size else None
+        t = br.next_rotation(t, ia, ib, step_n, pairs.lever, reach)
+        active = np.nonzero(~br.done)[0]
+    br.ok[active] = False  # not converged
+    delta = np.where(br.ok, br.lo_t, np.inf)
+    if contact_data:
+        _backed_off_contacts(pairs, br, delta)
+    return Contact(delta, br.p, br.q, br.nt, br.ok)
 
 
 def closing_direct(drive, imp: Imperfections, phi_h: float, side: int, sections=None) -> float:
