@@ -163,22 +163,7 @@ def run_sweep(
         return info
     cluster = own = None
     try:
-        if client is None:
-            from distributed import Client
-
-            if scheduler is not None:
-                try:
-                    client = own = Client(scheduler, timeout="20s")
-                except (OSError, TimeoutError) as e:
-                    raise WgcadError(f"--scheduler {scheduler}: cannot reach the Dask scheduler ({e})") from None
-                info.executor = f"Dask scheduler {scheduler}"
-            else:
-                n = workers or max(1, min(os.cpu_count() or 1, 64))
-                cluster = local_cluster(n)
-                client = own = Client(cluster)
-                info.executor = f"Dask LocalCluster, {n} processes on loopback"
-        else:
-            info.executor = f"Dask client {getattr(client.scheduler, 'address', '')}"
+        client, own, cluster = _connect(client, scheduler, workers, info)
         info.workers = max(1, len(client.scheduler_info(n_workers=-1)["workers"]))
         # one future under a fresh key: scattering the dict itself would name each value by its dict key
         # ('design', 'ke_table', ...), and a second run on the same client (a resume) would then ask for keys
@@ -186,49 +171,12 @@ def run_sweep(
         [pf] = client.scatter([payload], broadcast=True, hash=False)
         gaps = list(gaps)
         if not batch:
-            # Dask's round trip: empty tasks, after one to warm the connection
-            client.submit(noop, 0, pure=False).result()
-            rt = []
-            for k in range(5):
-                s = time.perf_counter()
-                client.submit(noop, k, pure=False).result()
-                rt.append(time.perf_counter() - s)
-            info.overhead_s = statistics.median(rt)
-            # one sample's time: a probe of a few samples (the first pays for the shared data)
-            a, b = gaps[0]
-            pb = min(3, b - a)
-            tick("probe task (builds the shared data)")
-            res = client.submit(_timed_batch, pf, a, a + pb, pure=False).result()
-            ts = res.pop("sample_s")
-            info.sample_s = statistics.mean(ts[1:]) if len(ts) > 1 else ts[0]
-            stop = stored(res)
-            gaps[0] = (a + pb, b)
-            if a + pb == b:
-                gaps.pop(0)
-            if stop:
+            if _probe(client, pf, gaps, info, stored, tick):
                 info.stopped_early = bool(gaps)
                 return info
-            batch = plan_batch(info.sample_s, info.overhead_s, remaining - pb, info.workers)
+            batch = plan_batch(info.sample_s, info.overhead_s, sum(b - a for a, b in gaps), info.workers)
         info.batch = batch
-        from distributed import as_completed
-
-        futs = [client.submit(run_batch, pf, a, b, pure=False, retries=1) for a, b in _ranges(gaps, batch)]
-        ac = as_completed(futs)
-        try:
-            for f in ac:
-                try:
-                    res = f.result()
-                except Exception as e:  # noqa: BLE001 - KilledWorker, lost scheduler, CommClosedError...
-                    raise ClusterError(
-                        f"a Dask task failed ({type(e).__name__}: {' '.join(str(e).split())[:200]}); "
-                        f"{info.chunks_written} chunks stored this run are kept: run again to resume"
-                    ) from e
-                if stored(res):
-                    info.stopped_early = info.computed + info.skipped < spec.total
-                    break
-        finally:
-            for f in futs:
-                f.cancel()
+        _collect(client, pf, gaps, batch, info, stored, spec.total)
     finally:
         info.wall_s = time.perf_counter() - t0
         if own is not None:
@@ -236,6 +184,75 @@ def run_sweep(
         if cluster is not None:
             cluster.close()
     return info
+
+
+def _connect(client, scheduler, workers, info: RunInfo):
+    """``(client, client this run opened, cluster this run started)``: the given client, one to ``scheduler``, or a
+    new LocalCluster of ``workers`` processes; ``info.executor`` says which."""
+    if client is not None:
+        info.executor = f"Dask client {getattr(client.scheduler, 'address', '')}"
+        return client, None, None
+    from distributed import Client
+
+    if scheduler is not None:
+        try:
+            own = Client(scheduler, timeout="20s")
+        except (OSError, TimeoutError) as e:
+            raise WgcadError(f"--scheduler {scheduler}: cannot reach the Dask scheduler ({e})") from None
+        info.executor = f"Dask scheduler {scheduler}"
+        return own, own, None
+    n = workers or max(1, min(os.cpu_count() or 1, 64))
+    cluster = local_cluster(n)
+    own = Client(cluster)
+    info.executor = f"Dask LocalCluster, {n} processes on loopback"
+    return own, own, cluster
+
+
+def _probe(client, pf, gaps: list, info: RunInfo, stored, tick) -> bool:
+    """Measure Dask's round trip (empty tasks, after one to warm the connection) and one sample's time (a probe
+    task of a few samples, whose first pays for the shared data), storing the probe's samples and taking them
+    off ``gaps``; True when the store says stop."""
+    client.submit(noop, 0, pure=False).result()
+    rt = []
+    for k in range(5):
+        s = time.perf_counter()
+        client.submit(noop, k, pure=False).result()
+        rt.append(time.perf_counter() - s)
+    info.overhead_s = statistics.median(rt)
+    a, b = gaps[0]
+    pb = min(3, b - a)
+    tick("probe task (builds the shared data)")
+    res = client.submit(_timed_batch, pf, a, a + pb, pure=False).result()
+    ts = res.pop("sample_s")
+    info.sample_s = statistics.mean(ts[1:]) if len(ts) > 1 else ts[0]
+    stop = stored(res)
+    gaps[0] = (a + pb, b)
+    if a + pb == b:
+        gaps.pop(0)
+    return stop
+
+
+def _collect(client, pf, gaps, batch: int, info: RunInfo, stored, total: int) -> None:
+    """Submit the batches of ``gaps`` and store each result as it arrives; a failed task is a ClusterError that
+    keeps what was stored; every future still pending is cancelled on the way out."""
+    from distributed import as_completed
+
+    futs = [client.submit(run_batch, pf, a, b, pure=False, retries=1) for a, b in _ranges(gaps, batch)]
+    try:
+        for f in as_completed(futs):
+            try:
+                res = f.result()
+            except Exception as e:  # noqa: BLE001 - KilledWorker, lost scheduler, CommClosedError...
+                raise ClusterError(
+                    f"a Dask task failed ({type(e).__name__}: {' '.join(str(e).split())[:200]}); "
+                    f"{info.chunks_written} chunks stored this run are kept: run again to resume"
+                ) from e
+            if stored(res):
+                info.stopped_early = info.computed + info.skipped < total
+                break
+    finally:
+        for f in futs:
+            f.cancel()
 
 
 def _timed_batch(payload, start, stop):
