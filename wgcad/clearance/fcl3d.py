@@ -315,38 +315,11 @@ def check_tooth(scene: Scene, phi: float, n_sections: int = 9, sections=None, tr
     t0 = time.perf_counter()
     coned = scene.drive.coned
     zs = _heights(scene, n_sections, sections)
-    zl = [float(z) for z in zs] if coned else [None]
     rot, shift = _flex_poses(scene, float(phi), zs if coned else zs[:1], track)
-    # rigid teeth the tooth can touch: neighbours at the middle section, then any other section's
-    order = [len(zl) // 2] + [k for k in range(len(zl)) if k != len(zl) // 2]
-    teeth = []
-    for k in order:
-        for idx in scene.neighbours(shift[k : k + 1], rot[k : k + 1]):
-            if int(idx[0]) not in teeth:
-                teeth.append(int(idx[0]))
-    # 2D: per section, per rigid tooth; and the engine's own figure
-    c = np.array(
-        [
-            [float(scene.clearance_to(rot[k : k + 1], shift[k : k + 1], np.array([j]))[0]) for j in teeth]
-            for k in range(len(zl))
-        ]
-    )  # (K, T)
-    # the engine's own figure of each section (its neighbour search and third-tooth bound)
-    c_engine = np.array(
-        [float(clearance_at_poses(scene, rot[k : k + 1], shift[k : k + 1])["min"][0]) for k in range(len(zl))]
-    )
+    teeth = _touchable_teeth(scene, rot, shift)
+    c, c_engine = _section_clearances(scene, rot, shift, teeth)
     t_2d = time.perf_counter() - t0
-    # bounds (coning only)
-    if coned:
-        err = loft_error(scene, float(phi), zs, track)
-        geom = float(np.max(err["chord"] + err["twist"]))
-        vh = err["speed"] * err["h"]
-        lo_int = np.minimum(np.minimum(c[:-1], c[1:]), 0.5 * (c[:-1] + c[1:] - vh[:, None]))  # (K-1, T)
-        lower_t = lo_int.min(axis=0) - geom
-    else:
-        geom = 0.0
-        lower_t = c.min(axis=0)
-    # FCL
+    geom, lower_t = _lower_bounds(scene, float(phi), zs, track, c) if coned else (0.0, c.min(axis=0))
     t1 = time.perf_counter()
     flex = flex_tooth_solid(scene, float(phi), sections=zs, track=track)
     per, query_ms = [], []
@@ -354,27 +327,7 @@ def check_tooth(scene: Scene, phi: float, n_sections: int = 9, sections=None, tr
         tq = time.perf_counter()
         d, ov, pts = fcl_distance(flex, rigid_tooth_solid(scene, j), nearest=True)
         query_ms.append(1e3 * (time.perf_counter() - tq))
-        c2 = float(c[:, ti].min())
-        ok = _agrees(c2, d, ov, float(lower_t[ti]), not coned)
-        row = {
-            "rigid_tooth": j,
-            "fcl_distance_um": round(1e3 * d, 6),
-            "fcl_overlap": ov,
-            "clearance_2d_um": round(1e3 * c2, 6),
-            "bound_um": round(1e3 * max(c2 - float(lower_t[ti]), 0.0), 6) if c2 >= 0 else None,
-        }
-        if coned and not ov:
-            # the section through FCL's nearest point on the flexspline tooth: the
-            # loft's slice there is within `geom` of the true section, so the 2D
-            # clearance of that section must match FCL to `geom`
-            zw = float(np.clip(pts[0][2], zs[0], zs[-1]))
-            r, s = track(zw) if track is not None else scene.pose(np.array([phi]), zw)
-            cw = float(scene.clearance_to(r, s, np.array([j]))[0])
-            row["fcl_witness_z_mm"] = round(zw, 6)
-            row["clearance_2d_at_witness_um"] = round(1e3 * cw, 6)
-            ok = ok and abs(d - cw) <= geom + FCL_TOL
-        row["agree"] = bool(ok)
-        per.append((d, row))
+        per.append((d, _pair_row(scene, phi, zs, track, j, c[:, ti], (float(lower_t[ti]), geom), (d, ov, pts))))
     t_fcl = time.perf_counter() - t1
     d_min, best = min(per, key=lambda t: t[0])
     ov_any = any(r["fcl_overlap"] for _, r in per)
@@ -406,6 +359,72 @@ def check_tooth(scene: Scene, phi: float, n_sections: int = 9, sections=None, tr
         "fcl_per_query": [round(q, 3) for q in query_ms],
     }
     return out
+
+
+def _touchable_teeth(scene: Scene, rot, shift) -> list[int]:
+    """The rigid teeth the tooth posed ``(rot, shift)`` per section can touch: the neighbours at the middle
+    section, then any other section's."""
+    n = len(rot)
+    teeth = []
+    for k in [n // 2] + [k for k in range(n) if k != n // 2]:
+        for idx in scene.neighbours(shift[k : k + 1], rot[k : k + 1]):
+            if int(idx[0]) not in teeth:
+                teeth.append(int(idx[0]))
+    return teeth
+
+
+def _section_clearances(scene: Scene, rot, shift, teeth) -> tuple[np.ndarray, np.ndarray]:
+    """2D clearance (mm) per section and rigid tooth ``(K, T)``, and the engine's own figure per section (its
+    neighbour search and third-tooth bound)."""
+    n = len(rot)
+    c = np.array(
+        [
+            [float(scene.clearance_to(rot[k : k + 1], shift[k : k + 1], np.array([j]))[0]) for j in teeth]
+            for k in range(n)
+        ]
+    )
+    c_engine = np.array(
+        [float(clearance_at_poses(scene, rot[k : k + 1], shift[k : k + 1])["min"][0]) for k in range(n)]
+    )
+    return c, c_engine
+
+
+def _lower_bounds(scene: Scene, phi: float, zs, track, c) -> tuple[float, np.ndarray]:
+    """A coned drive's loft error (chord + twist, mm) and per rigid tooth the lowest clearance the true surfaces
+    can have between the sections (the Lipschitz dip, less the loft error)."""
+    err = loft_error(scene, phi, zs, track)
+    geom = float(np.max(err["chord"] + err["twist"]))
+    vh = err["speed"] * err["h"]
+    lo_int = np.minimum(np.minimum(c[:-1], c[1:]), 0.5 * (c[:-1] + c[1:] - vh[:, None]))  # (K-1, T)
+    return geom, lo_int.min(axis=0) - geom
+
+
+def _pair_row(scene: Scene, phi, zs, track, j: int, c_j, bounds, fcl) -> dict:
+    """One rigid tooth's row: FCL's ``(distance, overlap, nearest points)`` against the 2D clearances ``c_j`` of its
+    sections, with ``bounds`` = (lowest clearance between the sections, loft error); and their agreement."""
+    lower, geom = bounds
+    d, ov, pts = fcl
+    coned = scene.drive.coned
+    c2 = float(c_j.min())
+    ok = _agrees(c2, d, ov, lower, not coned)
+    row = {
+        "rigid_tooth": j,
+        "fcl_distance_um": round(1e3 * d, 6),
+        "fcl_overlap": ov,
+        "clearance_2d_um": round(1e3 * c2, 6),
+        "bound_um": round(1e3 * max(c2 - lower, 0.0), 6) if c2 >= 0 else None,
+    }
+    if coned and not ov:
+        # the section through FCL's nearest point on the flexspline tooth: the loft's slice there is within `geom`
+        # of the true section, so the 2D clearance of that section must match FCL to `geom`
+        zw = float(np.clip(pts[0][2], zs[0], zs[-1]))
+        r, s = track(zw) if track is not None else scene.pose(np.array([phi]), zw)
+        cw = float(scene.clearance_to(r, s, np.array([j]))[0])
+        row["fcl_witness_z_mm"] = round(zw, 6)
+        row["clearance_2d_at_witness_um"] = round(1e3 * cw, 6)
+        ok = ok and abs(d - cw) <= geom + FCL_TOL
+    row["agree"] = bool(ok)
+    return row
 
 
 def imperfect_track(drive, imp, phi_h: float, tooth: int):
