@@ -195,7 +195,7 @@ def drive_report(drive) -> dict:
 
 def format_summary(rep: dict) -> str:
     """A readable multi-line summary of :func:`drive_report`."""
-    d, f, b, m = rep["drive"], rep["flexspline"], rep["rigid"], rep["mesh"]
+    d = rep["drive"]
     lines = [
         f"{rep['design']}  ({rep['source']})",
         f"  module {d['module_mm']} mm, z_flex {d['z_flex']}, z_rigid {d['z_rigid']}, {d['waves']} waves, "
@@ -204,13 +204,25 @@ def format_summary(rep: dict) -> str:
         "",
         f"  {'':38s}{'flexspline':>20s}{'rigid':>20s}",
     ]
+    lines += _gear_rows(rep["flexspline"], rep["rigid"])
+    lines += ["", "  workshop measurements (undeformed gears)"]
+    lines += _workshop_rows(rep["flexspline"], rep["rigid"])
+    lines += [""] + _mesh_lines(rep)
+    return "\n".join(lines)
 
-    def fmt(v):
-        return "-" if v is None else f"{v:.4f}" if isinstance(v, float) else str(v)
 
-    def row(label, fv, bv):
-        lines.append(f"  {label:38s}{fmt(fv):>20s}{fmt(bv):>20s}")
+def _fmt(v) -> str:
+    return "-" if v is None else f"{v:.4f}" if isinstance(v, float) else str(v)
 
+
+def _row(label: str, fv, bv) -> str:
+    """One line of the two-column table: the flexspline's figure, the rigid gear's."""
+    return f"  {label:38s}{_fmt(fv):>20s}{_fmt(bv):>20s}"
+
+
+def _gear_rows(f: dict, b: dict) -> list[str]:
+    """The gears' radii, tip thickness, outline size, and the pitch-circle figures where they mean something."""
+    lines = []
     for label, key in (
         ("pitch radius, mm", "pitch_radius_mm"),
         ("tip radius, mm", "tip_radius_mm"),
@@ -220,9 +232,11 @@ def format_summary(rep: dict) -> str:
         ("tip thickness, mm", "tip_thickness_mm"),
         ("outline vertices", "outline_vertices"),
     ):
-        row(label, f.get(key), b.get(key))
+        lines.append(_row(label, f.get(key), b.get(key)))
     if "cycloid_rack_vs_exact_um" in f:
-        row("rack vs exact cycloid, um", f.get("cycloid_rack_vs_exact_um"), b.get("cycloid_rack_vs_exact_um"))
+        lines.append(
+            _row("rack vs exact cycloid, um", f.get("cycloid_rack_vs_exact_um"), b.get("cycloid_rack_vs_exact_um"))
+        )
     # the pitch-circle figures only where the pitch circle crosses the teeth: outside them they are
     # figures of the extended flanks (one of them negative), not something to measure
     if f["pitch_circle_within_teeth"] or b["pitch_circle_within_teeth"]:
@@ -230,61 +244,78 @@ def format_summary(rep: dict) -> str:
             ("tooth thickness @pitch, mm", "tooth_thickness_pitch_mm"),
             ("space width @pitch, mm", "space_width_pitch_mm"),
         ):
-            row(label, *(g[key] if g["pitch_circle_within_teeth"] else None for g in (f, b)))
+            lines.append(_row(label, *(g[key] if g["pitch_circle_within_teeth"] else None for g in (f, b))))
+    return lines
+
+
+def _span(w) -> str:
+    sp = w["span"]
+    if sp is None:
+        return "internal teeth"
+    return "none fits" if sp.get("k") is None else f"{sp['w_k_mm']:.4f} (k={sp['k']})"
+
+
+def _span_rate(w) -> str:
+    sp = w["span"]
+    if sp is None or sp.get("k") is None or sp["dW_per_thickness"] is None:
+        return "-"
+    return f"{sp['dW_per_thickness']:.3f}"
+
+
+def _pin_fits(w) -> bool:
+    p = w["pins"]
+    return p["pin_stands_out_of_the_teeth"] and p["pin_clear_of_the_root"]
+
+
+def _pin(w, key) -> str:
+    # a pin that does not stand out of the teeth or rests on the root checks no tooth thickness: not given
+    if not _pin_fits(w):
+        return "none fits"
+    p = w["pins"]
+    if key == "dimension":
+        return f"{p.get('over_pins_mm', p.get('between_pins_mm')):.4f}"
+    if key == "diameter":
+        return f"{p['pin_diameter_mm']:.3f}"
+    return "not smooth" if p["dM_per_thickness"] is None else f"{p['dM_per_thickness']:.3f}"
+
+
+def _workshop_rows(f: dict, b: dict) -> list[str]:
+    """What a shop measures on the undeformed gears: thicknesses, span, pins, concave radii; with the methods."""
     wf, wb = f["workshop"], b["workshop"]
-    lines += ["", "  workshop measurements (undeformed gears)"]
-    row(
-        "flanks between diameters, mm",
-        f"{wf['flank_from_diameter_mm']:.3f}-{wf['flank_to_diameter_mm']:.3f}",
-        f"{wb['flank_from_diameter_mm']:.3f}-{wb['flank_to_diameter_mm']:.3f}",
-    )
-    row("mid-depth diameter, mm", wf["mid_depth"]["diameter_mm"], wb["mid_depth"]["diameter_mm"])
-    row("  thickness there: arc, mm", wf["mid_depth"]["arc_mm"], wb["mid_depth"]["arc_mm"])
-    row("  chordal thickness, mm", wf["mid_depth"]["chordal_mm"], wb["mid_depth"]["chordal_mm"])
-    row("  chordal height from the tip, mm", wf["mid_depth"]["chordal_height_mm"], wb["mid_depth"]["chordal_height_mm"])
+    lines = [
+        _row(
+            "flanks between diameters, mm",
+            f"{wf['flank_from_diameter_mm']:.3f}-{wf['flank_to_diameter_mm']:.3f}",
+            f"{wb['flank_from_diameter_mm']:.3f}-{wb['flank_to_diameter_mm']:.3f}",
+        ),
+        _row("mid-depth diameter, mm", wf["mid_depth"]["diameter_mm"], wb["mid_depth"]["diameter_mm"]),
+        _row("  thickness there: arc, mm", wf["mid_depth"]["arc_mm"], wb["mid_depth"]["arc_mm"]),
+        _row("  chordal thickness, mm", wf["mid_depth"]["chordal_mm"], wb["mid_depth"]["chordal_mm"]),
+        _row(
+            "  chordal height from the tip, mm",
+            wf["mid_depth"]["chordal_height_mm"],
+            wb["mid_depth"]["chordal_height_mm"],
+        ),
+    ]
     if "at_chosen_diameter" in wf or "at_chosen_diameter" in wb:
         cf, cb = wf.get("at_chosen_diameter", {}), wb.get("at_chosen_diameter", {})
-        row("chosen diameter, mm", cf.get("diameter_mm"), cb.get("diameter_mm"))
-        row("  thickness there: arc, mm", cf.get("arc_mm"), cb.get("arc_mm"))
-        row("  chordal thickness, mm", cf.get("chordal_mm"), cb.get("chordal_mm"))
-        row("  chordal height from the tip, mm", cf.get("chordal_height_mm"), cb.get("chordal_height_mm"))
-
-    def span(w):
-        sp = w["span"]
-        if sp is None:
-            return "internal teeth"
-        return "none fits" if sp.get("k") is None else f"{sp['w_k_mm']:.4f} (k={sp['k']})"
-
-    def span_rate(w):
-        sp = w["span"]
-        if sp is None or sp.get("k") is None or sp["dW_per_thickness"] is None:
-            return "-"
-        return f"{sp['dW_per_thickness']:.3f}"
-
-    def fits(w):
-        p = w["pins"]
-        return p["pin_stands_out_of_the_teeth"] and p["pin_clear_of_the_root"]
-
-    def pin(w, key):
-        # a pin that does not stand out of the teeth or rests on the root checks no tooth thickness: not given
-        if not fits(w):
-            return "none fits"
-        p = w["pins"]
-        if key == "dimension":
-            return f"{p.get('over_pins_mm', p.get('between_pins_mm')):.4f}"
-        if key == "diameter":
-            return f"{p['pin_diameter_mm']:.3f}"
-        return "not smooth" if p["dM_per_thickness"] is None else f"{p['dM_per_thickness']:.3f}"
-
-    row("span W_k over k teeth, mm", span(wf), span(wb))
-    row("  change per mm of tooth thickness", span_rate(wf), span_rate(wb))
-    row("pin (ball) diameter, mm", pin(wf, "diameter"), pin(wb, "diameter"))
-    row("dimension over / between pins, mm", pin(wf, "dimension"), pin(wb, "dimension"))
-    row("  change per mm of tooth thickness", pin(wf, "rate"), pin(wb, "rate"))
-    row("smallest concave radius, mm", wf["smallest_concave_radius_mm"], wb["smallest_concave_radius_mm"])
+        lines += [
+            _row("chosen diameter, mm", cf.get("diameter_mm"), cb.get("diameter_mm")),
+            _row("  thickness there: arc, mm", cf.get("arc_mm"), cb.get("arc_mm")),
+            _row("  chordal thickness, mm", cf.get("chordal_mm"), cb.get("chordal_mm")),
+            _row("  chordal height from the tip, mm", cf.get("chordal_height_mm"), cb.get("chordal_height_mm")),
+        ]
+    lines += [
+        _row("span W_k over k teeth, mm", _span(wf), _span(wb)),
+        _row("  change per mm of tooth thickness", _span_rate(wf), _span_rate(wb)),
+        _row("pin (ball) diameter, mm", _pin(wf, "diameter"), _pin(wb, "diameter")),
+        _row("dimension over / between pins, mm", _pin(wf, "dimension"), _pin(wb, "dimension")),
+        _row("  change per mm of tooth thickness", _pin(wf, "rate"), _pin(wb, "rate")),
+        _row("smallest concave radius, mm", wf["smallest_concave_radius_mm"], wb["smallest_concave_radius_mm"]),
+    ]
     methods = sorted(
         {w["span"]["method"] for w in (wf, wb) if w["span"] and w["span"].get("method")}
-        | {w["pins"]["method"] for w in (wf, wb) if fits(w)}
+        | {w["pins"]["method"] for w in (wf, wb) if _pin_fits(w)}
     )
     lines.append(
         f"  (span and pins: {'; '.join(methods)}; thicknesses and concave radii: closed form;"
@@ -298,8 +329,13 @@ def format_summary(rep: dict) -> str:
             f"  ({' and '.join(outside)}: the pitch circle lies outside the teeth, so no thickness is given there; "
             "report.json keeps the virtual values of the extended flanks)"
         )
-    lines += [
-        "",
+    return lines
+
+
+def _mesh_lines(rep: dict) -> list[str]:
+    """The mesh on the major and minor axes, per coned section, and a warning for every radial collision."""
+    m = rep["mesh"]
+    lines = [
         f"  depth of engagement on the major axis: {m['depth_of_engagement_mm']:.4f} mm (w = {m['w_major_mm']:.4f} mm)",
         f"  radial clearance, major axis: flexspline tip {m['clearance_flex_tip_major_um']:.1f} um, "
         f"rigid tip {m['clearance_rigid_tip_major_um']:.1f} um",
@@ -330,4 +366,4 @@ def format_summary(rep: dict) -> str:
             lines.append(
                 f"  WARNING ({where}): {label}: {v:.1f} um, the teeth collide radially there (wgcad audit shows where)"
             )
-    return "\n".join(lines)
+    return lines
