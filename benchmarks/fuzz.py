@@ -45,44 +45,8 @@ SPECS = sorted((TEMPLATES / "sweeps").glob("*.toml"))
 MEMORY_CAP = 4 << 30
 
 
-# ------------------------------------------------------------------ a TOML writer (nested tables)
-def _value(v) -> str:
-    if isinstance(v, bool):
-        return "true" if v else "false"
-    if isinstance(v, int):
-        return str(v)
-    if isinstance(v, float):
-        if math.isnan(v):
-            return "nan"
-        if math.isinf(v):
-            return "inf" if v > 0 else "-inf"
-        return repr(v)
-    if isinstance(v, str):
-        return '"' + v.replace("\\", "\\\\").replace('"', '\\"').replace("\n", "\\n") + '"'
-    if isinstance(v, list):
-        return "[" + ", ".join(_value(x) for x in v) + "]"
-    if isinstance(v, dict):
-        return "{" + ", ".join(f"{k} = {_value(x)}" for k, x in v.items()) + "}"
-    raise TypeError(type(v))
-
-
 def _is_table(v) -> bool:
     return isinstance(v, dict)
-
-
-def to_toml(data: dict, prefix: str = "") -> str:
-    lines = [f"{k} = {_value(v)}" for k, v in data.items() if not _is_table(v)]
-    for k, v in data.items():
-        if _is_table(v):
-            name = f"{prefix}{k}"
-            scalars = {kk: vv for kk, vv in v.items() if not _is_table(vv)}
-            if scalars or not v:
-                lines.append(f"\n[{name}]")
-                lines += [f"{kk} = {_value(vv)}" for kk, vv in scalars.items()]
-            sub = {kk: vv for kk, vv in v.items() if _is_table(vv)}
-            if sub:
-                lines.append(to_toml(sub, f"{name}."))
-    return "\n".join(lines) + "\n"
 
 
 # ------------------------------------------------------------------ mutations
@@ -205,6 +169,7 @@ def _init() -> None:
 
 def run_one(job: dict) -> dict:
     from wgcad.cli import main
+    from wgcad.testing import to_toml
 
     rng = random.Random(job["seed"])
     tmp = Path(tempfile.mkdtemp(prefix="wgcad-fuzz-"))

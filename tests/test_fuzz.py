@@ -25,6 +25,7 @@ from wgcad.cli import main
 from wgcad.design import TABLES, load_design
 from wgcad.drive import build_drive
 from wgcad.errors import DesignError, InputFileError, WgcadError
+from wgcad.testing import to_toml
 
 N_EXAMPLES = int(os.environ.get("WGCAD_FUZZ_EXAMPLES", "120"))
 NAMES = ["d1_involute", "d1_cycloidal", "d2", "d3_external", "d4_discrete"]
@@ -35,37 +36,6 @@ CHORD_TOL_UM = 10.0
 #: names a refusal may carry besides design fields: run settings and flags
 FLAGS = {"--max-memory-mb", "chord_tol", "--step-deg", "--sections", "--chord-tol-um", "--interference-tol-um"}
 REAL_FIELDS = {f"{t}.{f.name}" for t, cls in TABLES.items() for f in fields(cls)} | set(TABLES)
-
-
-# ----------------------------------------------------------------------------- a TOML writer for the mutants
-def _value(v) -> str:
-    if isinstance(v, bool):
-        return "true" if v else "false"
-    if isinstance(v, int):
-        return str(v)
-    if isinstance(v, float):
-        if math.isnan(v):
-            return "nan"
-        if math.isinf(v):
-            return "inf" if v > 0 else "-inf"
-        return repr(v)
-    if isinstance(v, str):
-        return '"' + v.replace("\\", "\\\\").replace('"', '\\"').replace("\n", "\\n") + '"'
-    if isinstance(v, list):
-        return "[" + ", ".join(_value(x) for x in v) + "]"
-    if isinstance(v, dict):
-        return "{" + ", ".join(f"{k} = {_value(x)}" for k, x in v.items()) + "}"
-    raise TypeError(type(v))  # pragma: no cover
-
-
-def to_toml(data: dict) -> str:
-    top = [f"{k} = {_value(v)}" for k, v in data.items() if not isinstance(v, dict)]
-    out = top[:]
-    for k, v in data.items():
-        if isinstance(v, dict):
-            out.append(f"\n[{k}]")
-            out += [f"{kk} = {_value(vv)}" for kk, vv in v.items()]
-    return "\n".join(out) + "\n"
 
 
 def test_the_writer_round_trips_the_templates():
