@@ -111,7 +111,7 @@ def _pick(rng, good, bad, p_bad=0.15):
 
 def command(rng: random.Random, design: Path, spec: Path, out: Path) -> tuple[str, list]:
     """A command line (without ``wgcad``) for one run, writing under ``out``."""
-    cmd = rng.choice(["generate", "audit", "load", "kinematics", "ke", "sector", "parts", "sweep"])
+    cmd = rng.choice(["generate", "audit", "load", "kinematics", "ke", "rating", "sector", "parts", "sweep"])
     d = str(design)
     if cmd == "generate":
         args = ["generate", d, "--out", str(out / "g"), "--no-stl", "--quiet"]
@@ -144,6 +144,12 @@ def command(rng: random.Random, design: Path, spec: Path, out: Path) -> tuple[st
                 "--load-samples",
                 _pick(rng, ["8", "12"], ["1", "x"]),
             ]
+    elif cmd == "rating":
+        args = ["rating", d, "--json", str(out / "r.json")]
+        if rng.random() < 0.3:
+            args += ["--speed-rpm", _pick(rng, ["500", "2000", "3000"], ["0", "-1", "nan", "1e9", "x"])]
+        if rng.random() < 0.2:
+            args += ["--sections", _pick(rng, ["1", "2", "3"], ["0", "x", "100"])]
     elif cmd == "sector":
         args = ["sector", d, "--out", str(out / "s"), "--no-stl"]
         args += ["--step-deg", _pick(rng, ["0.2", "0.5", "1"], ["0", "-1", "nan", "1e-7"])]

@@ -26,6 +26,7 @@ FLOORS = [
     {"clearance"},
     {"elastic"},
     {"accuracy", "sector"},
+    {"rating"},
     {"audit", "regression"},
     {"sweep"},
     {"report"},

@@ -56,6 +56,51 @@ class MaterialSpec:
         default=None,
         default_doc="flexspline.rim_thickness",
     )
+    # ---- strength (wgcad rating; docs/models.md 10) ----
+    ultimate_strength_mpa: float | None = _key(
+        "tensile strength S_u of the flexspline steel",
+        unit="MPa",
+        lo=0.0,
+        lo_open=True,
+        hi=5000.0,
+        why="positive; no steel is stronger than ~5000 MPa",
+        default=None,
+        default_doc="required by wgcad rating",
+    )
+    yield_strength_mpa: float | None = _key(
+        "yield strength S_y of the flexspline steel (the static check of the peak stress)",
+        unit="MPa",
+        lo=0.0,
+        lo_open=True,
+        hi=5000.0,
+        rule="at most ultimate_strength_mpa",
+        why="positive; no steel is stronger than ~5000 MPa",
+        default=None,
+        default_doc="0.9 ultimate_strength_mpa (a quenched and tempered steel)",
+    )
+    endurance_limit_mpa: float | None = _key(
+        "rotating-beam endurance limit S_e' of a polished specimen, before the modifying factors",
+        unit="MPa",
+        lo=0.0,
+        lo_open=True,
+        hi=2500.0,
+        rule="below ultimate_strength_mpa",
+        why="positive; below the strength",
+        default=None,
+        default_doc="0.5 ultimate_strength_mpa, at most 700 MPa (Shigley, steels)",
+    )
+    surface_finish: str = _key(
+        "finish of the tooth roots (sets the surface factor k_a = a S_u^b, Shigley table 6-2)",
+        choices=("ground", "machined", "hot_rolled", "forged"),
+        default="machined",
+    )
+    reliability: float = _key(
+        "share of parts that must reach the endurance limit (reliability factor k_e = 1 - 0.08 z)",
+        lo=0.5,
+        hi=0.99999,
+        why="from the median to five nines, the range of the factor's normal model",
+        default=0.99,
+    )
 
 
 @dataclass(frozen=True)
@@ -167,6 +212,48 @@ class LoadSpec:
     #: bending and shearing as a thin tube from the diaphragm (docs/models.md 4.1); 0 lets the rim float
     #: radial stiffness of the cam's support (input shaft and its bearings), N/mm: the balls' imbalance moves the
     #: cam against it (docs/models.md 4.1); 0 for a floating (self-centring) generator, e.g. on an Oldham coupling
+    input_speed_rpm: float = _key(
+        "input (wave generator) speed the bearing life is rated at",
+        unit="rpm",
+        lo=0.0,
+        lo_open=True,
+        hi=1e5,
+        why="positive; 100000 rpm is beyond any flexible bearing",
+        default=2000.0,
+    )
+    required_life_h: float = _key(
+        "L10 life the wave-generator bearing must reach at the rated torque and input speed",
+        unit="h",
+        lo=0.0,
+        lo_open=True,
+        hi=1e7,
+        why="positive; 1e7 h is over a thousand years",
+        default=7000.0,
+    )
+    fatigue_safety_min: float = _key(
+        "smallest Goodman safety factor of the flexspline the rated torque may leave",
+        lo=1.0,
+        hi=10.0,
+        why="at least the Goodman line itself; 10 is beyond any design practice",
+        default=1.0,
+    )
+    ratcheting_safety_min: float = _key(
+        "smallest ratio of ratcheting torque to rated torque",
+        lo=1.0,
+        hi=10.0,
+        why="the teeth must not skip at the rated torque; 10 is beyond any design practice",
+        default=1.0,
+    )
+    output_inertia_kg_m2: float | None = _key(
+        "moment of inertia on the output, for the first torsional natural frequency",
+        unit="kg m^2",
+        lo=0.0,
+        lo_open=True,
+        hi=1e6,
+        why="positive; a sanity bound",
+        default=None,
+        default_doc="none: the frequency is not computed",
+    )
     cam_support_stiffness_n_per_mm: float | None = _key(
         "radial stiffness holding the cam on the drive axis (0: floating generator)",
         unit="N/mm",

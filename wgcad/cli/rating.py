@@ -1,0 +1,75 @@
+"""``wgcad rating``: the catalogue-style datasheet of a drive: rated torque and what binds it, stresses, stiffness, lost motion, ratcheting, bearing life (docs/models.md 10)."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+from .common import EXIT_INTERFERENCE, EXIT_OK, epilog, positive_float, whole_number
+
+__all__ = ["register", "cmd_rating"]
+
+
+def cmd_rating(args) -> int:
+    from ..atomic import atomic_batch
+    from ..design import load_design
+    from ..drive import build_drive
+    from ..rating.datasheet import rate_drive
+    from ..report.rating import rating_document, rating_lines
+    from .common import Progress, want_progress
+    from .outputs import check_output_file
+
+    for flag, path in (("--json", args.json), ("--plot", args.plot)):
+        if path:
+            check_output_file(path, flag=flag, inputs=[args.design])
+    design = load_design(args.design)
+    drive = build_drive(design)
+    bar = Progress(want_progress(args.progress))
+    bar.start("torque levels")
+    ds = rate_drive(drive, speed_rpm=args.speed_rpm, sections=args.sections, progress=bar.set)
+    bar.close()
+    print("\n".join(rating_lines(ds)))
+    with atomic_batch() as batch:
+        if args.json:
+            doc = rating_document(ds, str(args.design))
+            Path(batch.temp_path(Path(args.json))).write_text(json.dumps(doc, allow_nan=False, indent=2))
+        if args.plot:
+            from ..export.rating_figures import rating_png
+
+            Path(batch.temp_path(Path(args.plot))).write_bytes(rating_png(ds))
+    return EXIT_OK if ds.rated_torque_nm > 0 else EXIT_INTERFERENCE
+
+
+def register(sub) -> None:
+    """Add the subcommand to the ``wgcad`` parser's subparsers."""
+    import argparse
+
+    r = sub.add_parser(
+        "rating",
+        help="datasheet: rated torque and the criterion that binds it, stresses, stiffness, ratcheting, bearing life",
+        epilog=epilog(
+            one="no rated torque: a criterion fails at no load (the datasheet says which)",
+            model="the elastic model cannot solve the unloaded drive",
+        ),
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
+    r.add_argument(
+        "design",
+        help="design file (TOML) with [bearing] and [material] ultimate_strength_mpa, e.g. templates/d1_involute.toml",
+    )
+    r.add_argument(
+        "--speed-rpm",
+        type=positive_float(0.0, 1e5, "rpm"),
+        default=None,
+        help="input speed the bearing life is rated at (default [load] input_speed_rpm, 2000)",
+    )
+    r.add_argument(
+        "--sections",
+        type=whole_number(1, 9, "sections"),
+        default=3,
+        help="cross-sections of the elastic model over the face width (default 3)",
+    )
+    r.add_argument("--json", help="write the datasheet as JSON here")
+    r.add_argument("--plot", help="write the datasheet's picture (PNG) here")
+    r.add_argument("--progress", action="store_true", help="show the progress bar even when stderr is not a terminal")
+    r.set_defaults(func=cmd_rating)
