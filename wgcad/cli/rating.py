@@ -5,7 +5,7 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
-from .common import EXIT_INTERFERENCE, EXIT_OK, epilog, positive_float, whole_number
+from .common import EXIT_INTERFERENCE, EXIT_OK, epilog, key_float, positive_float, whole_number
 
 __all__ = ["register", "cmd_rating"]
 
@@ -26,7 +26,12 @@ def cmd_rating(args) -> int:
     drive = build_drive(design)
     bar = Progress(want_progress(args.progress))
     bar.start("torque levels")
-    ds = rate_drive(drive, speed_rpm=args.speed_rpm, sections=args.sections, progress=bar.set)
+    ld = design.load
+    offset = (
+        ld.cam_offset_um if args.cam_offset_um is None else args.cam_offset_um,
+        ld.cam_offset_deg if args.cam_offset_deg is None else args.cam_offset_deg,
+    )
+    ds = rate_drive(drive, speed_rpm=args.speed_rpm, sections=args.sections, progress=bar.set, cam_offset=offset)
     bar.close()
     print("\n".join(rating_lines(ds)))
     with atomic_batch() as batch:
@@ -62,6 +67,19 @@ def register(sub) -> None:
         type=positive_float(0.0, 1e5, "rpm"),
         default=None,
         help="input speed the bearing life is rated at (default [load] input_speed_rpm, 2000)",
+    )
+    r.add_argument(
+        "--cam-offset-um",
+        type=key_float("load", "cam_offset_um"),
+        default=None,
+        help="radial offset of the cam axis the drive is rated with (default [load] cam_offset_um); the ratcheting "
+        "torque is also given without it",
+    )
+    r.add_argument(
+        "--cam-offset-deg",
+        type=key_float("load", "cam_offset_deg"),
+        default=None,
+        help="direction of the offset from the major axis (default [load] cam_offset_deg)",
     )
     r.add_argument(
         "--sections",

@@ -30,11 +30,11 @@ def _wind_up(ax, ds):
     )
     for t, name in ((f.t1, "T1"), (f.t2, "T2")):
         ax.axvline(t, color="0.6", lw=0.8, ls=":")
-        ax.text(t, ax.get_ylim()[0], f" {name}", fontsize=8, va="bottom")
+        ax.text(t, ax.get_ylim()[1], f" {name}", fontsize=8, va="top")
     ax.set_xlabel("output torque, N m")
     ax.set_ylabel("wind-up, arcmin")
     ax.set_title("torsional wind-up (free play included)", fontsize=9)
-    ax.legend(fontsize=7)
+    ax.legend(fontsize=7, loc="lower right")
 
 
 def _stress(ax, ds):
@@ -43,8 +43,22 @@ def _stress(ax, ds):
         for s in lv.stresses:
             if s.where != "root" and lv is ds.levels[0] and ds.fit:
                 continue
-            name = f"roots z {s.z:g}" if s.where == "root" else f"cup wall z {s.z:g}"
-            ax.plot(np.rad2deg(s.psi), s.sigma, ls, lw=1.0, label=f"{name} mm, {label} (n {s.safety:.2f})")
+            name = {
+                "root": "roots",
+                "cup": "cup wall",
+                "diaphragm_hub": "diaphragm hub",
+                "diaphragm_wall": "diaphragm edge",
+            }[s.where]
+            name = f"{name} z {s.z:g}"
+            note = "" if s.rated else ", not rated: derived sizes"
+            style = ls if s.rated else "--"
+            ax.plot(
+                np.rad2deg(s.psi),
+                s.sigma,
+                style,
+                lw=1.0 if s.rated else 0.8,
+                label=f"{name} mm, {label} (n {s.safety:.2f}{note})",
+            )
     ax.axhline(0.0, color="k", lw=0.6)
     ax.set_xlim(0, 360)
     ax.set_xticks(range(0, 361, 45))

@@ -34,7 +34,8 @@ __all__ = ["Level", "Limit", "Datasheet", "rate_drive", "ratcheting_torque", "CR
 
 #: the criteria, in the order the datasheet lists them: name -> what it asks
 CRITERIA = {
-    "fatigue": "Goodman safety of the flexspline (tooth roots, cup wall) at least [load] fatigue_safety_min",
+    "fatigue": "Goodman safety of the flexspline (tooth roots, cup wall, diaphragm if [parts] gives it) at least "
+    "[load] fatigue_safety_min",
     "yield": "peak von Mises stress of the flexspline below the yield strength",
     "bearing_life": "wave-generator bearing L10 at [load] input_speed_rpm at least [load] required_life_h",
     "entry_gap": "no tip interference at tooth entry (the loaded entry gap stays open)",
@@ -119,8 +120,8 @@ def _level(sheet_ctx, T: float, warm, offset) -> Level:
         torque_nm=float(T),
         state=st,
         stresses=stresses,
-        safety=min(s.safety for s in stresses),
-        yield_safety=min(s.yield_safety for s in stresses),
+        safety=min(s.safety for s in stresses if s.rated),
+        yield_safety=min(s.yield_safety for s in stresses if s.rated),
         life_h=life.l10_h,
         life=life,
         entry_gap=min(gaps) if gaps else float("inf"),
@@ -300,8 +301,11 @@ class _Like:
     design: object
 
 
-def rate_drive(drive, speed_rpm: float | None = None, sections: int = 3, progress=None) -> Datasheet:
+def rate_drive(drive, speed_rpm: float | None = None, sections: int = 3, progress=None, cam_offset=None) -> Datasheet:
     """The datasheet of ``drive`` (needs ``[bearing]`` and ``[material] ultimate_strength_mpa``).
+
+    ``speed_rpm`` and ``cam_offset`` (``(um, deg)``) replace ``[load]`` input_speed_rpm and cam_offset_um/_deg;
+    ``progress(fraction, stage)`` is called as the work goes.
 
     Raises :class:`DesignError` for missing or contradictory data, :class:`ModelError` when the model cannot
     solve the unloaded drive.
@@ -311,7 +315,7 @@ def rate_drive(drive, speed_rpm: float | None = None, sections: int = 3, progres
     speed = d.load.input_speed_rpm if speed_rpm is None else float(speed_rpm)
     ctx, kt = _context(drive, sections, speed)
     model, setup = ctx[0], ctx[1]
-    offset = (d.load.cam_offset_um, d.load.cam_offset_deg)
+    offset = (d.load.cam_offset_um, d.load.cam_offset_deg) if cam_offset is None else tuple(map(float, cam_offset))
     like = _Like(d)
     t_setup = time.perf_counter() - t0
 
@@ -341,7 +345,20 @@ def rate_drive(drive, speed_rpm: float | None = None, sections: int = 3, progres
     notes = []
     if setup.t_cup is None:
         notes.append("the cup wall: the design has no cup ([generator] cone_length)")
-    notes.append("the diaphragm and the output flange: the design file does not give them")
+    if setup.plate is not None and not setup.plate_given:
+        notes.append(
+            "the diaphragm in the rating: [parts] does not give its thickness and bolt circle, so its stresses are "
+            "shown for the derived sizes (wgcad parts) and left out of the rated torque"
+        )
+    if setup.plate is not None:
+        p = setup.plate
+        notes.append(
+            f"the diaphragm's joints: taken rigid (clamped at the bolt circle, r = {p.r_i:.1f} mm; joined to the wall "
+            f"at {p.r_o:.1f} mm, [parts] sizes), no stress concentration at either; the bolt holes; the wall's own "
+            "bending near the joint; the output flange"
+        )
+    else:
+        notes.append("the output flange")
     notes.append("the bearing's own rings in bending and the cam: only the ball contacts are rated")
     if d.imperfections.any:
         notes.append(

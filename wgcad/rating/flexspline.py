@@ -7,6 +7,7 @@ from math import pi, sqrt
 
 import numpy as np
 
+from .diaphragm import Diaphragm, diaphragm_stress
 from .fatigue import Strength, goodman_safety
 from .rim import RimCycle, curvature_change, torque_shear
 
@@ -41,6 +42,30 @@ class StressSetup:
     s_f: float
     r_f: float
     strength: Strength
+    nu: float = 0.3
+    #: the cup's diaphragm (None without a cup) and its centre law's amplitude, mm
+    plate: Diaphragm | None = None
+    w0_centre: float = 0.0
+    plate_z: float = 0.0
+    #: whether the design's [parts] gives the diaphragm (thickness and bolt circle): only then it enters the rating
+    plate_given: bool = False
+
+
+def _plate(drive, t_cup: float) -> Diaphragm:
+    """The diaphragm from ``[parts]`` (its defaults when the design file has none): clamped at the cup's bolt circle
+    (an assumption the datasheet states: inside it the output flange holds the plate), joined to the wall's
+    mid-surface."""
+    from pathlib import Path
+
+    from wgcad.design.parts import PartsSpec, load_parts, part_sizes
+
+    d = drive.design
+    spec = load_parts(d.source) if Path(d.source).is_file() else PartsSpec()
+    v = part_sizes(spec, drive)
+    r_o = drive.flex_rim_radius + 0.5 * t_cup
+    r_i = 0.5 * v.cup_bolt_circle_diameter
+    given = spec.diaphragm_thickness is not None and spec.cup_bolt_circle_diameter is not None
+    return Diaphragm(r_i, r_o, v.diaphragm_thickness, d.generator.cone_length - d.generator.generator_z), given
 
 
 def stress_setup(drive, kt: float, strength: Strength) -> StressSetup:
@@ -51,6 +76,7 @@ def stress_setup(drive, kt: float, strength: Strength) -> StressSetup:
     q = strength.notch_sensitivity(rho_f)
     t_cup = (d.material.cup_wall_thickness_mm or h1) if drive.coned else None
     outside = flex.r_f > drive.flex_rim_radius
+    plate = _plate(drive, t_cup) if t_cup is not None and outside else None
     return StressSetup(
         E=d.material.youngs_modulus_gpa * 1e3,
         h1=h1,
@@ -65,6 +91,11 @@ def stress_setup(drive, kt: float, strength: Strength) -> StressSetup:
         s_f=float(flex.tooth_thickness(flex.r_f + rho_f)),
         r_f=flex.r_f,
         strength=strength,
+        nu=d.material.poisson,
+        plate=plate[0] if plate else None,
+        w0_centre=drive.law.w0,
+        plate_z=d.generator.cone_length if drive.coned else 0.0,
+        plate_given=bool(plate and plate[1]),
     )
 
 
@@ -80,6 +111,8 @@ class SectionStress(RimCycle):
 
     where: str = "root"
     z: float = 0.0
+    #: False: reported, but left out of the rating (its sizes are derived defaults, not the design's)
+    rated: bool = True
     shear: float = 0.0
     safety: float = float("inf")
     yield_safety: float = float("inf")
@@ -101,11 +134,13 @@ def _tooth_bending(setup: StressSetup, state, section: int, law) -> tuple[np.nda
     return phi, y_s * 6.0 * F * h_f / (b * setup.s_f**2)
 
 
-def _section(where, z, psi, sigma, shear, st: Strength) -> SectionStress:
+def _section(where, z, psi, sigma, shear, st: Strength, rated: bool = True) -> SectionStress:
     cyc = RimCycle(psi, sigma)
     vm = sqrt(float(np.abs(sigma).max()) ** 2 + 3.0 * shear**2)
     safety = goodman_safety(cyc.amplitude, cyc.mean, shear, st)
-    return SectionStress(psi, sigma, where=where, z=z, shear=shear, safety=safety, yield_safety=st.yield_ / vm)
+    return SectionStress(
+        psi, sigma, where=where, z=z, rated=rated, shear=shear, safety=safety, yield_safety=st.yield_ / vm
+    )
 
 
 def state_stresses(setup: StressSetup, state) -> list[SectionStress]:
@@ -127,4 +162,10 @@ def state_stresses(setup: StressSetup, state) -> list[SectionStress]:
         sigma = setup.E * y * curvature_change(law, base)
         tau = torque_shear(state.torque_nm, setup.r_cup, setup.t_cup)
         out.append(_section("cup", float(m.zs[-1]), base, sigma, tau, setup.strength))
+    if setup.plate is not None:
+        p = setup.plate
+        psi, hub, wall = diaphragm_stress(state.laws[0].with_w0(setup.w0_centre), p, setup.E, setup.nu)
+        for where, r, sigma in (("diaphragm_hub", p.r_i, hub), ("diaphragm_wall", p.r_o, wall)):
+            tau = torque_shear(state.torque_nm, r, p.h)
+            out.append(_section(where, setup.plate_z, psi, sigma, tau, setup.strength, setup.plate_given))
     return out

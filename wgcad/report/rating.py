@@ -28,6 +28,7 @@ def _stress(s) -> dict:
         "goodman_safety": _r(s.safety, 3),
         "yield_safety": _r(s.yield_safety, 3),
         "largest_tension_at_deg": _r(np.rad2deg(s.peak_at), 2),
+        "rated": s.rated,
     }
 
 
@@ -66,7 +67,8 @@ def rating_document(ds, design_path: str) -> dict:
             for k, v in ds.limits.items()
         },
         "input_speed_rpm": _r(ds.speed_rpm, 1),
-        "cam_offset_um": ld.cam_offset_um,
+        "cam_offset_um": ds.ratcheting["offset_um"],
+        "cam_offset_deg": ds.ratcheting["offset_deg"],
         "flexspline": {
             "root_kt": _r(ds.kt.kt, 3),
             "root_kt_method": "plane-strain FE of a 5-tooth sector in pure bending (docs/models.md 10.2)",
@@ -137,7 +139,7 @@ def rating_lines(ds) -> list[str]:
     speed = ds.speed_rpm
     out = [
         f"{d.drive.name}: datasheet (elastic model, {len(ds.model.zs)} sections; input {speed:g} rpm; "
-        f"cam offset {ld.cam_offset_um:g} um)",
+        f"cam offset {ds.ratcheting['offset_um']:g} um at {ds.ratcheting['offset_deg']:g} deg)",
         f"  RATED TORQUE {ds.rated_torque_nm:.0f} N m, bound by {ds.binding}: {CRITERIA[ds.binding]}"
         if ds.rated_torque_nm > 0
         else f"  NO RATED TORQUE: {ds.binding} fails at no load ({CRITERIA[ds.binding]})",
@@ -155,10 +157,17 @@ def rating_lines(ds) -> list[str]:
     for label, lv in (("at no load", ds.levels[0]), (f"at {ds.rated_torque_nm:.0f} N m", ds.rated)):
         out.append(f"    {label}:")
         for s in lv.stresses:
-            where = f"tooth roots z {s.z:g} mm" if s.where == "root" else f"cup wall  z {s.z:g} mm"
+            where = {
+                "root": "tooth roots",
+                "cup": "cup wall",
+                "diaphragm_hub": "diaphragm at hub",
+                "diaphragm_wall": "diaphragm at wall",
+            }[s.where]
+            where = f"{where} z {s.z:g} mm"
             out.append(
-                f"      {where:<22} {s.sigma.min():7.0f} .. {s.sigma.max():5.0f} MPa (largest tension at "
+                f"      {where:<28} {s.sigma.min():7.0f} .. {s.sigma.max():5.0f} MPa (largest tension at "
                 f"{np.rad2deg(s.peak_at):6.1f} deg), shear {s.shear:5.1f} MPa: Goodman safety {s.safety:.2f}, yield {s.yield_safety:.2f}"
+                + ("" if s.rated else "  (not rated: derived sizes)")
             )
     lf = ds.rated.life
     out.append(
@@ -193,7 +202,7 @@ def rating_lines(ds) -> list[str]:
         r0 = r["no_offset"]
         out.append(f"    without the offset: {'above ' if r0['above'] else ''}{r0['torque_nm']:.0f} N m; {r0['note']}")
     elif r["offset_um"] == 0:
-        out.append("    with a cam offset: not computed (the design's [load] cam_offset_um is 0)")
+        out.append("    with a cam offset: not computed (none given: [load] cam_offset_um or --cam-offset-um)")
     for n in ds.notes:
         out.append(f"  NOT CHECKED: {n}")
     out.append(f"  {ds.timing['total_s']:.1f} s")
