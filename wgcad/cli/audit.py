@@ -49,12 +49,9 @@ def _check_outputs(args) -> None:
 
 def cmd_audit(args) -> int:
     if args.torque_nm is not None:  # under load: cli/load.py
-        if args.html:
-            from ..errors import OutputError
-
-            raise OutputError("--html: the load audit has no page yet (its figures: --plot)")
         from .load import run_load
 
+        _check_outputs(args)
         return run_load(args)
     from .common import Progress, want_progress
     from .outputs import STDOUT, write_stdout

@@ -34,6 +34,14 @@ def cmd_ke(args) -> int:
         check_writable_dir(Path(args.plot).parent if str(Path(args.plot).parent) else Path("."))
     if args.json:
         check_writable_dir(Path(args.json).parent if str(Path(args.json).parent) else Path("."))
+    if args.html:
+        from .outputs import STDOUT, check_output_file
+
+        if args.html == STDOUT:
+            from ..errors import OutputError
+
+            raise OutputError("--html: writes a page, so it needs a path, not - (standard output)")
+        check_output_file(args.html, flag="--html", inputs=[args.design])
     from ..report.ke_run import add_install_scan, add_loaded, no_load
     from .common import Progress, want_progress
 
@@ -56,6 +64,10 @@ def cmd_ke(args) -> int:
     with atomic_batch() as batch:
         if args.json:
             Path(batch.temp_path(Path(args.json))).write_text(json.dumps(run.doc, allow_nan=False, indent=2))
+        if args.html:
+            from ..export.ke_html import ke_html
+
+            Path(batch.temp_path(Path(args.html))).write_text(ke_html(run), encoding="utf-8")
         if args.plot:
             from ..export.ke_figures import ke_pngs
 
@@ -94,6 +106,7 @@ def register(sub) -> None:
         help="scan the rigid gear's installation angle (36 angles, then finer) and the flexspline's position",
     )
     k.add_argument("--json", help="write the figures as JSON here")
+    k.add_argument("--html", help="write one self-contained interactive page (zoomable figures, the tables) here")
     k.add_argument("--plot", help="PNG path stem: writes STEM_ke.png, STEM_flank.png (and STEM_install.png)")
     k.add_argument(
         "--per-mesh",

@@ -176,7 +176,7 @@ def run_load(args) -> int:
     from ..atomic import atomic_batch, check_writable_dir
 
     torques = _levels(args)
-    for path in (args.json, args.plot):
+    for path in (args.json, args.plot, args.html):
         if path:
             check_writable_dir(Path(path).parent if str(Path(path).parent) else Path("."))
     prog = Progress(args.progress or sys.stderr.isatty())
@@ -199,6 +199,10 @@ def run_load(args) -> int:
     with atomic_batch() as batch:
         if args.json:
             Path(batch.temp_path(args.json)).write_text(json.dumps(res, allow_nan=False, indent=2) + "\n")
+        if args.html:
+            from ..export.load_html import load_html
+
+            Path(batch.temp_path(args.html)).write_text(load_html(res), encoding="utf-8")
         if args.plot:
             from ..export.load_figures import entry_gap_png, force_distribution_png
 

@@ -14,12 +14,15 @@ def cmd_rating(args) -> int:
     from ..atomic import atomic_batch
     from ..design import load_design
     from ..drive import build_drive
+    from ..errors import OutputError
     from ..rating.datasheet import rate_drive
     from ..report.rating import rating_document, rating_lines
     from .common import Progress, want_progress
-    from .outputs import check_output_file
+    from .outputs import STDOUT, check_output_file
 
-    for flag, path in (("--json", args.json), ("--plot", args.plot)):
+    for flag, path in (("--json", args.json), ("--plot", args.plot), ("--html", args.html)):
+        if path == STDOUT:
+            raise OutputError(f"{flag}: writes a file, so it needs a path, not - (standard output)")
         if path:
             check_output_file(path, flag=flag, inputs=[args.design])
     design = load_design(args.design)
@@ -42,6 +45,10 @@ def cmd_rating(args) -> int:
             from ..export.rating_figures import rating_png
 
             Path(batch.temp_path(Path(args.plot))).write_bytes(rating_png(ds))
+        if args.html:
+            from ..export.rating_html import rating_html
+
+            Path(batch.temp_path(Path(args.html))).write_text(rating_html(ds), encoding="utf-8")
     return EXIT_OK if ds.rated_torque_nm > 0 else EXIT_INTERFERENCE
 
 
@@ -89,5 +96,6 @@ def register(sub) -> None:
     )
     r.add_argument("--json", help="write the datasheet as JSON here")
     r.add_argument("--plot", help="write the datasheet's picture (PNG) here")
+    r.add_argument("--html", help="write the datasheet as one self-contained interactive page here")
     r.add_argument("--progress", action="store_true", help="show the progress bar even when stderr is not a terminal")
     r.set_defaults(func=cmd_rating)

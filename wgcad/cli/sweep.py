@@ -46,6 +46,13 @@ def cmd_sweep(args) -> int:
     spec = load_spec(args.spec)
     out = Path(args.out) if args.out else Path("output") / f"sweep_{Path(args.spec).stem}"
     check_writable_dir(out)
+    if args.html:
+        from ..errors import OutputError as _OutputError
+        from .outputs import STDOUT, check_output_file
+
+        if args.html == STDOUT:
+            raise _OutputError("--html: writes a page, so it needs a path, not - (standard output)")
+        check_output_file(args.html, flag="--html", inputs=[args.spec])
     if args.summary_only and not (out / "sweep.json").is_file():
         raise OutputError(f"--summary-only: {out} holds no sweep results (no sweep.json)")
     from ..sweep.runner import run_sweep
@@ -79,6 +86,10 @@ def cmd_sweep(args) -> int:
 
             for name, png in sweep_pngs(spec, cols, summ).items():
                 Path(batch.temp_path(out / name)).write_bytes(png)
+        if args.html and len(cols["sample"]):
+            from ..export.sweep_html import sweep_html
+
+            Path(batch.temp_path(Path(args.html))).write_text(sweep_html(spec, cols, summ), encoding="utf-8")
     bar.close()
     if not args.quiet:
         print(format_summary(summ, info))
@@ -127,6 +138,7 @@ def register(sub) -> None:
     s.add_argument("--out", help="results folder (default output/sweep_SPECNAME); reused to resume")
     s.add_argument("--summary-only", action="store_true", help="compute nothing: summarise the samples stored in --out")
     s.add_argument("--no-plots", action="store_true", help="no PNGs")
+    s.add_argument("--html", help="write one self-contained interactive page (zoomable figures, the tables) here")
     s.add_argument("--progress", action="store_true", help="draw the progress bar even when stderr is not a terminal")
     s.add_argument("--quiet", action="store_true", help="no summary on stdout")
     s.set_defaults(func=cmd_sweep)

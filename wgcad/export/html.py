@@ -14,28 +14,12 @@ import html
 
 import numpy as np
 
+from .html_page import figure as _figure
+from .html_page import fmt as _fmt
+from .html_page import notes as _notes
+from .html_page import page
+
 __all__ = ["audit_html"]
-
-_CSS = """
-body { font-family: system-ui, sans-serif; margin: 1.5em; color: #222; max-width: 1200px; }
-h1 { font-size: 1.4em; } h2 { font-size: 1.15em; margin-top: 1.6em; }
-table { border-collapse: collapse; margin: 0.5em 0; } td, th { border: 1px solid #ccc; padding: 0.25em 0.6em; text-align: left; }
-th { background: #f3f3f3; } .bad { color: #b00; font-weight: bold; } .ok { color: #070; font-weight: bold; }
-.note { color: #555; font-size: 0.92em; } .fig { margin: 0.5em 0 1.5em 0; }
-"""
-
-
-def _fmt(v, nd: int = 3) -> str:
-    if v is None:
-        return "-"
-    if isinstance(v, float):
-        return "-" if not np.isfinite(v) else f"{v:.{nd}f}"
-    return html.escape(str(v))
-
-
-def _figure(fig, div_id: str) -> str:
-    html_div = fig.to_html(full_html=False, include_plotlyjs=False, div_id=div_id, config={"displaylogo": False})
-    return '<div class="fig">' + html_div + "</div>"
 
 
 def _lines(go, fig, polys, name, color, width=1.0, show=True):
@@ -58,7 +42,6 @@ def audit_html(drive, result, doc: dict, data: dict) -> str:
     """The page: verdict and figures of the audit (``doc``: :func:`wgcad.report.audit_run.audit_document`'s document;
     ``data``: :func:`wgcad.export.audit_figures.audit_plot_data`)."""
     import plotly.graph_objects as go
-    from plotly.offline import get_plotlyjs
 
     from ..placement.deformed import deformed_state
 
@@ -171,23 +154,12 @@ def audit_html(drive, result, doc: dict, data: dict) -> str:
         '<span class="bad">INTERFERENCE</span>' if doc["interference"] else '<span class="ok">no interference</span>'
     )
     table = "".join(f"<tr><th>{a}</th><td>{b}</td><td>{c}</td></tr>" for a, b, c in rows)
-    notes = "".join(f"<li>{html.escape(n)}</li>" for n in doc.get("not_checked", []))
     st = doc["settings"]
-    body = [
-        f"<h1>{html.escape(name)}: clearance audit</h1>",
+    head = [
         f"<p>{verdict} (tolerance {_fmt(doc.get('interference_tol_um'), 3)} um); "
         f"{'figures on the exact tooth curves' if st.get('refined') else 'polygon figures'}; "
         f"{st.get('angles')} generator angles, sections {html.escape(str(st.get('sections_z_mm')))} mm.</p>",
         f"<table>{table}</table>",
-        f"<p class='note'>NOT CHECKED:</p><ul class='note'>{notes}</ul>" if notes else "",
+        _notes(doc.get("not_checked", [])),
     ]
-    for title, div in figs:
-        body += [f"<h2>{html.escape(title)}</h2>", div]
-    return (
-        "<!DOCTYPE html>\n<html lang='en'><head><meta charset='utf-8'>"
-        f"<title>{html.escape(name)}: wgcad audit</title><style>{_CSS}</style>"
-        f"<script type='text/javascript'>{get_plotlyjs()}</script></head><body>\n"
-        + "\n".join(body)
-        + "\n<p class='note'>wgcad: every figure here is also in the audit's JSON; the page loads nothing from the network.</p>"
-        + "\n</body></html>\n"
-    )
+    return page(f"{name}: clearance audit", "audit", head, figs)
