@@ -187,3 +187,45 @@ def test_install_lever_finds_the_scans_best_and_never_reports_a_worse_angle(d1):
         drive, imp.replace(rigid_runout=0.0), 300.0, model=model, samples=n, scan_samples=n, n_grid=grid
     )
     assert flat.best_angle == 0.0 and flat.lever == 1.0 and flat.best is flat.design
+
+
+def test_the_loaded_ke_picture_joins_each_cam_phase_into_one_line():
+    """D2's 404 loaded states step the cam by 0.2475 turn each: every 4th sample sees the same cam phase, so the
+    picture draws 4 lines per curve (issue 23: the samples were drawn as unjoined dots that read as interleaved
+    strands); a step of whole turns draws one."""
+    from types import SimpleNamespace
+
+    import matplotlib
+    import matplotlib.axes
+
+    matplotlib.use("Agg")
+    from wgcad.export import ke_figures
+
+    turns = np.arange(404) * (100.0 / 404.0)
+    assert ke_figures.strands(turns) == 4
+    assert ke_figures.strands(np.arange(50) * 2.0) == 1
+    assert ke_figures.strands(np.arange(50) * (1.0 / 3.0 + 1.0)) == 3
+    # the picture: one joined line per strand and torque (plus the no-load ones)
+    n = 404
+    res = SimpleNamespace(
+        phi_h=2 * np.pi * np.arange(n * 8) / 8 * (100.0 / 404.0) * 1.0,
+        ke=np.sin(np.arange(n * 8) * 0.01),
+        ke_pp=2.0,
+        n_per_mesh=8,
+    )
+    L = SimpleNamespace(
+        phi_h=2 * np.pi * turns, ke=np.cos(turns * 0.1), ke_pp=2.0, torque_nm=80.0, periods=np.arange(n)
+    )
+    drawn = []
+    real_plot = matplotlib.axes.Axes.plot
+
+    def spy(self, *a, **k):
+        drawn.append(a[2] if len(a) > 2 and isinstance(a[2], str) else k.get("ls", "-"))
+        return real_plot(self, *a, **k)
+
+    matplotlib.axes.Axes.plot = spy
+    try:
+        ke_figures.ke_load_png("t", res, [L])
+    finally:
+        matplotlib.axes.Axes.plot = real_plot
+    assert sum(1 for s in drawn if s.startswith("-") and s != "-") == 8  # 4 no-load strands, 4 loaded ones, all joined

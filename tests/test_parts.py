@@ -419,3 +419,31 @@ def test_library_call_writes_what_the_cli_wrote(small_run, tmp_path):
             assert p.read_bytes() == (out / p.name).read_bytes(), p.name
     cli = json.loads((out / "small_parts.json").read_text())
     assert res.report["parts"] == cli["parts"] and res.report["sizes_mm"] == cli["sizes_mm"]
+
+
+@pytest.mark.parametrize("name", ["d1_involute", "d3_external", "d4_sectored"])
+def test_every_part_drawing_has_a_title_block_below_the_part(name, tmp_path):
+    """Issue 23, item 4: drawings had data blocks but no title block. Every part's DXF (read back with ezdxf) has a
+    TITLE layer naming the drive, the part, the design file, units and scale, and the material as the design
+    states it (only for the flexspline: [material] is its material), lying wholly below the drawing."""
+    path = TEMPLATES / f"{name}.toml"
+    assert main(["parts", str(path), "--out", str(tmp_path), "--format", "dxf", "--quiet"]) == 0
+    files = sorted(tmp_path.glob(f"{name}_*.dxf"))
+    assert files
+    design = load_design(path)
+    for f in files:
+        doc = ezdxf.readfile(f)
+        msp = doc.modelspace()
+        title = [e for e in msp.query("TEXT") if e.dxf.layer == "TITLE"]
+        text = "\n".join(e.dxf.text for e in title)
+        assert text.startswith(f"TITLE: {design.drive.name} - "), f.name
+        part = f.stem[len(name) + 1 :]
+        for word in (f"design file: {name}.toml", f"part: {part}", "units: mm", "scale: 1:1", "material:"):
+            assert word in text, (f.name, word)
+        assert ("S_u =" in text) == (part == "flexspline" and design.material.ultimate_strength_mpa is not None)
+        top = max(e.dxf.insert[1] + e.dxf.height for e in title)
+        others = [e for e in msp if e.dxf.layer != "TITLE"]
+        from ezdxf import bbox
+
+        lowest = min(bbox.extents(others).extmin[1], *(e.dxf.insert[1] for e in others if e.dxftype() == "TEXT"))
+        assert top < lowest, f.name

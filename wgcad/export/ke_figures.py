@@ -9,7 +9,7 @@ from wgcad.units import ARCSEC_PER_RAD
 from .mpl import png_bytes
 from .mpl import pyplot as _plt
 
-__all__ = ["ke_png", "install_png", "flank_png", "ke_load_png"]
+__all__ = ["ke_png", "install_png", "flank_png", "ke_load_png", "strands"]
 
 _AS = ARCSEC_PER_RAD
 
@@ -161,42 +161,70 @@ def flank_png(title: str, turns, errors: dict, zones=("major axis", "second wave
     return png_bytes(fig)  # laid out above, with room for the legend below the panels
 
 
+def strands(turns: np.ndarray) -> int:
+    """How many interleaved strands samples at ``turns`` (generator turns, evenly spaced) form: successive samples
+    step the cam by a fraction of a turn, so every ``m``-th sample sees nearly the same cam phase and they lie on
+    one smooth curve (1 when the step is a whole number of turns or there are too few samples)."""
+    if len(turns) < 3:
+        return 1
+    frac = float(np.mod(turns[1] - turns[0], 1.0))
+    frac = min(frac, 1.0 - frac)
+    if frac < 1e-9:
+        return 1
+    return max(1, min(int(round(1.0 / frac)), len(turns) // 2))
+
+
 def ke_load_png(title: str, res, loaded: list) -> bytes:
-    """No-load KE over the revolution with the loaded KE at its whole mesh periods, one curve per torque (arcsec against generator turns)."""
+    """No-load KE over the revolution with the loaded KE at its whole mesh periods, one colour per torque, each drawn
+    as its strands (the samples of one cam phase joined; arcsec against generator turns)."""
     plt = _plt()
     fig, ax = plt.subplots(1, 1, figsize=(11, 5.2), dpi=150)
     turns = np.abs(res.phi_h) / (2 * np.pi)
     ax.plot(
-        turns, res.ke * _AS, lw=0.4, color="0.55", label=f"no load, every angle: {res.ke_pp * _AS:.2f}'' peak to peak"
+        turns, res.ke * _AS, lw=0.4, color="0.75", label=f"no load, every angle: {res.ke_pp * _AS:.2f}'' peak to peak"
     )
+    m = 1
     if loaded:
         L = loaded[0]
         idx = L.periods * res.n_per_mesh
         nl = (res.ke[idx] - res.ke[idx[0]]) * _AS
-        ax.plot(
-            np.abs(L.phi_h) / (2 * np.pi),
-            nl,
-            "s",
-            ms=3.5,
-            mfc="none",
-            color="k",
-            label=f"no load at the loaded samples' angles: {nl.max() - nl.min():.2f}'' peak to peak",
-        )
+        t = np.abs(L.phi_h) / (2 * np.pi)
+        m = strands(t)
+        for j in range(m):
+            ax.plot(
+                t[j::m],
+                nl[j::m],
+                "-s",
+                ms=2.5,
+                lw=0.8,
+                mfc="none",
+                color="k",
+                label=f"no load at the loaded samples' angles: {nl.max() - nl.min():.2f}'' peak to peak"
+                if j == 0
+                else None,
+            )
     for i, L in enumerate(loaded):
         t = np.abs(L.phi_h) / (2 * np.pi)
-        ax.plot(
-            t,
-            L.ke * _AS,
-            "o",
-            ms=2.5,
-            color=f"C{i}",
-            label=f"{L.torque_nm:g} N m: {L.ke_pp * _AS:.2f}'' peak to peak at {len(L.ke)} whole mesh periods",
-        )
+        for j in range(m):
+            ax.plot(
+                t[j::m],
+                L.ke[j::m] * _AS,
+                "-o",
+                ms=2.0,
+                lw=0.9,
+                color=f"C{i}",
+                label=f"{L.torque_nm:g} N m: {L.ke_pp * _AS:.2f}'' peak to peak at {len(L.ke)} whole mesh periods"
+                if j == 0
+                else None,
+            )
     ax.set_xlabel("generator turns (one flexspline revolution)")
     ax.set_ylabel("KE, arcsec (each curve from its first sample)")
     ax.legend(fontsize=8.5, loc="upper left", bbox_to_anchor=(1.01, 1.0), borderaxespad=0.0)
     ax.grid(alpha=0.3)
-    ax.set_title(title + "\n(samples at whole mesh periods: a stroboscopic view of the cam-order content)", fontsize=10)
+    how = f"every {m}th sample joined: one line per cam phase" if m > 1 else "samples joined"
+    ax.set_title(
+        title + f"\n(samples at whole mesh periods, {how}: a stroboscopic view of the cam-order content)", fontsize=10
+    )
     return _png(fig, plt)
 
 

@@ -94,17 +94,21 @@ def write_part_files(
             files.append(path)
             return batch.temp_path(path)
 
+        from .parts.title import title_layer
+
         for p in parts:
             tick(done / total, f"files: {p.name}")
             report["parts"][p.name] = {"volume_mm3": round(p.volume_mm3, 4), **_jsonable(p.info)}
-            if p.layers and "dxf" in fmts:
+            # every drawing carries its title block (what, from which design, units, scale, material)
+            layers = [*p.layers, title_layer(p.name, design, source, p.layers, drive.tol)] if p.layers else []
+            if layers and "dxf" in fmts:
                 from .dxf import write_dxf
 
-                write_dxf(target(f"{stem}_{p.name}.dxf"), p.layers)
-            if p.layers and "svg" in fmts:
+                write_dxf(target(f"{stem}_{p.name}.dxf"), layers)
+            if layers and "svg" in fmts:
                 from .svg import write_svg
 
-                write_svg(target(f"{stem}_{p.name}.svg"), p.layers, f"{design.drive.name}: {p.name}")
+                write_svg(target(f"{stem}_{p.name}.svg"), layers, f"{design.drive.name}: {p.name}")
             if "stl" in fmts:
                 from .stl import write_stl
 
