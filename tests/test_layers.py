@@ -26,7 +26,7 @@ FLOORS = [
     {"clearance"},
     {"elastic"},
     {"accuracy", "sector"},
-    {"rating"},
+    {"rating", "envelope"},
     {"audit", "regression"},
     {"sweep"},
     {"report"},
