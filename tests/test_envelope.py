@@ -141,30 +141,55 @@ def test_the_conjugate_flank_is_touched_and_never_crossed_over_the_pass(name):
 
 @pytest.mark.parametrize("name", ["d1_involute", "d2"])
 def test_the_audit_of_a_conjugate_pair_finds_contact_and_no_interference(name):
-    """Issue 25: the rigid gear made conjugate to the flexspline (at the generator's centre section) audited by
-    the clearance engine over a whole generator turn at that section, 0.5 deg steps, figures refined on the exact
-    pieces: no interference, and the smallest clearance is the contact: between -0.01 um (the chords' error) and
-    1 um (measured -3.3e-5 um on D1, -3.9e-5 um on D2; backlash zero to 1e-5 arcmin)."""
+    """Issue 25: the design with [rigid] flanks = "conjugate" (its rigid gear made for the flexspline at the
+    generator's centre section) audited by the clearance engine over a whole generator turn at that section, 0.5
+    deg steps, refined on the exact pieces (the engine rebuilds the drive from the design for its finer polygons,
+    so the design itself must say conjugate): no interference, and the smallest clearance is the contact, between
+    -0.01 um (the chords' error) and 1 um (measured -0.0022 um on D1); no dead travel: the backlash is nan (the
+    engine finds the flanks touching) or below 1e-3 arcmin."""
     import dataclasses
 
     from wgcad.clearance import AuditSettings, audit
-    from wgcad.envelope.rigid import conjugate_rigid_gear
 
-    d = build_drive(load_design(TEMPLATES / f"{name}.toml"))
-    gear, cf = conjugate_rigid_gear(d)
-    assert gear.spec.form == "conjugate" and gear.spec.z == d.rigid.spec.z
-    conj = dataclasses.replace(d, rigid=gear)
-    z = d.design.generator.generator_z if d.coned else None
-    n = 720
-    res = audit(
-        conj,
-        AuditSettings(angles=np.deg2rad(np.arange(n) * (360.0 / n)), sections=[z], interference_tol=1e-3, refine=True),
-    )
-    f = res.findings["min_clearance"]
+    design = load_design(TEMPLATES / f"{name}.toml")
+    own = build_drive(design)
+    conj_design = dataclasses.replace(design, rigid=dataclasses.replace(design.rigid, flanks="conjugate"))
+    d = build_drive(conj_design)
+    assert d.rigid.spec.form == "conjugate" and d.rigid.spec.z == own.rigid.spec.z
+    z = design.generator.generator_z if own.coned else None
+    st = AuditSettings(angles=np.deg2rad(np.arange(720) * 0.5), sections=[z], interference_tol=1e-3, refine=True)
+    res = audit(d, st)
     assert not res.interference
-    assert f.method == "exact"
+    assert res.findings["min_clearance"].method == "exact"
     assert -1e-5 < res.min_clearance < 1e-3, res.min_clearance
-    assert abs(np.rad2deg(res.backlash) * 60) < 1e-3
-    # the design's own rigid gear, for contrast, leaves tens of um of play at the same section
-    own = audit(d, AuditSettings(angles=np.deg2rad(np.arange(n) * (360.0 / n)), sections=[z], interference_tol=1e-3))
-    assert own.min_clearance > 5e-3
+    assert not (abs(np.rad2deg(res.backlash) * 60) > 1e-3)
+    # the design's own rigid gear, for contrast, leaves um of play at the same section
+    assert audit(own, st).min_clearance > 5e-3
+
+
+def test_every_command_runs_on_the_conjugate_template(tmp_path, capsys):
+    """templates/d1_conjugate.toml (D1 with [rigid] flanks = "conjugate"): generate, audit, the load audit, ke,
+    parts and rating all run on it without a traceback. Its audit shows why coned cups need spatial teeth: made
+    for the generator's centre line (z = 18 mm), the pair touches there (-0.0022 um), interferes at the open end
+    where coning deepens the mesh (z = 0: -88.7 um) and gapes at the inner end (z = 30: 18.4 um)."""
+    from wgcad.clearance import AuditSettings, audit
+    from wgcad.cli import main
+
+    t = str(TEMPLATES / "d1_conjugate.toml")
+    runs = [
+        (["generate", t, "--out", str(tmp_path / "g"), "--no-stl", "--quiet"], {0}),
+        (["audit", t, "--quiet", "--json", str(tmp_path / "a.json")], {1}),  # interferes at the open end
+        (["audit", t, "--torque-nm", "0,500", "--quiet"], {0, 1}),
+        (["ke", t, "--per-mesh", "4"], {0}),
+        (["parts", t, "--out", str(tmp_path / "p"), "--format", "dxf", "--quiet"], {0}),
+    ]
+    for args, codes in runs:
+        assert main(args) in codes, args
+        assert "Traceback" not in capsys.readouterr().err
+    d = build_drive(load_design(t))
+    assert d.rigid.spec.form == "conjugate"
+    figs = {}
+    for z in (0.0, 18.0, 30.0):
+        res = audit(d, AuditSettings(angles=np.deg2rad(np.arange(720) * 0.5), sections=[z], interference_tol=1e-3))
+        figs[z] = res.min_clearance
+    assert figs[0.0] < -50e-3 and -1e-5 < figs[18.0] < 1e-3 and figs[30.0] > 5e-3

@@ -121,7 +121,12 @@ def test_arc_pieces_expose_centre_and_radius():
         next(p for p in g.pieces if p.kind == "involute").center
 
 
-@pytest.mark.parametrize("name,g", [(n, g) for n, g in GEARS if "d1_" in n], ids=[n for n, _ in GEARS if "d1_" in n])
+# the conjugate rigid gear (d1_conjugate) is left out: its flanks are line pieces between exact envelope points (a
+# chord of a line has no error to split) and its tip and root arcs are short, so neither side reaches 0.2 tol
+_BANDED = [(n, g) for n, g in GEARS if "d1_" in n and g.spec.form != "conjugate"]
+
+
+@pytest.mark.parametrize("name,g", _BANDED, ids=[n for n, _ in _BANDED])
 def test_symmetric_band_stays_within_tol_on_either_side(name, g):
     # issue 8: one-sided chords make teeth systematically thin or fat; the band splits the error
     from wgcad.profiles.band import band_deviation, band_points

@@ -184,4 +184,24 @@ def build_drive(
         beta=None if g.beta_deg is None else float(np.deg2rad(g.beta_deg)),
         offset=g.offset,
     )
-    return Drive(design, flex, rigid, law, float(r_m), float(flex_rim), float(rigid_rim), tol)
+    drive = Drive(design, flex, rigid, law, float(r_m), float(flex_rim), float(rigid_rim), tol)
+    if design.rigid.flanks == "conjugate":
+        drive = _conjugate(drive)
+    return drive
+
+
+def _conjugate(drive: Drive) -> Drive:
+    """The drive with its rigid gear's flanks made conjugate to the flexspline's teeth (docs/models.md 13)."""
+    from dataclasses import replace
+
+    from .envelope.rigid import conjugate_rigid_gear
+
+    d = drive.design
+    z = d.rigid.conjugate_z
+    if z is None:
+        z = d.generator.generator_z if drive.coned else 0.5 * d.drive.face_width
+    try:
+        gear, _ = conjugate_rigid_gear(drive, z if drive.coned else None)
+    except ValueError as e:
+        raise DesignError("rigid.flanks", f"cannot be made conjugate: {e}") from None
+    return replace(drive, rigid=gear)

@@ -209,6 +209,22 @@ class GearSpec:
         rule="touches both flanks (checked when the report is made)",
         why="measuring pins are about 1.5-1.9 m; a pin outside [0.1 m, 5 m] cannot touch both flanks",
     )
+    flanks: str = _key(
+        "the flanks: of [tooth] form, or conjugate to the flexspline's teeth under the law (rigid gear only)",
+        choices=("form", "conjugate"),
+        default="form",
+        rule="conjugate: rigid gear of an internal-deformation drive only (docs/models.md 13)",
+    )
+    conjugate_z: float | None = _key(
+        "axial section whose law the conjugate flanks are made for",
+        unit="mm",
+        lo=Rel("0", lambda c: 0.0),
+        hi=Rel("face width", lambda c: c["face_width"]),
+        default=None,
+        default_doc="the generator's centre line (generator_z) on a coned cup, else mid-face",
+        rule="only with flanks = conjugate",
+        why="a section of the toothed rim",
+    )
 
 
 @dataclass(frozen=True)
@@ -421,8 +437,14 @@ def validate(d: Design) -> Design:
     _positive("tooth.addendum_coef", t.addendum_coef)
     if t.clearance_coef is not None and t.clearance_coef < 0:
         raise DesignError("tooth.clearance_coef", f"must be >= 0, got {t.clearance_coef:g}")
+    if d.flexspline.flanks != "form":
+        raise DesignError("flexspline.flanks", "only the rigid gear's flanks can be made conjugate (give 'form')")
+    if d.rigid.flanks == "conjugate" and dr.deformation != "internal":
+        raise DesignError("rigid.flanks", "conjugate flanks are built for internal deformation only")
     for name in ("flexspline", "rigid"):
         gs: GearSpec = getattr(d, name)
+        if gs.conjugate_z is not None and gs.flanks != "conjugate":
+            raise DesignError(f"{name}.conjugate_z", "is used only with flanks = 'conjugate'")
         _positive(f"{name}.rim_thickness", gs.rim_thickness)
         if gs.fillet_coef < 0:
             raise DesignError(f"{name}.fillet_coef", f"must be >= 0, got {gs.fillet_coef:g}")

@@ -5,8 +5,10 @@ joined by chords within 5 nm of the envelope). Where the flexspline tooth
 never touches, the tooth is completed by stated rules: from the tip circle to
 the flank's first point the tip circle is raised to that point (the tooth's
 path there is bounded by its own corners, which a radial wall did not clear),
-and from its last point to the root circle the wall runs radially; tip and
-root are arcs about the gear's centre. The gear keeps
+beyond its last point the tooth's corners trace paths, not envelopes: the wall
+follows the largest angle the tooth reaches at each radius (1 um bands) plus
+0.2 um, then runs radially to the root circle; tip and root are arcs about
+the gear's centre. The gear keeps
 the design's tooth count, module and radii; only its flanks change.
 """
 
@@ -30,6 +32,47 @@ def _turn(p: np.ndarray, a: float) -> np.ndarray:
     return p @ np.array([[c, s], [-s, c]])
 
 
+#: the wall beyond the conjugate flank clears the tooth's sampled path by this much, mm (0.2 um: the samples are
+#: 0.25 um apart along the tooth and 2e-4 rad of generator angle apart, so the path between them strays less)
+WALL_MARGIN = 2e-4
+
+
+def _tip_wall(drive, cf, side: int = 1) -> np.ndarray:
+    """Points (rigid frame, by radius) of the wall beyond the flank's last point: the tooth's corners there trace
+    paths, not envelopes (D1: the tip corner passed a radial wall by 2.3 um), so the wall follows the largest
+    angle the tooth reaches at each radius, plus :data:`WALL_MARGIN`, in 1 um bands of radius."""
+    from .conjugate import flank_pieces
+
+    r_last = float(np.hypot(*cf.points[-1]))
+    pts = np.concatenate(
+        [p.point(np.linspace(p.t0, p.t1, max(2, int(p.length() / 2.5e-4)))) for p in flank_pieces(drive.flex, side)]
+    )
+    pts = pts[np.hypot(*pts.T) > drive.flex.r_f + 0.5 * (drive.flex.r_a - drive.flex.r_f)]  # the tooth's upper half
+    t = np.arange(-0.6, 0.6, 2e-4)
+    rot, shift = cf.motion.pose(t)
+    r_all, a_all = [], []
+    for k in range(0, len(t), 500):
+        c, s = np.cos(rot[k : k + 500]), np.sin(rot[k : k + 500])
+        X = np.einsum("kij,nj->kni", np.stack([np.stack([c, -s], -1), np.stack([s, c], -1)], 1), pts)
+        X = X + shift[k : k + 500, None]
+        r = np.hypot(X[..., 0], X[..., 1])
+        sel = r > r_last
+        r_all.append(r[sel])
+        a_all.append(np.arctan2(X[..., 1][sel], X[..., 0][sel]))
+    r, a = np.concatenate(r_all), np.concatenate(a_all)
+    if not len(r):
+        return np.empty((0, 2))
+    bands = np.floor((r - r_last) / 1e-3).astype(int)
+    top = np.full(bands.max() + 1, -np.inf)
+    np.maximum.at(top, bands, side * a)
+    rb = r_last + (np.arange(len(top)) + 1.0) * 1e-3
+    ok = np.isfinite(top)
+    rb, ang = rb[ok], side * (top[ok] + WALL_MARGIN / rb[ok])
+    # one wall, never turning back towards the tooth as it goes out
+    ang = side * np.maximum.accumulate(side * ang)
+    return np.stack([rb * np.cos(ang), rb * np.sin(ang)], -1)
+
+
 def conjugate_rigid_gear(drive, z: float | None = None) -> tuple[Gear, object]:
     """The rigid gear conjugate to ``drive``'s flexspline at section ``z`` (default: the generator's centre
     section), and the :class:`~wgcad.envelope.space.ConjugateFlank` it was made from."""
@@ -41,7 +84,8 @@ def conjugate_rigid_gear(drive, z: float | None = None) -> tuple[Gear, object]:
     half = pi / zr
     # the flank bounds space 0 (centred on +x) from above; in the tooth frame (rigid tooth centred on +x) it is
     # the tooth's lower flank: turn by -pi/z, then mirror for the upper flank that the half period runs along
-    low = _turn(np.asarray(cf.points, float), -half)
+    wall = _tip_wall(drive, cf)
+    low = _turn(np.concatenate([np.asarray(cf.points, float), wall]), -half)
     up = low * np.array([1.0, -1.0])
     up = up[np.argsort(np.hypot(*up.T))]  # from the tip (inner) outward
     a_up = np.arctan2(up[:, 1], up[:, 0])
@@ -63,16 +107,20 @@ def conjugate_rigid_gear(drive, z: float | None = None) -> tuple[Gear, object]:
         raise ValueError("the conjugate flank reaches past the middle of the space: the rigid teeth would be pointed")
     hp.append(pc.arc((0.0, 0.0), r_f, float(a_up[-1]), half))
     pieces = tuple(pc.merge_arcs(pc.mirror_path(hp) + hp))
-    # the polylines of the outline: the flank's points as they are, the arcs within the drive's tolerance
+    # the polylines of the outline, within the drive's tolerance like every other gear's: arcs by their sagitta,
+    # the flank's exact points thinned (Douglas-Peucker to half the tolerance); the pieces keep every point
+    import shapely
+
     tol = drive.tol
-    n_tip = max(2, int(np.ceil(r_a * a_up[0] / max(tol, 1e-4))) + 1)
-    n_root = max(2, int(np.ceil(r_f * (half - a_up[-1]) / max(tol, 1e-4))) + 1)
-    tip = r_a * np.stack([np.cos(np.linspace(0, a_up[0], n_tip)), np.sin(np.linspace(0, a_up[0], n_tip))], -1)
-    ang = np.linspace(a_up[-1], half, n_root)
-    root = r_f * np.stack([np.cos(ang), np.sin(ang)], -1)
-    half_period = np.concatenate(
-        [tip, up if np.hypot(*(up[0] - tip_pt)) <= 1e-12 else np.vstack([tip_pt, up])[1:], root]
-    )
+
+    def arc_pts(r, a0, a1):
+        n = max(2, int(np.ceil(abs(a1 - a0) * r / np.sqrt(8.0 * r * tol))) + 1)
+        a = np.linspace(a0, a1, n)
+        return r * np.stack([np.cos(a), np.sin(a)], -1)
+
+    flank = np.vstack([tip_pt, up]) if np.hypot(*(up[0] - tip_pt)) > 1e-12 else up
+    flank = np.asarray(shapely.LineString(flank).simplify(0.5 * tol).coords)
+    half_period = np.concatenate([arc_pts(r_a, 0.0, a_up[0])[:-1], flank, arc_pts(r_f, a_up[-1], half)[1:]])
     keep = np.concatenate([[True], np.hypot(*np.diff(half_period, axis=0).T) > 1e-9])
     half_period = half_period[keep]
     mirror = half_period[::-1] * np.array([1.0, -1.0])

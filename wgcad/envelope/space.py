@@ -135,7 +135,7 @@ def conjugate_flank(
     side: int = 1,
     t_max: float = 1.4,
     steps: int = 1401,
-    points: int = 400,
+    points: int = 50,
     sagitta_tol: float = 5e-6,
 ) -> ConjugateFlank:
     """The rigid flank conjugate to the flexspline tooth of ``drive`` under its law at section ``z`` (default:
@@ -168,7 +168,7 @@ def conjugate_flank(
     if len(keep) < 2:
         raise ValueError("the flexspline tooth never touches the rigid tooth's side of its path: no conjugate flank")
     # again, finely, over the stretch of the pass where the flank is touched, until the chords lie within
-    # sagitta_tol of the envelope (doubling the angles up to 16 times the first count)
+    # sagitta_tol of the envelope (doubling the angles up to 64 times the first count)
     dt = t[1] - t[0]
     lo, hi = env.t[keep].min() - 3 * dt, env.t[keep].max() + 3 * dt
     n = points
@@ -176,9 +176,24 @@ def conjugate_flank(
         env = envelope(pieces, mot, np.linspace(lo, hi, n))
         keep = _boundary(env, rigid_side(env), t, polys, tol, pieces, mot)
         sag = _sagitta(env, keep, pieces, mot)
-        if sag < sagitta_tol or n >= 16 * points:
+        if sag < sagitta_tol or n >= 64 * points:
             break
         n *= 2
+    # the flank's ends to a 64th of that step: where the boundary starts and stops does not hang on the grid
+    # (D1 involute at 50 angles: its first point 20 um above the tip circle; the rigid tip follows it)
+    step = (hi - lo) / (n - 1)
+    tk = env.t[keep]
+    extra = [np.linspace(tk.min() - step, tk.min(), 65), np.linspace(tk.max(), tk.max() + step, 65)]
+    ends = envelope(pieces, mot, np.concatenate(extra))
+    ek = _boundary(ends, rigid_side(ends), t, polys, tol, pieces, mot)
+    if len(ek):
+        merged = {
+            f: np.concatenate([getattr(env, f)[keep], getattr(ends, f)[ek]])
+            for f in ("t", "piece", "s", "points", "normal", "branch", "residual_mm")
+        }
+        order = np.argsort(np.hypot(*merged["points"].T))
+        env = type(env)(**{f: v[order] for f, v in merged.items()})
+        keep = np.arange(len(order))  # every point kept, in order of radius (more points: shorter chords)
     pts = env.points[keep]
     pts.flags.writeable = False
     return ConjugateFlank(pts, env.t[keep], env.residual_mm[keep], sag, mot)

@@ -108,6 +108,14 @@ class Gear:
         """Half the tooth's angular thickness at ``radius`` (flank zone, no fillet), rad."""
         sp = self.spec
         radius = np.asarray(radius, dtype=float)
+        if sp.form == "conjugate":  # the flank as built (docs/models.md 13): its polyline, angle against radius
+            hp = self.half_period
+            r = np.hypot(hp[:, 0], hp[:, 1])
+            lo, hi = min(self.r_a, self.r_f), max(self.r_a, self.r_f)
+            on = (r > lo + 1e-9) & (r < hi - 1e-9)
+            rf, af = r[on], np.arctan2(hp[on, 1], hp[on, 0])
+            o = np.argsort(rf)
+            return np.interp(radius, rf[o], af[o])
         if sp.form == "involute":
             psi_b = _involute_base_angle(sp)
             h = iv.half_angle_at(psi_b, self.r_base, radius)

@@ -84,6 +84,12 @@ def flank_zone(gear: Gear) -> tuple[float, float]:
     sp = gear.spec
     if sp.form == "cycloidal":
         return tuple(sorted((gear.r_a, gear.r_f)))
+    if sp.form == "conjugate":  # the conjugate flank as built (docs/models.md 13): tip circle to its last point
+        hp = gear.half_period
+        r = np.hypot(hp[:, 0], hp[:, 1])
+        lo, hi = min(gear.r_a, gear.r_f), max(gear.r_a, gear.r_f)
+        on = r[(r > lo + 1e-9) & (r < hi - 1e-9)]
+        return (gear.r_a, float(on.max())) if sp.internal else (float(on.min()), gear.r_a)
     r_b = gear.r_base
     rho = sp.fillet_coef * sp.module
     base = _involute_base_angle(sp)
@@ -335,6 +341,9 @@ def concave_radii(gear: Gear) -> dict:
     """Smallest curvature radius of each concave piece of the outline (material side), mm; closed forms."""
     sp = gear.spec
     out = {}
+    if sp.form == "conjugate":
+        # the radial wall above the conjugate flank meets the root circle in a corner (docs/models.md 13)
+        return {"root_corner": 0.0, "root_circle": gear.r_f} if sp.internal else {"root_corner": 0.0}
     if sp.form == "involute":
         rho = sp.fillet_coef * sp.module
         out["root_fillet"] = rho  # 0: the flank meets the root in a sharp corner
@@ -413,6 +422,12 @@ def pin_check(gear: Gear, pin_diameter: float | None = None) -> dict:
 
 
 def _per_thickness(gear: Gear, figure, at: float) -> float | None:
+    if gear.spec.form == "conjugate":  # its flanks are the envelope, not a thinned rack form: no thickness lever
+        return None
+    return _per_thickness_form(gear, figure, at)
+
+
+def _per_thickness_form(gear: Gear, figure, at: float) -> float | None:
     """d figure / d tooth thickness (mm/mm), or None where it is not a derivative one can use.
 
     Central differences of +-:data:`SENSITIVITY_STEP` (one-sided where a
