@@ -145,7 +145,7 @@ def test_the_audit_of_a_conjugate_pair_finds_contact_and_no_interference(name):
     generator's centre section) audited by the clearance engine over a whole generator turn at that section, 0.5
     deg steps, refined on the exact pieces (the engine rebuilds the drive from the design for its finer polygons,
     so the design itself must say conjugate): no interference, and the smallest clearance is the contact, between
-    -0.01 um (the chords' error) and 1 um (measured -0.0022 um on D1); no dead travel: the backlash is nan (the
+    -0.01 um and 1 um (measured -6e-12 um on D1, 3e-12 on D2); no dead travel: the backlash is nan (the
     engine finds the flanks touching) or below 1e-3 arcmin."""
     import dataclasses
 
@@ -170,8 +170,8 @@ def test_the_audit_of_a_conjugate_pair_finds_contact_and_no_interference(name):
 def test_every_command_runs_on_the_conjugate_template(tmp_path, capsys):
     """templates/d1_conjugate.toml (D1 with [rigid] flanks = "conjugate"): generate, audit, the load audit, ke,
     parts and rating all run on it without a traceback. Its audit shows why coned cups need spatial teeth: made
-    for the generator's centre line (z = 18 mm), the pair touches there (-0.0022 um), interferes at the open end
-    where coning deepens the mesh (z = 0: -88.7 um) and gapes at the inner end (z = 30: 18.4 um)."""
+    for the generator's centre line (z = 18 mm), the pair touches there (-6e-12 um), interferes at the open end
+    where coning deepens the mesh (z = 0: -39.0 um) and gapes at the inner end (z = 30: 18.4 um)."""
     from wgcad.clearance import AuditSettings, audit
     from wgcad.cli import main
 
@@ -192,4 +192,4 @@ def test_every_command_runs_on_the_conjugate_template(tmp_path, capsys):
     for z in (0.0, 18.0, 30.0):
         res = audit(d, AuditSettings(angles=np.deg2rad(np.arange(720) * 0.5), sections=[z], interference_tol=1e-3))
         figs[z] = res.min_clearance
-    assert figs[0.0] < -50e-3 and -1e-5 < figs[18.0] < 1e-3 and figs[30.0] > 5e-3
+    assert figs[0.0] < -20e-3 and -1e-5 < figs[18.0] < 1e-3 and figs[30.0] > 5e-3

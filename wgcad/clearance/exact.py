@@ -41,7 +41,10 @@ class ExactTooth:
         self.hi = np.array([max(p.t0, p.t1) for p in pcs])
         # travel direction of the counter-clockwise polygon along increasing t
         self.sense = np.array([1.0 if p.t1 >= p.t0 else -1.0 for p in pcs])
-        grid = [np.linspace(lo, hi, _SEED_GRID) for lo, hi in zip(self.lo, self.hi)]
+        # a spline (many cubic segments in one piece) gets four seeds per segment: one seed per 2.6 segments left
+        # the projection in a neighbouring segment's basin (a -38 um figure at a contact on D1's conjugate flank)
+        self.seed_grid = max([_SEED_GRID] + [4 * (len(p.params) // 8) + 1 for p in pcs if p.kind == "spline"])
+        grid = [np.linspace(lo, hi, self.seed_grid) for lo, hi in zip(self.lo, self.hi)]
         self.grid_t = np.array(grid)  # (n, G)
         self.grid_p = np.stack([p.point(g) for p, g in zip(pcs, grid)])  # (n, G, 2)
         # longest step between grid points of each piece: bounds how far the nearest grid point can be
@@ -77,14 +80,21 @@ class ExactTooth:
         """Per-piece parameters as arrays, so one call evaluates many pieces of one kind (by kind, not by piece)."""
         n = self.n
         self.kind = np.array(
-            [{"arc": 0, "line": 1, "involute": 2, "epicycloid": 3, "hypocycloid": 3}[p.kind] for p in self.pieces]
+            [
+                {"arc": 0, "line": 1, "involute": 2, "epicycloid": 3, "hypocycloid": 3, "cubic": 4, "spline": 5}[p.kind]
+                for p in self.pieces
+            ]
         )
-        par = np.zeros((n, 4))
+        par = np.zeros((n, 8))
         for i, p in enumerate(self.pieces):
             if p.kind == "arc":
                 par[i, :3] = p.params
             elif p.kind == "line":
+                par[i, :4] = p.params
+            elif p.kind == "cubic":
                 par[i] = p.params
+            elif p.kind == "spline":
+                pass  # evaluated by the piece itself (its segments are not one row of parameters)
             elif p.kind == "involute":
                 par[i, :2] = p.params
             else:
@@ -108,6 +118,15 @@ class ExactTooth:
             if not sel.any():
                 continue
             ii, tt = idx[sel], t[sel]
+            if kd == 5:  # spline: each piece evaluates itself (rot and flip included)
+                where = np.flatnonzero(sel)
+                for j in np.unique(ii):
+                    m = ii == j
+                    pcs = self.pieces[j]
+                    P[where[m]] = pcs.point(tt[m])
+                    D1[where[m]] = pcs.deriv(tt[m])
+                    D2[where[m]] = pcs.deriv2(tt[m])
+                continue
             pr = self.par[ii]
             if kd == 0:  # arc
                 c, s_ = np.cos(tt), np.sin(tt)
@@ -135,6 +154,14 @@ class ExactTooth:
                 px, py = cu * ca, cu * sa
                 qx, qy = du * ca - dn * sa, du * sa + dn * ca
                 rx, ry = eu * ca - en * sa, eu * sa + en * ca
+            elif kd == 4:  # cubic Bezier (pieces._cubic)
+                P0, P1, P2, P3 = pr[:, 0:2], pr[:, 2:4], pr[:, 4:6], pr[:, 6:8]
+                u = (1.0 - tt)[:, None]
+                v = tt[:, None]
+                b = u**3 * P0 + 3 * u * u * v * P1 + 3 * u * v * v * P2 + v**3 * P3
+                d = 3 * u * u * (P1 - P0) + 6 * u * v * (P2 - P1) + 3 * v * v * (P3 - P2)
+                e = 6 * u * (P2 - 2 * P1 + P0) + 6 * v * (P3 - 2 * P2 + P1)
+                px, py, qx, qy, rx, ry = b[:, 0], b[:, 1], d[:, 0], d[:, 1], e[:, 0], e[:, 1]
             else:  # epi/hypocycloid in u = 1 - cos(phi/2) (pieces._cycloid)
                 r, rho, sg = pr[:, 0], pr[:, 1], pr[:, 2]
                 k = rho / r
@@ -168,7 +195,7 @@ class ExactTooth:
         """Piece index and parameter of points that lie on the pieces (the polygon's vertices)."""
         d2 = self.grid_d2(pts)  # (V, n, G)
         flat = d2.reshape(len(pts), -1).argmin(axis=1)
-        idx, g = np.divmod(flat, _SEED_GRID)
+        idx, g = np.divmod(flat, self.seed_grid)
         t = self.grid_t[idx, g]
         t = self._project(pts, idx, t)
         return idx, t

@@ -1,13 +1,15 @@
 """A rigid gear whose flanks are conjugate to the flexspline's teeth under the design's law (docs/models.md 13).
 
-The flank is :func:`wgcad.envelope.space.conjugate_flank` (exact points
-joined by chords within 5 nm of the envelope). Where the flexspline tooth
+The flank is :func:`wgcad.envelope.space.conjugate_flank`: its exact points
+joined by one tangent-continuous cubic Hermite spline with the envelope's tangents (smooth,
+one piece for the exports, and closer to the envelope than the chords, which
+lie within 5 nm of it). Where the flexspline tooth
 never touches, the tooth is completed by stated rules: from the tip circle to
 the flank's first point the tip circle is raised to that point (the tooth's
 path there is bounded by its own corners, which a radial wall did not clear),
 beyond its last point the tooth's corners trace paths, not envelopes: the wall
-follows the largest angle the tooth reaches at each radius (1 um bands) plus
-0.2 um, then runs radially to the root circle; tip and root are arcs about
+steps along the circle of the flank's last point to the largest angle the
+tooth reaches beyond it (plus 0.2 um), then runs radially to the root circle; tip and root are arcs about
 the gear's centre. The gear keeps
 the design's tooth count, module and radii; only its flanks change.
 """
@@ -38,9 +40,10 @@ WALL_MARGIN = 2e-4
 
 
 def _tip_wall(drive, cf, side: int = 1) -> np.ndarray:
-    """Points (rigid frame, by radius) of the wall beyond the flank's last point: the tooth's corners there trace
-    paths, not envelopes (D1: the tip corner passed a radial wall by 2.3 um), so the wall follows the largest
-    angle the tooth reaches at each radius, plus :data:`WALL_MARGIN`, in 1 um bands of radius."""
+    """The wall's step beyond the flank's last point (rigid frame; none when the flank's own end angle is enough):
+    the tooth's corners there trace paths, not envelopes (D1: the tip corner passed a radial wall by 2.3 um), so
+    the wall steps along the circle of the last point to the largest angle the tooth reaches beyond it (1 um bands
+    of radius) plus :data:`WALL_MARGIN`, and then runs radially."""
     from .conjugate import flank_pieces
 
     r_last = float(np.hypot(*cf.points[-1]))
@@ -67,10 +70,15 @@ def _tip_wall(drive, cf, side: int = 1) -> np.ndarray:
     np.maximum.at(top, bands, side * a)
     rb = r_last + (np.arange(len(top)) + 1.0) * 1e-3
     ok = np.isfinite(top)
-    rb, ang = rb[ok], side * (top[ok] + WALL_MARGIN / rb[ok])
-    # one wall, never turning back towards the tooth as it goes out
-    ang = side * np.maximum.accumulate(side * ang)
-    return np.stack([rb * np.cos(ang), rb * np.sin(ang)], -1)
+    ang = side * (top[ok] + WALL_MARGIN / rb[ok])
+    # one wall, at the largest angle the tooth reaches beyond the flank (or the flank's own end angle when that is
+    # larger): a step along the circle of the flank's last point, then radially out; a shop reads a step, and it
+    # keeps the wall on the clear side everywhere
+    a_last = float(np.arctan2(cf.points[-1, 1], cf.points[-1, 0]))
+    a_wall = side * max(side * a_last, float(side * ang.max() if side > 0 else side * ang.min()))
+    if side * (a_wall - a_last) <= 1e-12:
+        return np.empty((0, 2))
+    return np.array([[r_last * np.cos(a_wall), r_last * np.sin(a_wall)]])
 
 
 def conjugate_rigid_gear(drive, z: float | None = None) -> tuple[Gear, object]:
@@ -85,14 +93,23 @@ def conjugate_rigid_gear(drive, z: float | None = None) -> tuple[Gear, object]:
     # the flank bounds space 0 (centred on +x) from above; in the tooth frame (rigid tooth centred on +x) it is
     # the tooth's lower flank: turn by -pi/z, then mirror for the upper flank that the half period runs along
     wall = _tip_wall(drive, cf)
-    low = _turn(np.concatenate([np.asarray(cf.points, float), wall]), -half)
-    up = low * np.array([1.0, -1.0])
-    up = up[np.argsort(np.hypot(*up.T))]  # from the tip (inner) outward
+    # flank points 0.1 um apart at least (the ends are found finely), with their tangents
+    fp, fn = np.asarray(cf.points, float), np.asarray(cf.normal, float)
+    keep = np.concatenate([[True], np.hypot(*np.diff(fp, axis=0).T) > 1e-4])
+    fp, fn = fp[keep], fn[keep]
+    o = np.argsort(np.hypot(*fp.T))  # from the tip (inner) outward, then the wall's step beyond the last point
+    fp, fn = fp[o], fn[o]
+    n_flank = len(fp)
+    up = _turn(np.concatenate([fp, wall]), -half) * np.array([1.0, -1.0])
+    tan = _turn(np.stack([-fn[:, 1], fn[:, 0]], -1), -half) * np.array([1.0, -1.0])
+    is_flank = np.arange(len(up)) < n_flank
+    tan_up = np.zeros_like(up)
+    tan_up[:n_flank] = tan
     a_up = np.arctan2(up[:, 1], up[:, 0])
     r_f = rg.r_f
     # the tip starts where the flank does: below the flank's first point the tooth's path is bounded by its own
     # corners, not by the envelope, and a radial wall there was crossed (D1: by 0.72 um over 2.3 um of wall), so
-    # the tip circle is raised to the first point (D1 involute: from 82.92 to 82.9223 mm)
+    # the tip circle is raised to the first point (D1 involute: from 82.92 to 82.9202 mm)
     r_a = max(rg.r_a, float(np.hypot(*up[0])))
     # above its last point the wall runs radially to the root circle
     tip_pt = r_a * np.array([np.cos(a_up[0]), np.sin(a_up[0])])
@@ -100,7 +117,18 @@ def conjugate_rigid_gear(drive, z: float | None = None) -> tuple[Gear, object]:
     hp = [pc.arc((0.0, 0.0), r_a, 0.0, float(a_up[0]))]
     if np.hypot(*(up[0] - tip_pt)) > 1e-12:
         hp.append(pc.line(tip_pt, up[0]))
-    hp += [pc.line(a, b) for a, b in zip(up[:-1], up[1:])]
+    # the flank: one tangent-continuous cubic Hermite spline through its exact points with the envelope's tangents (smooth, so
+    # exports fit it with few tangent arcs); the wall beyond it: lines
+    f_idx = np.flatnonzero(is_flank)
+    ends = (f_idx[0], f_idx[-1])
+    if not np.all(np.diff(f_idx) == 1):
+        raise ValueError("the wall beyond the conjugate flank dips below its last point")
+    fpts = up[ends[0] : ends[1] + 1]
+    ftan = tan_up[ends[0] : ends[1] + 1]
+    ftan = ftan * np.sign(np.einsum("ij,ij->i", ftan, np.gradient(fpts, axis=0)))[:, None]
+    hp.append(pc.spline(fpts, ftan))
+    for i in range(ends[1], len(up) - 1):
+        hp.append(pc.line(up[i], up[i + 1]))
     if np.hypot(*(root_pt - up[-1])) > 1e-12:
         hp.append(pc.line(up[-1], root_pt))
     if a_up[-1] >= half:
@@ -120,7 +148,8 @@ def conjugate_rigid_gear(drive, z: float | None = None) -> tuple[Gear, object]:
 
     flank = np.vstack([tip_pt, up]) if np.hypot(*(up[0] - tip_pt)) > 1e-12 else up
     flank = np.asarray(shapely.LineString(flank).simplify(0.5 * tol).coords)
-    half_period = np.concatenate([arc_pts(r_a, 0.0, a_up[0])[:-1], flank, arc_pts(r_f, a_up[-1], half)[1:]])
+    root = arc_pts(r_f, a_up[-1], half)  # from the radial wall's foot (it starts at root_pt, not at the flank)
+    half_period = np.concatenate([arc_pts(r_a, 0.0, a_up[0])[:-1], flank, root])
     keep = np.concatenate([[True], np.hypot(*np.diff(half_period, axis=0).T) > 1e-9])
     half_period = half_period[keep]
     mirror = half_period[::-1] * np.array([1.0, -1.0])

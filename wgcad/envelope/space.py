@@ -35,6 +35,8 @@ class ConjugateFlank:
         Exact envelope points on the boundary of the swept region, ordered by radius.
     t : (M,) float
         Generator angle at which each is touched.
+    normal : (M, 2) float
+        The flank's unit normal at each (the envelope's normal there).
     residual_mm : (M,) float
         Their Newton residuals.
     sagitta_mm : float
@@ -47,6 +49,7 @@ class ConjugateFlank:
     residual_mm: np.ndarray
     sagitta_mm: float
     motion: object
+    normal: np.ndarray = None
 
 
 def _outside_all(x: np.ndarray, polys: np.ndarray, tol: float, exact) -> np.ndarray:
@@ -196,7 +199,7 @@ def conjugate_flank(
         keep = np.arange(len(order))  # every point kept, in order of radius (more points: shorter chords)
     pts = env.points[keep]
     pts.flags.writeable = False
-    return ConjugateFlank(pts, env.t[keep], env.residual_mm[keep], sag, mot)
+    return ConjugateFlank(pts, env.t[keep], env.residual_mm[keep], sag, mot, env.normal[keep])
 
 
 def _sagitta(env, keep, pieces, mot) -> float:

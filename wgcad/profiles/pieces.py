@@ -17,6 +17,12 @@ Kinds and parameters (``params``)
                    ``phi``, with ``t = 1 - cos(phi/2)`` (constant speed: no stationary
                    parameter at the pitch-point cusp, see :func:`roll_to_u`).
 ``"hypocycloid"``  ``(r, rho)``: :func:`wgcad.profiles.cycloid.hypocycloid`, same parameter.
+``"cubic"``        ``(x0, y0, x1, y1, x2, y2, x3, y3)``: the cubic Bezier curve of these
+                   control points, ``t`` in ``[0, 1]``.
+``"spline"``       ``n`` such Bezier segments end to end (``8 n`` numbers), ``t`` in ``[0, n]``,
+                   segment ``floor(t)``: a tangent-continuous Hermite spline through exact points with their
+                   tangents (the conjugate flank, docs/models.md 13), one piece so that exports
+                   fit it with few arcs.
 
 Non-arc, non-line kinds are then mirrored (``flip = -1``: ``y -> -y``) and
 turned by ``rot`` about the origin: ``point = R(rot) diag(1, flip) base(t)``.
@@ -28,7 +34,19 @@ from dataclasses import dataclass
 
 import numpy as np
 
-__all__ = ["Piece", "arc", "line", "involute", "cycloid", "roll_to_u", "mirror_path", "merge_arcs", "path_points"]
+__all__ = [
+    "Piece",
+    "arc",
+    "line",
+    "involute",
+    "cycloid",
+    "cubic",
+    "spline",
+    "roll_to_u",
+    "mirror_path",
+    "merge_arcs",
+    "path_points",
+]
 
 
 def _rot(v: np.ndarray, a: float) -> np.ndarray:
@@ -160,11 +178,35 @@ class Piece:
             out = _cycloid(self.params, t, order, +1.0)
         elif k == "hypocycloid":
             out = _cycloid(self.params, t, order, -1.0)
+        elif k == "cubic":
+            out = _cubic(self.params, t, order)
+        elif k == "spline":
+            n = len(self.params) // 8
+            seg = np.clip(np.floor(t), 0, n - 1).astype(int)
+            P = np.asarray(self.params, dtype=float).reshape(n, 8)[seg]
+            out = _bezier(P, t - seg, order)
         else:  # pragma: no cover - constructors only make the kinds above
             raise ValueError(f"unknown piece kind {k!r}")
         if self.flip < 0:
             out = out * np.array([1.0, -1.0])
         return _rot(out, self.rot) if self.rot else out
+
+
+def _cubic(params, t, order):
+    """The Bezier curve of control points ``params`` and its derivatives in ``t``."""
+    return _bezier(np.broadcast_to(np.asarray(params, dtype=float), (len(t), 8)), t, order)
+
+
+def _bezier(P, t, order):
+    """Bezier segments ``P (K, 8)`` (four control points each) at ``t (K,)`` and their derivatives."""
+    P0, P1, P2, P3 = P[:, 0:2], P[:, 2:4], P[:, 4:6], P[:, 6:8]
+    t = t[:, None]
+    u = 1.0 - t
+    if order == 0:
+        return u**3 * P0 + 3 * u * u * t * P1 + 3 * u * t * t * P2 + t**3 * P3
+    if order == 1:
+        return 3 * u * u * (P1 - P0) + 6 * u * t * (P2 - P1) + 3 * t * t * (P3 - P2)
+    return 6 * u * (P2 - 2 * P1 + P0) + 6 * t * (P3 - 2 * P2 + P1)
 
 
 def _involute(params, t, order):
@@ -241,6 +283,28 @@ def line(p0, p1) -> Piece:
     p0, p1 = np.asarray(p0, dtype=float), np.asarray(p1, dtype=float)
     d = p1 - p0
     return Piece("line", 0.0, 1.0, (float(p0[0]), float(p0[1]), float(d[0]), float(d[1])))
+
+
+def cubic(p0, m0, p1, m1) -> Piece:
+    """The cubic Hermite segment from ``p0`` to ``p1`` with end derivatives ``m0``, ``m1`` (per unit ``t``), as a
+    Bezier piece."""
+    p0, m0, p1, m1 = (np.asarray(a, dtype=float) for a in (p0, m0, p1, m1))
+    c = np.concatenate([p0, p0 + m0 / 3.0, p1 - m1 / 3.0, p1])
+    return Piece("cubic", 0.0, 1.0, tuple(float(x) for x in c))
+
+
+def spline(points, tangents) -> Piece:
+    """The cubic Hermite spline through ``points (n, 2)`` with unit ``tangents (n, 2)`` (each segment's end
+    derivatives its chord times the tangents), one piece of ``n - 1`` Bezier segments, ``t`` in ``[0, n - 1]``:
+    tangent-continuous, its derivative's length and second derivative jumping at the knots."""
+    p = np.asarray(points, dtype=float)
+    d = np.asarray(tangents, dtype=float)
+    # each segment's end derivatives scaled by its own chord: with uneven knots (a flank's ends are found finely)
+    # a knot's mean chord overshot the short segments by 0.1 um; the spline is then tangent-continuous (G1),
+    # its derivative's length jumping at the knots
+    L = np.hypot(*np.diff(p, axis=0).T)[:, None]
+    c = np.concatenate([p[:-1], p[:-1] + d[:-1] * L / 3.0, p[1:] - d[1:] * L / 3.0, p[1:]], axis=1)
+    return Piece("spline", 0.0, float(len(p) - 1), tuple(float(x) for x in c.ravel()))
 
 
 def involute(psi_base: float, r_base: float, t0: float, t1: float) -> Piece:
