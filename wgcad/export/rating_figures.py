@@ -78,7 +78,11 @@ def _criteria(ax, ds):
     ax.axhline(1.0, color="k", lw=0.8)
     ax.set_yscale("log")
     ax.axvline(
-        ds.rated_torque_nm, color="r", lw=1.0, ls="--", label=f"rated {ds.rated_torque_nm:.0f} N m ({ds.binding})"
+        ds.rated_torque_nm,
+        color="r",
+        lw=1.0,
+        ls="--",
+        label=f"rated {ds.rated_torque_nm:.0f} N m ({ds.binding})" if ds.fit else f"no rated torque ({ds.binding})",
     )
     ax.set_xlabel("output torque, N m")
     ax.set_ylabel("ratio to the required value (above 1: met)")
