@@ -38,24 +38,18 @@ def _equal(fig, title):
     fig.update_xaxes(title="x, mm")
 
 
-def audit_html(drive, result, doc: dict, data: dict) -> str:
-    """The page: verdict and figures of the audit (``doc``: :func:`wgcad.report.audit_run.audit_document`'s document;
-    ``data``: :func:`wgcad.export.audit_figures.audit_plot_data`)."""
-    import plotly.graph_objects as go
-
+def _drive_figure(go, drive, w: dict, tightest):
+    """The whole drive at the tightest spot's generator angle and section, the tightest teeth drawn over it."""
     from ..placement.deformed import deformed_state
 
     name = drive.design.drive.name
-    w, e = doc["worst"], doc["entry"]
-    figs = []
-    # 1. the whole drive at the tightest spot's generator angle and section, the tightest teeth drawn over it
     z = w.get("section_z_mm")
     st = deformed_state(drive, np.deg2rad(w["generator_angle_deg"]), drive.tol, z=z)
     fig = go.Figure()
     _lines(go, fig, [st.rigid_outline], "rigid gear", "#b00000")
     _lines(go, fig, [st.flex_outline], "flexspline (deformed)", "#0040c0")
     _lines(go, fig, [st.neutral], "neutral line", "#008000", width=0.8)
-    teeth, labels, rig, overlaps, t_title = data["tightest"]
+    teeth, labels, rig, overlaps, t_title = tightest
     if overlaps:
         _lines(go, fig, overlaps, "overlap", "#ff8000", width=2.0)
     fig.add_trace(
@@ -75,17 +69,24 @@ def audit_html(drive, result, doc: dict, data: dict) -> str:
         + ("" if z is None else f", section z = {z:g} mm")
         + " (zoom in on the cross to the tooth pair)",
     )
-    figs.append(("The whole drive", _figure(fig, "drive")))
-    # 2. the tightest spot, close up (the teeth around it in their own frame, as the PNG)
+    return fig
+
+
+def _tightest_figure(go, tightest):
+    """The tightest spot, close up (the teeth around it in their own frame, as the PNG)."""
+    teeth, labels, rig, overlaps, t_title = tightest
     fig = go.Figure()
     _lines(go, fig, list(rig), "rigid teeth", "#b00000")
     _lines(go, fig, list(teeth), "flexspline teeth", "#0040c0")
     if overlaps:
         _lines(go, fig, overlaps, "overlap", "#ff8000", width=2.0)
     _equal(fig, t_title)
-    figs.append(("The tightest spot", _figure(fig, "tightest")))
-    # 3. clearance along a tooth's passage
-    prof, p_title = data["profile"]
+    return fig
+
+
+def _profile_figure(go, profile):
+    """Clearance along a tooth's passage, per section and edge, with the audit's figures marked."""
+    prof, p_title = profile
     fig = go.Figure()
     for sec in prof["sections"]:
         tag = "" if sec["z"] is None else f", z = {sec['z']:g} mm"
@@ -108,9 +109,12 @@ def audit_html(drive, result, doc: dict, data: dict) -> str:
     fig.update_layout(title=p_title, height=520, template="plotly_white")
     fig.update_xaxes(title="tooth angle from the major axis, deg")
     fig.update_yaxes(title="clearance, um (negative: overlap)")
-    figs.append(("Clearance along a tooth's passage", _figure(fig, "profile")))
-    # 4. against generator angle (or every passage's entry gap)
-    kind, args = data["vs_angle"]
+    return fig
+
+
+def _vs_angle_figure(go, vs_angle):
+    """Clearance against generator angle (or every passage's entry gap of an imperfect drive)."""
+    kind, args = vs_angle
     fig = go.Figure()
     if kind == "curve":
         ang, wv, nv, tol, v_title = args
@@ -124,8 +128,22 @@ def audit_html(drive, result, doc: dict, data: dict) -> str:
     fig.add_hrect(y0=-tol, y1=tol, fillcolor="gray", opacity=0.2, line_width=0)
     fig.update_layout(title=v_title, height=520, template="plotly_white")
     fig.update_yaxes(title="clearance, um")
-    figs.append(("Against generator angle", _figure(fig, "vs_angle")))
+    return fig
 
+
+def audit_html(drive, result, doc: dict, data: dict) -> str:
+    """The page: verdict and figures of the audit (``doc``: :func:`wgcad.report.audit_run.audit_document`'s document;
+    ``data``: :func:`wgcad.export.audit_figures.audit_plot_data`)."""
+    import plotly.graph_objects as go
+
+    name = drive.design.drive.name
+    w, e = doc["worst"], doc["entry"]
+    figs = [
+        ("The whole drive", _figure(_drive_figure(go, drive, w, data["tightest"]), "drive")),
+        ("The tightest spot", _figure(_tightest_figure(go, data["tightest"]), "tightest")),
+        ("Clearance along a tooth's passage", _figure(_profile_figure(go, data["profile"]), "profile")),
+        ("Against generator angle", _figure(_vs_angle_figure(go, data["vs_angle"]), "vs_angle")),
+    ]
     rows = [
         (
             "minimum clearance",

@@ -34,6 +34,24 @@ class PartFiles:
     files: list
 
 
+def _write_drawings(part, drive, source, fmts, target) -> None:
+    """The part's DXF and SVG drawings (``target(kind)`` gives each file's temporary path), each with its title block
+    (what, from which design, units, scale, material)."""
+    if not part.layers:
+        return
+    from .parts.title import title_layer
+
+    layers = [*part.layers, title_layer(part.name, drive.design, source, part.layers, drive.tol)]
+    if "dxf" in fmts:
+        from .dxf import write_dxf
+
+        write_dxf(target("dxf"), layers)
+    if "svg" in fmts:
+        from .svg import write_svg
+
+        write_svg(target("svg"), layers, f"{drive.design.drive.name}: {part.name}")
+
+
 def write_part_files(
     drive, sizes, source, out, *, formats=FORMATS, dxf_style: str = "arcs", generator_angles_deg=(), progress=None
 ) -> PartFiles:
@@ -49,7 +67,6 @@ def write_part_files(
     tick = progress or (lambda f, stage: None)
     fmts = list(formats)
     out, stem = Path(out), Path(source).stem
-    design = drive.design
     parts = build_parts(drive, sizes, style=dxf_style, tol=drive.tol, generator_angles_deg=list(generator_angles_deg))
     # the steps weighted by what they cost (D1: a mesh ~0.2 s, a STEP solid ~0.8 s and its file ~0.9 s, a DXF/SVG/STL
     # file ~0.05 s; OCP's import ~0.5 s on the first solid): the progress moves with the work
@@ -94,21 +111,10 @@ def write_part_files(
             files.append(path)
             return batch.temp_path(path)
 
-        from .parts.title import title_layer
-
         for p in parts:
             tick(done / total, f"files: {p.name}")
             report["parts"][p.name] = {"volume_mm3": round(p.volume_mm3, 4), **_jsonable(p.info)}
-            # every drawing carries its title block (what, from which design, units, scale, material)
-            layers = [*p.layers, title_layer(p.name, design, source, p.layers, drive.tol)] if p.layers else []
-            if layers and "dxf" in fmts:
-                from .dxf import write_dxf
-
-                write_dxf(target(f"{stem}_{p.name}.dxf"), layers)
-            if layers and "svg" in fmts:
-                from .svg import write_svg
-
-                write_svg(target(f"{stem}_{p.name}.svg"), layers, f"{design.drive.name}: {p.name}")
+            _write_drawings(p, drive, source, fmts, lambda kind, p=p: target(f"{stem}_{p.name}.{kind}"))
             if "stl" in fmts:
                 from .stl import write_stl
 

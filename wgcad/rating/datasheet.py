@@ -61,9 +61,9 @@ class Level:
     depth: np.ndarray
     max_pressure: float
 
-    def margins(self, sheet) -> dict:
-        """Each criterion's margin (>= 0: met) apart from ratcheting and the static limit, which are torques."""
-        ld = sheet.design.load
+    def margins(self, ld) -> dict:
+        """Each criterion's margin (>= 0: met) against the ``[load]`` table ``ld``; ratcheting and the static limit
+        are torques of their own."""
         return {
             "fatigue": self.safety - ld.fatigue_safety_min,
             "yield": self.yield_safety - 1.0,
@@ -130,14 +130,23 @@ def _level(sheet_ctx, T: float, warm, offset) -> Level:
     )
 
 
+@dataclass(frozen=True)
+class _Stop:
+    """Why a search stopped: ``static`` when a ball reached the bearing's static limit (the model refuses the
+    load), else no convergence or the search's own end."""
+
+    why: str
+    static: bool = False
+
+
 def _try(ctx, T, warm, offset):
-    """``(Level, None)`` or ``(None, why)`` when the model cannot answer at ``T``."""
+    """``(Level, None)`` or ``(None, _Stop)`` when the model cannot answer at ``T``."""
     try:
         return _level(ctx, T, warm, offset), None
-    except DesignError as e:  # the bearing's static limit
-        return None, str(e.rule)
+    except DesignError as e:  # the bearing's static limit (FlexibleBearing.check)
+        return None, _Stop(str(e.rule), static=True)
     except ModelError as e:
-        return None, str(e)
+        return None, _Stop(str(e))
 
 
 def _first_torque(drive) -> float:
@@ -157,13 +166,13 @@ def _bracket(ctx, lo: Level, hi_T: float, ok, offset) -> tuple[float, Level]:
     return hi_T, lo
 
 
-def _limits(ctx, levels, stop, sheet_like, offset, ratchet_T, static: Limit) -> dict:
+def _limits(ctx, levels, ld, offset, ratchet_T, static: Limit) -> dict:
     out = {}
     names = ["fatigue", "yield", "bearing_life", "entry_gap"]
     for name in names:
 
         def ok(lv, name=name):
-            return lv.margins(sheet_like)[name] >= 0
+            return lv.margins(ld)[name] >= 0
 
         if not ok(levels[0]):
             out[name] = Limit(name, levels[0].torque_nm, False, "not met even at the lowest torque")
@@ -174,23 +183,22 @@ def _limits(ctx, levels, stop, sheet_like, offset, ratchet_T, static: Limit) -> 
             continue
         hi, lo = _bracket(ctx, levels[k - 1], levels[k].torque_nm, ok, offset)
         # between the last level met and the first failed, the margin's zero by linear interpolation
-        m_lo, m_hi = ok_margin(lo, sheet_like, name), None
+        m_lo, m_hi = float(lo.margins(ld)[name]), None
         lv_hi, _ = _try(ctx, hi, lo.state, offset)
         if lv_hi is not None:
-            m_hi = ok_margin(lv_hi, sheet_like, name)
+            m_hi = float(lv_hi.margins(ld)[name])
         T = lo.torque_nm if m_hi is None or m_hi >= m_lo else lo.torque_nm + (hi - lo.torque_nm) * m_lo / (m_lo - m_hi)
         out[name] = Limit(name, float(T), False, f"bisected to {hi - lo.torque_nm:.3g} N m, then interpolated")
-    ld = sheet_like.design.load
     r_T, r_above, r_note = ratchet_T
     out["ratcheting"] = Limit("ratcheting", r_T / ld.ratcheting_safety_min, r_above, r_note)
     out["bearing_static"] = static
     return out
 
 
-def _static_limit(ctx, levels, stop_T, stop, offset) -> Limit:
+def _static_limit(ctx, levels, stop_T, stop: _Stop, offset) -> Limit:
     """Where the bearing's static limit stops the model (bisected), or the last torque solved when it did not."""
-    if not stop.startswith("the bearing"):
-        return Limit("bearing_static", levels[-1].torque_nm, True, stop)
+    if not stop.static:
+        return Limit("bearing_static", levels[-1].torque_nm, True, stop.why)
     hi, lo = _bracket(ctx, levels[-1], stop_T, lambda lv: True, offset)
     return Limit(
         "bearing_static",
@@ -200,16 +208,12 @@ def _static_limit(ctx, levels, stop_T, stop, offset) -> Limit:
     )
 
 
-def ok_margin(lv: Level, sheet_like, name: str) -> float:
-    return float(lv.margins(sheet_like)[name])
-
-
-def _doubling(ctx, drive, offset, progress=None, stop_when=None) -> tuple[list, str, float]:
+def _doubling(ctx, drive, offset, progress=None, stop_when=None) -> tuple[list, _Stop, float]:
     """Levels at zero and at torques doubling from :func:`_first_torque`, until the model stops or ``stop_when(level)``;
     returns the levels, why the search stopped and the torque the model could not solve (inf if none)."""
     first, why = _try(ctx, 0.0, None, offset)
     if first is None:
-        raise ModelError(f"the unloaded drive does not solve: {why}")
+        raise ModelError(f"the unloaded drive does not solve: {why.why}")
     levels = [first]
     T = _first_torque(drive)
     for k in range(_DOUBLINGS):
@@ -220,9 +224,9 @@ def _doubling(ctx, drive, offset, progress=None, stop_when=None) -> tuple[list, 
             return levels, why, T
         levels.append(lv)
         if stop_when is not None and stop_when(lv):
-            return levels, f"every criterion failed by {T:.0f} N m", float("inf")
+            return levels, _Stop(f"every criterion failed by {T:.0f} N m"), float("inf")
         T *= 2.0
-    return levels, f"the search stopped at {levels[-1].torque_nm:.0f} N m", float("inf")
+    return levels, _Stop(f"the search stopped at {levels[-1].torque_nm:.0f} N m"), float("inf")
 
 
 def _ratcheting(ctx, levels, static: Limit, offset, stop_T: float = float("inf")) -> tuple:
@@ -231,7 +235,7 @@ def _ratcheting(ctx, levels, static: Limit, offset, stop_T: float = float("inf")
     k = next((i for i, lv in enumerate(levels) if lv.depth.min() <= 0), None)
     if k == 0:
         return 0.0, False, "out of mesh at no load"
-    if k is None and not (np.isfinite(stop_T) and not static.note.startswith("a ball")):
+    if k is None and not (np.isfinite(stop_T) and static.above):  # above: the model stopped short of the limit
         return static.torque_nm, True, f"still in mesh where the model stops ({static.note})"
     lo, hi = levels[-1 if k is None else k - 1], stop_T if k is None else levels[k].torque_nm
     out_of_mesh = k is not None
@@ -296,11 +300,6 @@ def ratcheting_torque(drive, cam_offset_um: float = 0.0, cam_offset_deg: float =
     return _ratcheting(ctx, levels, _static_limit(ctx, levels, stop_T, stop, offset), offset, stop_T)
 
 
-@dataclass(frozen=True)
-class _Like:
-    design: object
-
-
 def rate_drive(drive, speed_rpm: float | None = None, sections: int = 3, progress=None, cam_offset=None) -> Datasheet:
     """The datasheet of ``drive`` (needs ``[bearing]`` and ``[material] ultimate_strength_mpa``).
 
@@ -316,12 +315,11 @@ def rate_drive(drive, speed_rpm: float | None = None, sections: int = 3, progres
     ctx, kt = _context(drive, sections, speed)
     model, setup = ctx[0], ctx[1]
     offset = (d.load.cam_offset_um, d.load.cam_offset_deg) if cam_offset is None else tuple(map(float, cam_offset))
-    like = _Like(d)
     t_setup = time.perf_counter() - t0
 
     # levels: zero, then doubling until the model stops or every criterion has failed
     levels, stop, stop_T = _doubling(
-        ctx, drive, offset, progress, stop_when=lambda lv: all(v < 0 for v in lv.margins(like).values())
+        ctx, drive, offset, progress, stop_when=lambda lv: all(v < 0 for v in lv.margins(d.load).values())
     )
     static = _static_limit(ctx, levels, stop_T, stop, offset)
     r = _ratcheting(ctx, levels, static, offset, stop_T)
@@ -331,7 +329,7 @@ def rate_drive(drive, speed_rpm: float | None = None, sections: int = 3, progres
         ratchet["no_offset"] = {"torque_nm": r0[0], "above": r0[1], "note": r0[2]}
     if progress:
         progress(0.55, "limits")
-    limits = _limits(ctx, levels, stop, like, offset, r, static)
+    limits = _limits(ctx, levels, d.load, offset, r, static)
     first = levels[0]
     binding = min(limits, key=lambda k: (limits[k].torque_nm, limits[k].above))
     rated_T = limits[binding].torque_nm
