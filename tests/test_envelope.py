@@ -186,6 +186,14 @@ def test_every_command_runs_on_the_conjugate_template(tmp_path, capsys):
     for args, codes in runs:
         assert main(args) in codes, args
         assert "Traceback" not in capsys.readouterr().err
+    # the rigid gear's data block speaks of its flanks, not of a rack form it does not have (it printed the design's
+    # profile shift 3.2 and "sampled cycloidal outline" for the conjugate gear)
+    import ezdxf
+
+    doc = ezdxf.readfile(tmp_path / "p" / "d1_conjugate_rigid.dxf")
+    data = "\n".join(e.dxf.text for e in doc.modelspace().query("TEXT") if e.dxf.layer == "GEAR_DATA")
+    assert "profile shift" not in data and "thinning" not in data and "cycloidal" not in data
+    assert "conjugate to the flexspline" in data and "sampled conjugate outline" in data
     d = build_drive(load_design(t))
     assert d.rigid.spec.form == "conjugate"
     figs = {}

@@ -58,13 +58,14 @@ def gear_data(gear, tol: float) -> dict:
         "module_mm": sp.module,
         "teeth": sp.z,
         "form": sp.form + (" internal" if sp.internal else " external"),
-        "profile_shift": sp.shift,
+        # a conjugate gear's flanks are an envelope, not a shifted rack form: no shift to state
+        "profile_shift": None if sp.form == "conjugate" else sp.shift,
         "pressure_angle_deg": float(np.rad2deg(sp.alpha)) if sp.form == "involute" else None,
         "tip_diameter_mm": 2.0 * gear.r_a,
         "root_diameter_mm": 2.0 * gear.r_f,
         "pitch_diameter_mm": 2.0 * gear.r,
         "base_diameter_mm": None if gear.r_base is None else 2.0 * gear.r_base,
-        "thinning_mm": sp.thinning,
+        "thinning_mm": None if sp.form == "conjugate" else sp.thinning,
         "chord_tolerance_mm": tol,
     }
     out["span"] = span_measurement(gear)
@@ -79,14 +80,17 @@ def data_lines(name: str, data: dict) -> list[str]:
         f"{name.upper()} GEAR DATA",
         f"module m = {data['module_mm']:g} mm",
         f"teeth z = {data['teeth']} ({data['form']})",
-        f"profile shift x = {data['profile_shift']:g}",
+        f"profile shift x = {data['profile_shift']:g}"
+        if data["profile_shift"] is not None
+        else "flanks: conjugate to the flexspline's teeth (envelope of their motion)",
         f"pressure angle = {f(data['pressure_angle_deg'], 2)} deg",
         f"tip diameter = {f(data['tip_diameter_mm'])} mm",
         f"root diameter = {f(data['root_diameter_mm'])} mm",
         f"pitch diameter = {f(data['pitch_diameter_mm'])} mm",
         f"base diameter = {f(data['base_diameter_mm'])} mm",
-        f"tooth thinning = {data['thinning_mm']:g} mm",
     ]
+    if data["thinning_mm"] is not None:
+        lines.append(f"tooth thinning = {data['thinning_mm']:g} mm")
     s = data.get("span")
     if s:
         rate = (
@@ -99,7 +103,11 @@ def data_lines(name: str, data: dict) -> list[str]:
     p = data.get("pins")
     if p:
         rate = (
-            " (its change with tooth thickness is not smooth: not given)"
+            (
+                " (no tooth-thickness lever: conjugate flanks)"
+                if "conjugate" in data["form"]
+                else " (its change with tooth thickness is not smooth: not given)"
+            )
             if p["dM_per_thickness"] is None
             else f" (changes {p['dM_per_thickness']:.3f} mm per mm of tooth thickness)"
         )

@@ -75,6 +75,10 @@ __all__ = [
 SENSITIVITY_STEP = 1e-3
 
 
+#: how the numerical measurements name the outline they sample
+_FORM_OUTLINE = {"involute": "involute outline", "cycloidal": "cycloidal outline", "conjugate": "conjugate outline"}
+
+
 def flank_zone(gear: Gear) -> tuple[float, float]:
     """Radii ``(lo, hi)`` between which the outline is the exact flank (involute or cycloid), mm.
 
@@ -183,7 +187,7 @@ def _span(gear: Gear) -> dict | None:
         "w_k_mm": w,
         "contact_diameter_mm": 2.0 * rc,
         "k_rule": rule,
-        "method": "closed form (involute)" if closed else "numerical (sampled cycloidal outline)",
+        "method": "closed form (involute)" if closed else f"numerical (sampled {_FORM_OUTLINE[gear.spec.form]})",
     }
 
 
@@ -327,7 +331,7 @@ def _pins(gear: Gear, d_pin: float | None) -> dict:
         "pin_centre_diameter_mm": 2.0 * R_m,
         "pin_stands_out_of_the_teeth": bool(proud),
         "pin_clear_of_the_root": bool(clear),
-        "method": "closed form (involute)" if closed else "numerical (sampled cycloidal outline)",
+        "method": "closed form (involute)" if closed else f"numerical (sampled {_FORM_OUTLINE[gear.spec.form]})",
     }
     if closed:
         # contact radius: where the flank normal through the centre touches the flank
@@ -383,7 +387,7 @@ def workshop_figures(gear: Gear, measure_diameter: float | None = None, pin_diam
     radii = concave_radii(gear)
     out["concave_radii_mm"] = radii
     out["smallest_concave_radius_mm"] = min(radii.values())
-    out["thickness_method"] = "closed form"
+    out["thickness_method"] = "closed form" if gear.spec.form != "conjugate" else "the conjugate flank as built"
     return out
 
 

@@ -317,8 +317,9 @@ def _workshop_rows(f: dict, b: dict) -> list[str]:
         {w["span"]["method"] for w in (wf, wb) if w["span"] and w["span"].get("method")}
         | {w["pins"]["method"] for w in (wf, wb) if _pin_fits(w)}
     )
+    thick = "; ".join(sorted({w.get("thickness_method", "closed form") for w in (wf, wb)}))
     lines.append(
-        f"  (span and pins: {'; '.join(methods)}; thicknesses and concave radii: closed form;"
+        f"  (span and pins: {'; '.join(methods)}; thicknesses and concave radii: {thick};"
         " external teeth over pins, internal between pins)"
     )
     if any(w["smallest_concave_radius_mm"] == 0.0 for w in (wf, wb)):
