@@ -55,7 +55,7 @@ class ConjugateFlank:
 def _outside_all(x: np.ndarray, polys: np.ndarray, tol: float, exact) -> np.ndarray:
     """For points ``x (M, 2)``: whether no position of the tooth covers one. The chord polygons ``polys (K, N, 2)``
     decide where they cover a point by more than ``tol`` (their distance from the exact pieces); closer calls go to
-    ``exact(i, j)``, the point's exact signed distance from the tooth at position ``j`` (negative: inside)."""
+    ``exact(i, j)``, the point's exact signed distance from the tooth at position ``j`` (positive: inside)."""
     import shapely
 
     geoms = shapely.polygons(polys)
@@ -67,14 +67,22 @@ def _outside_all(x: np.ndarray, polys: np.ndarray, tol: float, exact) -> np.ndar
         if not ok[i]:
             continue
         depth = shapely.distance(pts[i], geoms[j].exterior)
-        if depth > tol or exact(i, j) < -1e-9:
+        # covered, or within the chord tolerance of being covered by a sampled position: between the pass's
+        # positions (2e-3 rad apart) a tooth corner sweeps farther than the exact test at the samples sees (held
+        # to the strict test, the cycloidal flank kept points below the tip's path, crossed by 0.17 um)
+        if depth > tol or exact(i, j) > -tol:
             ok[i] = False
     return ok
 
 
-def _side_distance(piece, s0, x, rot, shift):
-    """Signed distance (along ``(p'_y, -p'_x)``, the right of the piece's direction) of points ``x (M, 2)`` from ``piece`` placed at
-    ``(rot, shift)`` (arrays), by Newton's projection started at ``s0``."""
+def _side_distance(piece, s0, x, rot, shift, with_gap: bool = False):
+    """Signed distance of points ``x (M, 2)`` from ``piece`` placed at ``(rot, shift)`` (arrays), positive on the
+    tooth's side, by Newton's projection started at ``s0``.
+
+    A tooth's pieces run from its centre line toward the space with the material on their left; the parameter
+    may run either way (an involute's roll parameter falls toward the root, an arc's angle may rise), so the
+    side is taken from the direction of travel, ``t0 -> t1``, not from ``p'`` alone (a double-arc flank, whose
+    angles rise, read every point on the wrong side)."""
     c, sn = np.cos(rot), np.sin(rot)
 
     def place(v):
@@ -90,8 +98,10 @@ def _side_distance(piece, s0, x, rot, shift):
         s = np.clip(s - f / df, lo, hi)
     X = place(piece.point(s)) + shift
     d1 = place(piece.deriv(s))
-    n = np.stack([d1[:, 1], -d1[:, 0]], axis=-1) / np.linalg.norm(d1, axis=-1)[:, None]
-    return np.einsum("ij,ij->i", x - X, n)
+    travel = 1.0 if piece.t1 >= piece.t0 else -1.0
+    n = -travel * np.stack([d1[:, 1], -d1[:, 0]], axis=-1) / np.linalg.norm(d1, axis=-1)[:, None]  # left of travel
+    side = np.einsum("ij,ij->i", x - X, n)
+    return (side, np.hypot(*(x - X).T)) if with_gap else side
 
 
 def _locally_outside(env, idx, pieces, mot, h: float = 2e-4) -> np.ndarray:
@@ -111,21 +121,27 @@ def _locally_outside(env, idx, pieces, mot, h: float = 2e-4) -> np.ndarray:
     return ok
 
 
-def _boundary(env, idx, t, polys, tol, pieces, mot):
+def _boundary(env, idx, t, polys, tol, pieces, mot, outline):
+    """The envelope points ``idx`` on the boundary of the region the tooth sweeps: locally outside (the flank
+    ``pieces``), and covered by no position of the whole tooth (its pitch's pieces ``outline``: a point near the tip
+    is covered by the tip, which one flank's pieces do not see; with them alone the cycloidal flank kept points
+    below the tip's path and the tooth crossed it by 0.17 um)."""
     idx = idx[_locally_outside(env, idx, pieces, mot)]
     x = env.points[idx]
-    starts = [np.linspace(p.t0, p.t1, 64) for p in pieces]
+    starts = [np.linspace(p.t0, p.t1, 64) for p in outline]
 
     def exact(i, j):
+        # the side of the nearest point of the flank (by distance: a projection clamped to a piece's end measures
+        # along that end's normal, which can point either way for a point off the piece)
         rot, shift = mot.pose(np.array([t[j]]))
-        best = np.inf
-        for p, sg in zip(pieces, starts):
+        best, gap = np.inf, np.inf
+        for p, sg in zip(outline, starts):
             c, sn = np.cos(rot[0]), np.sin(rot[0])
             P = p.point(sg) @ np.array([[c, sn], [-sn, c]]) + shift[0]
             s0 = sg[np.argmin(np.hypot(*(P - x[i]).T))]
-            d = _side_distance(p, np.array([s0]), x[i : i + 1], rot, shift)[0]
-            if abs(d) < abs(best):
-                best = d
+            d, g = _side_distance(p, np.array([s0]), x[i : i + 1], rot, shift, with_gap=True)
+            if g[0] < gap:
+                best, gap = d[0], g[0]
         return best
 
     keep = idx[_outside_all(x, polys, tol, exact)]
@@ -167,7 +183,7 @@ def conjugate_flank(
         return np.flatnonzero(near)
 
     env = envelope(pieces, mot, t)
-    keep = _boundary(env, rigid_side(env), t, polys, tol, pieces, mot)
+    keep = _boundary(env, rigid_side(env), t, polys, tol, pieces, mot, drive.flex.pieces)
     if len(keep) < 2:
         raise ValueError("the flexspline tooth never touches the rigid tooth's side of its path: no conjugate flank")
     # again, finely, over the stretch of the pass where the flank is touched, until the chords lie within
@@ -177,7 +193,7 @@ def conjugate_flank(
     n = points
     while True:
         env = envelope(pieces, mot, np.linspace(lo, hi, n))
-        keep = _boundary(env, rigid_side(env), t, polys, tol, pieces, mot)
+        keep = _boundary(env, rigid_side(env), t, polys, tol, pieces, mot, drive.flex.pieces)
         sag = _sagitta(env, keep, pieces, mot)
         if sag < sagitta_tol or n >= 64 * points:
             break
@@ -188,7 +204,7 @@ def conjugate_flank(
     tk = env.t[keep]
     extra = [np.linspace(tk.min() - step, tk.min(), 65), np.linspace(tk.max(), tk.max() + step, 65)]
     ends = envelope(pieces, mot, np.concatenate(extra))
-    ek = _boundary(ends, rigid_side(ends), t, polys, tol, pieces, mot)
+    ek = _boundary(ends, rigid_side(ends), t, polys, tol, pieces, mot, drive.flex.pieces)
     if len(ek):
         merged = {
             f: np.concatenate([getattr(env, f)[keep], getattr(ends, f)[ek]])
@@ -203,16 +219,27 @@ def conjugate_flank(
 
 
 def _sagitta(env, keep, pieces, mot) -> float:
-    """The largest distance between a chord and the exact envelope point at the middle of its two angles."""
+    """The largest distance between a chord and the exact envelope point at the middle of its two angles (the
+    middles of one piece's chords in one call of :func:`envelope`)."""
     pts = env.points[keep]
+    a, b = keep[:-1], keep[1:]
+    same = env.piece[a] == env.piece[b]
     sag = 0.0
-    for i, (a, b) in enumerate(zip(keep[:-1], keep[1:])):
-        if env.piece[a] != env.piece[b]:
-            continue
-        e = envelope([pieces[env.piece[a]]], mot, np.array([0.5 * (env.t[a] + env.t[b])]))
+    for k in np.unique(env.piece[a][same]):
+        idx = np.flatnonzero(same & (env.piece[a] == k))
+        tm = 0.5 * (env.t[a[idx]] + env.t[b[idx]])
+        e = envelope([pieces[k]], mot, tm)
         if not len(e.t):
             continue
-        seg = pts[i + 1] - pts[i]
-        x = e.points[np.argmin(np.hypot(*(e.points - 0.5 * (pts[i] + pts[i + 1])).T))]
-        sag = max(sag, abs(float(seg[0] * (x - pts[i])[1] - seg[1] * (x - pts[i])[0])) / float(np.hypot(*seg)))
+        order = np.argsort(tm, kind="stable")
+        pos = order[np.searchsorted(tm[order], e.t)]  # the chord whose middle angle each root belongs to
+        mid = 0.5 * (pts[idx] + pts[idx + 1])
+        dist = np.hypot(*(e.points - mid[pos]).T)
+        best = np.full(len(idx), np.inf)
+        np.minimum.at(best, pos, dist)
+        for j in np.flatnonzero(np.isfinite(best)):
+            x = e.points[(pos == j) & (dist == best[j])][0]
+            seg = pts[idx[j] + 1] - pts[idx[j]]
+            d = x - pts[idx[j]]
+            sag = max(sag, abs(float(seg[0] * d[1] - seg[1] * d[0])) / float(np.hypot(*seg)))
     return sag
