@@ -75,7 +75,8 @@ def test_arcs_within_chord_tolerance_of_the_exact_curve(drive, which):
     lines = shapely.linestrings(arc_points(path.vertices, path.ends, path.bulges, k + 1))
     _, d = shapely.STRtree(lines).query_nearest(shapely.points(gear.outline), return_distance=True)
     _, radius, theta = bulge_centres(path.vertices, path.ends, path.bulges)
-    sagitta = np.where(np.isfinite(radius), radius * (1 - np.cos(theta / (2 * k))), 0.0).max()
+    with np.errstate(invalid="ignore"):  # straight segments: infinite radius, no sagitta
+        sagitta = np.where(np.isfinite(radius), radius * (1 - np.cos(theta / (2 * k))), 0.0).max()
     assert d.max() <= TOL + sagitta
 
 

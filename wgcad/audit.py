@@ -74,6 +74,22 @@ FLAGS = {
 }
 
 
+def audit_settings(drive, rs: RunSettings, turns: int = 1) -> AuditSettings:
+    """The engine's settings of a run: ``rs.step_deg`` over ``turns`` generator turns, ``rs.sections`` and both face ends."""
+    n = int(round(360.0 / rs.step_deg))
+    return AuditSettings(
+        angles=np.deg2rad(np.arange(n * turns) * (360.0 / n)),
+        sections=_sections(drive, rs.sections),
+        use_period=rs.use_period,
+        use_waves=rs.use_waves,
+        use_mirror=rs.use_mirror,
+        cull=rs.cull,
+        bound=rs.bound,
+        interference_tol=rs.interference_tol_um * 1e-3,
+        refine=rs.refine,
+    )
+
+
 def run_audit(design_path, rs: RunSettings, progress=None):
     """Load, build and audit a design over a full generator revolution (an imperfect drive: ``rs.turns`` of them).
 
@@ -116,18 +132,7 @@ def run_audit(design_path, rs: RunSettings, progress=None):
             "rigid gear fixed): a perfect drive repeats every mesh period",
         )
     drive = build_drive(design, tol=rs.chord_tol_um * 1e-3, max_memory_mb=rs.max_memory_mb, run=run)
-    angles = np.deg2rad(np.arange(n * turns) * (360.0 / n))
-    settings = AuditSettings(
-        angles=angles,
-        sections=_sections(drive, rs.sections),
-        use_period=rs.use_period,
-        use_waves=rs.use_waves,
-        use_mirror=rs.use_mirror,
-        cull=rs.cull,
-        bound=rs.bound,
-        interference_tol=rs.interference_tol_um * 1e-3,
-        refine=rs.refine,
-    )
+    settings = audit_settings(drive, rs, turns)
     if imperfect:
         from .clearance.imperfect import audit_imperfect
         from .placement.imperfect import Imperfections

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from math import pi
 
 import numpy as np
@@ -44,7 +44,28 @@ def tooth_spec(design: Design, which: str) -> ToothSpec:
         fillet_coef=gs.fillet_coef,
         field=which,
         phase=0.0 if flex else pi / z,
+        **_double_arc(d),
     )
+
+
+def _double_arc(d: Design) -> dict:
+    """The double-arc parameters of a ToothSpec (docs/models.md 2.4), the form's defaults where the design gives none."""
+    if d.tooth.form != "double_arc":
+        return {}
+    from .profiles.double_arc import DEFAULTS
+
+    t, m = d.tooth, d.drive.module
+
+    def get(key):
+        v = getattr(t, key)
+        return DEFAULTS[key] if v is None else v
+
+    return {
+        "convex_radius": get("convex_radius_coef") * m,
+        "concave_radius": get("concave_radius_coef") * m,
+        "tangent_angle": float(np.deg2rad(get("tangent_angle_deg"))),
+        "tangent_length": get("tangent_length_coef") * m,
+    }
 
 
 @dataclass(frozen=True)
@@ -89,7 +110,51 @@ class Drive:
         if g.cone_length is None:
             return self.law
         w0 = float(coned_w0(self.law.w0, np.atleast_1d(float(z)), length=g.cone_length, z_h=g.generator_z)[0])
-        return self.law.with_w0(w0)
+        law = self.law.with_w0(w0)
+        off = self.tooth_offset(z)
+        return law if off == law.tooth_offset else replace(law, tooth_offset=off)
+
+    @property
+    def face_reference_z(self) -> float | None:
+        """Axial section (mm) where a face modification is zero: the conjugate section, else the generator's centre line."""
+        d = self.design
+        if not self.coned:
+            return None
+        if d.rigid.flanks == "conjugate" and d.rigid.conjugate_z is not None:
+            return float(d.rigid.conjugate_z)
+        return float(d.generator.generator_z)
+
+    @property
+    def face_taper(self) -> float:
+        """Radial offset of the flexspline's teeth per mm along the face (mm/mm; docs/models.md 13.4).
+
+        ``depth``: coning changes the amplitude by ``-W0 / (l - z_h)`` per mm, so the teeth move out by as much
+        and the depth of engagement on the major axis is the reference section's everywhere.
+        """
+        fs = self.design.flexspline
+        if fs.face_modification == "depth":
+            g = self.design.generator
+            return float(self.design.w0 / (g.cone_length - g.generator_z))
+        if fs.face_modification == "linear":
+            return 1e-3 * float(fs.face_taper_um_per_mm)
+        return 0.0
+
+    def with_face_taper(self, taper_um_per_mm: float) -> Drive:
+        """This drive with its flexspline's teeth offset linearly along the face (``face_modification = 'linear'``).
+
+        The gears are kept: the offset is zero at the reference section, where a conjugate rigid gear is made.
+        """
+        fs = replace(self.design.flexspline, face_modification="linear", face_taper_um_per_mm=float(taper_um_per_mm))
+        drive = replace(self, design=replace(self.design, flexspline=fs))
+        return replace(drive, law=replace(self.law, tooth_offset=drive.tooth_offset(None)))
+
+    def tooth_offset(self, z: float | None) -> float:
+        """Offset (mm) of the flexspline's teeth along their centre lines in section ``z`` (None: the centre section)."""
+        taper = self.face_taper
+        if taper == 0.0:
+            return 0.0
+        z = self.design.generator.generator_z if z is None else float(z)
+        return taper * (z - self.face_reference_z)
 
     def sections(self, k: int) -> np.ndarray:
         """Axial positions of ``k`` cross-sections spread over the face width (ends included for k >= 2), mm."""
@@ -185,6 +250,8 @@ def build_drive(
         offset=g.offset,
     )
     drive = Drive(design, flex, rigid, law, float(r_m), float(flex_rim), float(rigid_rim), tol)
+    if drive.face_taper:  # the centre section's law carries its teeth's offset like every other section's
+        drive = replace(drive, law=replace(law, tooth_offset=drive.tooth_offset(None)))
     if design.rigid.flanks == "conjugate":
         drive = _conjugate(drive)
     return drive
@@ -192,8 +259,6 @@ def build_drive(
 
 def _conjugate(drive: Drive) -> Drive:
     """The drive with its rigid gear's flanks made conjugate to the flexspline's teeth (docs/models.md 13)."""
-    from dataclasses import replace
-
     from .envelope.rigid import conjugate_rigid_gear
 
     d = drive.design
@@ -201,7 +266,7 @@ def _conjugate(drive: Drive) -> Drive:
     if z is None:
         z = d.generator.generator_z if drive.coned else 0.5 * d.drive.face_width
     try:
-        gear, _ = conjugate_rigid_gear(drive, z if drive.coned else None)
+        gear, _ = conjugate_rigid_gear(drive, z if drive.coned else None, 1e-3 * d.rigid.conjugate_clearance_um)
     except ValueError as e:
         raise DesignError("rigid.flanks", f"cannot be made conjugate: {e}") from None
     return replace(drive, rigid=gear)

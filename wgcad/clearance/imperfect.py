@@ -97,7 +97,8 @@ def _classify(scene: Scene, rot: float, shift: np.ndarray, j: int) -> str:
     m = g.spec.module
     if abs(R - g.r_a) < 0.05 * m:
         return "tip"
-    if (abs(R - g.r_f) < (g.spec.fillet_coef + 0.05) * m) if g.spec.form == "involute" else abs(R - g.r_f) < 0.05 * m:
+    filleted = g.spec.form in ("involute", "double_arc")
+    if (abs(R - g.r_f) < (g.spec.fillet_coef + 0.05) * m) if filleted else abs(R - g.r_f) < 0.05 * m:
         return "root"
     side = "upper" if loc[1] > 0 else "lower"
     return "working flank" if side == scene.working else "non-working flank"

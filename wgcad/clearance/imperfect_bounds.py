@@ -119,7 +119,7 @@ class ErrorBound:
         self.u = scene.ratios["u_hg"]
         self.T = rigid_translation(imp)
         phi = np.linspace(-pi, pi, 8192, endpoint=False)
-        lever_f = float(np.hypot(scene.flex_local[:, 0] - r_m, scene.flex_local[:, 1]).max())
+        lever_f0 = float(np.hypot(scene.flex_local[:, 0] - r_m, scene.flex_local[:, 1]).max())
         R_loc = np.hypot(scene.flex_local[:, 0], scene.flex_local[:, 1])
         half_w = float(np.abs(scene.flex_local[:, 1]).max())
         gamma_b = 2.0 * pi / scene.z_b
@@ -128,6 +128,9 @@ class ErrorBound:
         self.k_gain, self.rho_gain, self.dev_gain, self.fixed, self.cz = [], [], [], [], []
         for z in sections:
             st = scene.law(z).state(phi)
+            # a face-modified section's teeth stand tooth_offset further out: every lever and radius grows by at most it
+            off = abs(scene.law(z).tooth_offset)
+            lever_f, R_hi, R_lo = lever_f0 + off, R_loc.max() + off, R_loc.min() - off
             w_max, v_max = float(np.abs(st.w).max()), float(np.abs(st.v).max())
             dth = float(np.abs(st.dtheta).max())
             # 1 % on every maximum over the grid of rim angles (they vary by far less between its points)
@@ -136,10 +139,10 @@ class ErrorBound:
             )
             self.rho_gain.append(1.01 * (float(np.abs(st.theta).max()) + da_max * (1.0 + dth)))
             # a flexspline tooth point p: | |p| - r_b | and its angle from mat (tooth half-width, v, theta)
-            rad_spread = float(max(abs(R_loc.max() + w_max - self.r_b), abs(R_loc.min() - w_max - self.r_b)))
-            ang = half_w / R_loc.min() + v_max / r_m + float(np.abs(st.theta).max())
+            rad_spread = float(max(abs(R_hi + w_max - self.r_b), abs(R_lo - w_max - self.r_b)))
+            ang = half_w / R_lo + v_max / r_m + float(np.abs(st.theta).max())
             self.dev_gain.append(1.01 * (rad_spread + self.r_b * ang))
-            self.fixed.append(1.01 * self.a_b * 3.0 * gamma_b * (R_loc.max() + w_max))
+            self.fixed.append(1.01 * self.a_b * 3.0 * gamma_b * (R_hi + w_max))
             self.cz.append(coning_factor(drive, z))
         # second order: the rigid frame's own turn applied to the displacement (|dev| |Delta|), bounded
         # with the largest displacement the amplitudes allow

@@ -98,7 +98,8 @@ class Scene:
         if base.linear_in_w0:
             st = base.state(phi)
             f = np.array([self.law(z).w0 / base.w0 for z in zs])[zi]
-            return pose_from_displacements(phi, f * st.w, f * st.v, f * st.theta, self.drive.r_m, mat - phi)
+            off = np.array([self.law(z).tooth_offset for z in zs])[zi]
+            return pose_from_displacements(phi, f * st.w, f * st.v, f * st.theta, self.drive.r_m, mat - phi, off)
         rot = np.empty(len(phi))
         shift = np.empty((len(phi), 2))
         for i, z in enumerate(zs):
@@ -135,7 +136,10 @@ class Scene:
         st = self.law(z).state(np.asarray(phi, dtype=float))
         r_m = self.drive.r_m
         m1 = (self.z_b - self.z_g) / self.z_b
-        lever = float(np.hypot(self.flex_local[:, 0] - r_m, self.flex_local[:, 1]).max())
+        # the section's tooth offset moves every tooth point by it along the centre line (docs/models.md 13.4)
+        lever = float(np.hypot(self.flex_local[:, 0] - r_m, self.flex_local[:, 1]).max()) + abs(
+            self.law(z).tooth_offset
+        )
         v = np.abs(m1 + st.dtheta) * lever + abs(m1) * np.hypot(r_m + st.w, st.v) + np.hypot(st.dw, st.dv)
         return 1.1 * float(v.max())
 
@@ -328,7 +332,9 @@ def classify(scene: Scene, pts: np.ndarray, rigid_idx: int, phi: float, z) -> st
     m = g.spec.module
     tip_zone = abs(R - g.r_a) < 0.05 * m
     root_zone = (
-        abs(R - g.r_f) < (g.spec.fillet_coef + 0.05) * m if g.spec.form == "involute" else abs(R - g.r_f) < 0.05 * m
+        abs(R - g.r_f) < (g.spec.fillet_coef + 0.05) * m
+        if g.spec.form in ("involute", "double_arc")
+        else abs(R - g.r_f) < 0.05 * m
     )
     if tip_zone:
         return "tip"

@@ -6,6 +6,7 @@ import json
 import os
 import sys
 
+from ..errors import DesignError
 from .common import EXIT_INTERFERENCE, EXIT_OK, add_memory_flag, angle_count, epilog, positive_float, whole_number
 
 __all__ = ["register", "cmd_audit"]
@@ -51,6 +52,9 @@ def cmd_audit(args) -> int:
     if args.torque_nm is not None:  # under load: cli/load.py
         from .load import run_load
 
+        if args.by_section:
+            raise DesignError("--by-section", "audits the unloaded drive; the load audit reports every section already")
+
         _check_outputs(args)
         return run_load(args)
     from .common import Progress, want_progress
@@ -60,7 +64,6 @@ def cmd_audit(args) -> int:
     bar.start("loading modules")
     _check_outputs(args)
     from ..audit import FLAGS, RunSettings
-    from ..errors import DesignError
 
     bar.set(0.0, "reading the design")
 
@@ -111,6 +114,7 @@ def cmd_audit(args) -> int:
             plot=bool(args.plot),
             progress=bar.span(0.02, work_end, "clearance"),
             on_stage=lambda name: bar.set(work_end, name),
+            by_section=args.by_section,
         )
     except DesignError as exc:  # a run setting the design cannot take: named by the flag the user typed
         if exc.field in FLAGS:
@@ -137,6 +141,10 @@ def cmd_audit(args) -> int:
         # with a JSON document on stdout, the summary for people goes to stderr
         stream = sys.stderr if STDOUT in (args.json, args.write_baseline) else sys.stdout
         lines = [_audit_summary(res["design"], res)]
+        if "by_section" in res:
+            from ..report.sections import section_lines
+
+            lines += section_lines(res["by_section"], res.get("balanced_taper"))
         lines += [f"  NOT CHECKED: {n}" for n in res["not_checked"]]
         if "fcl" in res:
             lines.append(f"  FCL 3D check of the pairs the 2D engine singled out: {res['fcl']['summary']}")
@@ -275,6 +283,12 @@ def register(sub) -> None:
         action="store_true",
         help="progress bar (fraction, ETA) on stderr even when it is not a terminal or with --quiet; "
         "by default it is drawn only on a terminal",
+    )
+    a.add_argument(
+        "--by-section",
+        action="store_true",
+        help="also audit every section of a coned cup on its own: its tooth offset (face modification), depth of "
+        "engagement and smallest clearance side by side (one more exact audit per section; JSON by_section)",
     )
     a.add_argument("--quiet", action="store_true", help="print no summary")
     add_memory_flag(a)

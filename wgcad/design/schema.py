@@ -14,6 +14,7 @@ from .load import BearingSpec, LoadSpec, MaterialSpec
 from .rules import Rel, check_bounds, show
 from .rules import key as _key
 from .sectors import SectorsSpec, validate_sectors
+from .teeth import GearSpec, ToothFormSpec
 
 __all__ = [
     "DriveSpec",
@@ -99,132 +100,6 @@ class DriveSpec:
     )
     fixed: str = _key("the member held still", choices=("rigid", "flexspline"), default="rigid")
     rotation: str = _key("generator direction seen from the open end", choices=("ccw", "cw"), default="ccw")
-
-
-@dataclass(frozen=True)
-class ToothFormSpec:
-    """``[tooth]``: tooth form shared by both gears (docs/models.md 2)."""
-
-    form: str = _key("tooth form", choices=("involute", "cycloidal"), default="involute")
-    pressure_angle_deg: float = _key(
-        "pressure angle alpha (involute)",
-        unit="deg",
-        lo=5.0,
-        hi=45.0,
-        default=20.0,
-        why="standard 20 deg; harmonic drives use 20-30 deg; below 5 deg the base circle "
-        "is the pitch circle, above 45 deg the teeth are pointed",
-    )
-    addendum_coef: float = _key(
-        "addendum coefficient h_a*",
-        lo=0.1,
-        hi=2.0,
-        default=1.0,
-        why="harmonic drives use short teeth (0.5-1); above 2 the teeth are pointed for any shift",
-    )
-    clearance_coef: float | None = _key(
-        "root clearance coefficient c*",
-        lo=0.0,
-        hi=1.0,
-        default=None,
-        default_doc="0.25 involute, 0.1 cycloidal",
-        why="usual 0.1-0.4; more than a module of root clearance only thins the rim",
-    )
-
-
-@dataclass(frozen=True)
-class GearSpec:
-    """``[flexspline]`` / ``[rigid]``: one gear's teeth and body."""
-
-    rim_thickness: float = _key(
-        "flexspline: rim under the teeth h1; rigid: wall beyond the root circle",
-        unit="mm",
-        lo=Rel("0.1 m", lambda c: 0.1 * c["m"]),
-        hi=Rel("d", lambda c: c["d"]),
-        rule="> 0",
-        why="flexspline rims are 0.5-2 m thick, rigid walls several m; thinner than 0.1 m "
-        "is foil, thicker than the gear's pitch diameter d no longer a ring",
-    )
-    shift: float = _key(
-        "profile shift coefficient x (involute; 0 for cycloidal)",
-        lo=-5.0,
-        hi=10.0,
-        default=0.0,
-        rule="involute: no undercut, tip thickness >= 0.2 m" + _P,
-        why="harmonic drives use x up to about 4 (D1: 3.1/3.2); beyond these limits the teeth are "
-        "pointed or the space closed anyway",
-    )
-    tip_radius: float | None = _key(
-        "tip radius, overrides the standard tip",
-        unit="mm",
-        lo=Rel("r - 15 m", lambda c: c["r"] - 15 * c["m"]),
-        hi=Rel("r + 15 m", lambda c: c["r"] + 15 * c["m"]),
-        default=None,
-        default_doc="standard (docs/models.md 2.1, 2.2)",
-        rule="> 0; external teeth: outside the root; internal: inside" + _P,
-        why="the band the shift, addendum and clearance bounds allow around the pitch radius r",
-    )
-    root_radius: float | None = _key(
-        "root radius, overrides the standard root",
-        unit="mm",
-        lo=Rel("r - 15 m", lambda c: c["r"] - 15 * c["m"]),
-        hi=Rel("r + 15 m", lambda c: c["r"] + 15 * c["m"]),
-        default=None,
-        default_doc="standard (docs/models.md 2.1, 2.2)",
-        rule="> 0" + _P,
-        why="as tip_radius",
-    )
-    thinning: float = _key(
-        "tooth-thickness allowance at the pitch circle (backlash)",
-        unit="mm",
-        default=0.0,
-        rule="|thinning| < half the pitch, pi m / 2",
-        why="a thinning of half the pitch removes the tooth",
-    )
-    fillet_coef: float = _key(
-        "root fillet radius / m (involute)",
-        lo=0.0,
-        hi=2.0,
-        default=0.25,
-        rule="the fillet must fit the root space" + _P,
-        why="usual 0.25-0.38; the largest fillet that fits is searched in [0, 2]",
-    )
-    measure_diameter: float | None = _key(
-        "diameter at which the report gives the tooth thickness (arc and chordal)",
-        unit="mm",
-        lo=Rel("d - 30 m", lambda c: c["d"] - 30 * c["m"]),
-        hi=Rel("d + 30 m", lambda c: c["d"] + 30 * c["m"]),
-        default=None,
-        default_doc="none (mid-depth only)",
-        rule="on the flanks (checked when the report is made)",
-        why="as tip_radius, on the diameter",
-    )
-    pin_diameter: float | None = _key(
-        "pin (ball) diameter of the dimension over / between pins",
-        unit="mm",
-        lo=Rel("0.1 m", lambda c: 0.1 * c["m"]),
-        hi=Rel("5 m", lambda c: 5.0 * c["m"]),
-        default=None,
-        default_doc="chosen: contact nearest mid-flank, pin standing out",
-        rule="touches both flanks (checked when the report is made)",
-        why="measuring pins are about 1.5-1.9 m; a pin outside [0.1 m, 5 m] cannot touch both flanks",
-    )
-    flanks: str = _key(
-        "the flanks: of [tooth] form, or conjugate to the flexspline's teeth under the law (rigid gear only)",
-        choices=("form", "conjugate"),
-        default="form",
-        rule="conjugate: rigid gear of an internal-deformation drive only (docs/models.md 13)",
-    )
-    conjugate_z: float | None = _key(
-        "axial section whose law the conjugate flanks are made for",
-        unit="mm",
-        lo=Rel("0", lambda c: 0.0),
-        hi=Rel("face width", lambda c: c["face_width"]),
-        default=None,
-        default_doc="the generator's centre line (generator_z) on a coned cup, else mid-face",
-        rule="only with flanks = conjugate",
-        why="a section of the toothed rim",
-    )
 
 
 @dataclass(frozen=True)
@@ -321,7 +196,7 @@ class Design:
     def c_star(self) -> float:
         c = self.tooth.clearance_coef
         if c is None:
-            return 0.25 if self.tooth.form == "involute" else 0.1
+            return 0.1 if self.tooth.form == "cycloidal" else 0.25
         return c
 
     @property
@@ -431,7 +306,10 @@ def validate(d: Design) -> Design:
     expr = "z_rigid - z_flex" if dr.deformation == "internal" else "z_flex - z_rigid"
     if diff <= 0 or diff % dr.waves:
         raise DesignError("drive.z_rigid", f"{expr} = {diff} must be a positive multiple of drive.waves = {dr.waves}")
-    _choice("tooth.form", t.form, ("involute", "cycloidal"))
+    _choice("tooth.form", t.form, ("involute", "cycloidal", "double_arc"))
+    for key in ("convex_radius_coef", "concave_radius_coef", "tangent_angle_deg", "tangent_length_coef"):
+        if getattr(t, key) is not None and t.form != "double_arc":
+            raise DesignError(f"tooth.{key}", "is used only with form = 'double_arc'")
     if not 5.0 <= t.pressure_angle_deg <= 45.0:
         raise DesignError("tooth.pressure_angle_deg", f"must be in [5, 45] degrees, got {t.pressure_angle_deg:g}")
     _positive("tooth.addendum_coef", t.addendum_coef)
@@ -445,6 +323,21 @@ def validate(d: Design) -> Design:
         gs: GearSpec = getattr(d, name)
         if gs.conjugate_z is not None and gs.flanks != "conjugate":
             raise DesignError(f"{name}.conjugate_z", "is used only with flanks = 'conjugate'")
+        if gs.conjugate_clearance_um and gs.flanks != "conjugate":
+            raise DesignError(f"{name}.conjugate_clearance_um", "is used only with flanks = 'conjugate'")
+        _choice(f"{name}.face_modification", gs.face_modification, ("none", "depth", "linear"))
+        if gs.face_modification != "none":
+            if name != "flexspline":
+                raise DesignError(
+                    f"{name}.face_modification", "only the flexspline's teeth are modified along the face"
+                )
+            if g.cone_length is None or dr.deformation != "internal":
+                raise DesignError(
+                    f"{name}.face_modification",
+                    "needs a coned cup (generator.cone_length) and internal deformation: it compensates coning",
+                )
+        if (gs.face_taper_um_per_mm is None) != (gs.face_modification != "linear"):
+            raise DesignError(f"{name}.face_taper_um_per_mm", "is given exactly when face_modification = 'linear'")
         _positive(f"{name}.rim_thickness", gs.rim_thickness)
         if gs.fillet_coef < 0:
             raise DesignError(f"{name}.fillet_coef", f"must be >= 0, got {gs.fillet_coef:g}")

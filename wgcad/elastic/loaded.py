@@ -75,6 +75,11 @@ class LoadedLaw(Law):
         object.__setattr__(self, "loads", loads)
         object.__setattr__(self, "rigid", tuple(float(x) for x in self.rigid))
 
+    @property
+    def tooth_offset(self) -> float:
+        """The section's tooth offset (face modification, docs/models.md 13.4): loading moves the rim, not the teeth on it."""
+        return self.section.tooth_offset
+
     def with_w0(self, w0: float) -> LoadedLaw:
         """The loaded law of the section whose nominal amplitude is ``w0`` (coning scales the elastic field alike)."""
         return replace(self, section=self.centre.with_w0(w0), scale=float(w0) / float(self.centre.w0))

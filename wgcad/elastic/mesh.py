@@ -29,9 +29,9 @@ def passing_poses(scene: Scene, law, phi):
 def _poses_many(scene: Scene, laws, phis):
     """:func:`passing_poses` of several laws at once (one ring-field evaluation per load state)."""
     out = []
-    for phi, (w, v, th) in zip(phis, displacements_many(laws, phis)):
+    for law, phi, (w, v, th) in zip(laws, phis, displacements_many(laws, phis)):
         mat = phi * (scene.z_b - scene.z_g) / scene.z_b
-        out.append(pose_from_displacements(phi, w, v, th, scene.drive.r_m, mat - phi))
+        out.append(pose_from_displacements(phi, w, v, th, scene.drive.r_m, mat - phi, law.tooth_offset))
     return out
 
 

@@ -49,7 +49,7 @@ class LawMotion:
         o = np.stack([rad * c - st.v * s, rad * s + st.v * c], axis=-1)
         ct, stt = np.cos(t), np.sin(t)
         shift = np.stack([ct * o[:, 0] - stt * o[:, 1], stt * o[:, 0] + ct * o[:, 1]], axis=-1)
-        shift -= self.r_m * np.stack([np.cos(rot), np.sin(rot)], axis=-1)
+        shift -= (self.r_m - self.law.tooth_offset) * np.stack([np.cos(rot), np.sin(rot)], axis=-1)
         return rot, shift
 
     def rate(self, t) -> tuple[np.ndarray, np.ndarray]:
@@ -71,7 +71,7 @@ class LawMotion:
         ro = np.stack([ct * o[:, 0] - stt * o[:, 1], stt * o[:, 0] + ct * o[:, 1]], axis=-1)
         rdo = np.stack([ct * do[:, 0] - stt * do[:, 1], stt * do[:, 0] + ct * do[:, 1]], axis=-1)
         dshift = np.stack([-ro[:, 1], ro[:, 0]], axis=-1) + rdo
-        dshift -= self.r_m * drot[:, None] * np.stack([-np.sin(rot), np.cos(rot)], axis=-1)
+        dshift -= (self.r_m - self.law.tooth_offset) * drot[:, None] * np.stack([-np.sin(rot), np.cos(rot)], axis=-1)
         return drot, dshift
 
 

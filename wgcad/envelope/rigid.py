@@ -39,14 +39,15 @@ def _turn(p: np.ndarray, a: float) -> np.ndarray:
 WALL_MARGIN = 2e-4
 
 
-def _tip_wall(drive, cf, side: int = 1) -> np.ndarray:
+def _tip_wall(drive, cf, side: int = 1, clearance: float = 0.0, last=None) -> np.ndarray:
     """The wall's step beyond the flank's last point (rigid frame; none when the flank's own end angle is enough):
     the tooth's corners there trace paths, not envelopes (D1: the tip corner passed a radial wall by 2.3 um), so
     the wall steps along the circle of the last point to the largest angle the tooth reaches beyond it (1 um bands
     of radius) plus :data:`WALL_MARGIN`, and then runs radially."""
     from .conjugate import flank_pieces
 
-    r_last = float(np.hypot(*cf.points[-1]))
+    last = cf.points[-1] if last is None else np.asarray(last, float)  # the flank's last point (set back, if it is)
+    r_last = float(np.hypot(*last))
     pts = np.concatenate(
         [p.point(np.linspace(p.t0, p.t1, max(2, int(p.length() / 2.5e-4)))) for p in flank_pieces(drive.flex, side)]
     )
@@ -70,20 +71,24 @@ def _tip_wall(drive, cf, side: int = 1) -> np.ndarray:
     np.maximum.at(top, bands, side * a)
     rb = r_last + (np.arange(len(top)) + 1.0) * 1e-3
     ok = np.isfinite(top)
-    ang = side * (top[ok] + WALL_MARGIN / rb[ok])
+    ang = side * (top[ok] + (WALL_MARGIN + clearance) / rb[ok])
     # one wall, at the largest angle the tooth reaches beyond the flank (or the flank's own end angle when that is
     # larger): a step along the circle of the flank's last point, then radially out; a shop reads a step, and it
     # keeps the wall on the clear side everywhere
-    a_last = float(np.arctan2(cf.points[-1, 1], cf.points[-1, 0]))
+    a_last = float(np.arctan2(last[1], last[0]))
     a_wall = side * max(side * a_last, float(side * ang.max() if side > 0 else side * ang.min()))
     if side * (a_wall - a_last) <= 1e-12:
         return np.empty((0, 2))
     return np.array([[r_last * np.cos(a_wall), r_last * np.sin(a_wall)]])
 
 
-def conjugate_rigid_gear(drive, z: float | None = None) -> tuple[Gear, object]:
+def conjugate_rigid_gear(drive, z: float | None = None, clearance: float = 0.0) -> tuple[Gear, object]:
     """The rigid gear conjugate to ``drive``'s flexspline at section ``z`` (default: the generator's centre
-    section), and the :class:`~wgcad.envelope.space.ConjugateFlank` it was made from."""
+    section), and the :class:`~wgcad.envelope.space.ConjugateFlank` it was made from.
+
+    ``clearance`` (mm): the flank set back along its normal into the rigid tooth, and the wall beyond it by as
+    much: the offset of an envelope is the envelope of the offset tooth, so the pair keeps that normal clearance
+    where it was conjugate (designed backlash, docs/models.md 13.3)."""
     rg = drive.rigid
     if not rg.spec.internal:
         raise ValueError("conjugate rigid gears are built for internal deformation (an internal rigid gear)")
@@ -92,9 +97,13 @@ def conjugate_rigid_gear(drive, z: float | None = None) -> tuple[Gear, object]:
     half = pi / zr
     # the flank bounds space 0 (centred on +x) from above; in the tooth frame (rigid tooth centred on +x) it is
     # the tooth's lower flank: turn by -pi/z, then mirror for the upper flank that the half period runs along
-    wall = _tip_wall(drive, cf)
     # flank points 0.1 um apart at least (the ends are found finely), with their tangents
     fp, fn = np.asarray(cf.points, float), np.asarray(cf.normal, float)
+    if clearance:
+        # into the rigid tooth: the flank bounds space 0 from above, the tooth lies at larger polar angles
+        e_t = np.stack([-fp[:, 1], fp[:, 0]], -1) / np.hypot(*fp.T)[:, None]
+        fp = fp + clearance * np.sign(np.einsum("ij,ij->i", fn, e_t))[:, None] * fn
+    wall = _tip_wall(drive, cf, clearance=clearance, last=fp[np.argmax(np.hypot(*fp.T))])
     keep = np.concatenate([[True], np.hypot(*np.diff(fp, axis=0).T) > 1e-4])
     fp, fn = fp[keep], fn[keep]
     o = np.argsort(np.hypot(*fp.T))  # from the tip (inner) outward, then the wall's step beyond the last point

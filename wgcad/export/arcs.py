@@ -357,15 +357,23 @@ def arc_deviation(path: ArcPath, pieces, n_per_arc: int = 64, newton_steps: int 
     return dev
 
 
-def fit_gear(gear, tol: float) -> ArcPath:
+def fit_gear(gear, tol: float, offset: float = 0.0) -> ArcPath:
     """The whole toothed boundary of a gear as one closed arc path, in the order of ``gear.outline``.
 
     One pitch (``gear.pieces``) is fitted once and turned ``z`` times by
     ``k 2 pi / z + phase`` (bulges do not change under rotation); the
     segment sources index ``gear.pieces`` with the turn of their tooth.
+    ``offset`` (mm): every pitch moved that far out along its tooth's centre
+    line first (a face-modified section, docs/models.md 13.4); the last
+    segment of a pitch then ends on the next pitch's moved first vertex (at
+    the middle of the root, where the pitches part by ``2 offset sin(pi/z)``),
+    and the sources name the unmoved curves.
     """
     pieces = list(gear.pieces)
     one = fit_pieces(pieces, tol, closed=False)
+    if offset:
+        move = np.array([float(offset), 0.0])
+        one = ArcPath(one.vertices + move, one.bulges, one.source, None if one.end is None else one.end + move)
     turned = [one.rotated(k * gear.pitch_angle + gear.spec.phase) for k in range(gear.spec.z)]
     return ArcPath(
         np.concatenate([t.vertices for t in turned]),

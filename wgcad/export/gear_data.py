@@ -68,6 +68,14 @@ def gear_data(gear, tol: float) -> dict:
         "thinning_mm": None if sp.form == "conjugate" else sp.thinning,
         "chord_tolerance_mm": tol,
     }
+    if sp.form == "double_arc":
+        out["double_arc"] = {
+            "convex_radius_mm": sp.convex_radius,
+            "concave_radius_mm": sp.concave_radius,
+            "tangent_angle_deg": float(np.rad2deg(sp.tangent_angle)),
+            "tangent_length_mm": sp.tangent_length,
+            "datum_diameter_mm": 2.0 * (gear.r + sp.shift * sp.module),
+        }
     out["span"] = span_measurement(gear)
     out["pins"] = pin_dimension(gear)
     return out
@@ -89,6 +97,13 @@ def data_lines(name: str, data: dict) -> list[str]:
         f"pitch diameter = {f(data['pitch_diameter_mm'])} mm",
         f"base diameter = {f(data['base_diameter_mm'])} mm",
     ]
+    if data.get("double_arc"):
+        da = data["double_arc"]
+        lines.append(
+            f"double arc: convex R {da['convex_radius_mm']:.4f}, concave R {da['concave_radius_mm']:.4f} mm, "
+            f"common tangent {da['tangent_length_mm']:.4f} mm at {da['tangent_angle_deg']:g} deg"
+        )
+        lines.append(f"  tangent centred on the datum diameter {da['datum_diameter_mm']:.4f} mm")
     if data["thinning_mm"] is not None:
         lines.append(f"tooth thinning = {data['thinning_mm']:g} mm")
     s = data.get("span")

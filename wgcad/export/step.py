@@ -36,8 +36,8 @@ def _pnt(x, y, z=0.0):
     return gp_Pnt(float(x), float(y), float(z))
 
 
-def wire_from_path(vertices, bulges):
-    """A closed OCP wire of arcs (non-zero bulge) and lines (zero bulge) in the plane z = 0.
+def wire_from_path(vertices, bulges, z: float = 0.0):
+    """A closed OCP wire of arcs (non-zero bulge) and lines (zero bulge) in the plane ``z`` (default 0).
 
     Parameters
     ----------
@@ -61,7 +61,7 @@ def wire_from_path(vertices, bulges):
     b = np.asarray(bulges, dtype=float)
     e = np.roll(v, -1, axis=0)
     mid = arc_points(v, e, b, 3)[:, 1, :]
-    verts = [BRepBuilderAPI_MakeVertex(_pnt(*p)).Vertex() for p in v]
+    verts = [BRepBuilderAPI_MakeVertex(_pnt(p[0], p[1], z)).Vertex() for p in v]
     # BRepBuilderAPI_MakeWire searches the wire for shared vertices on every
     # Add (quadratic: 4 s for 774 edges); the edges already share vertices,
     # so the plain builder is enough (50 ms).
@@ -74,7 +74,8 @@ def wire_from_path(vertices, bulges):
         if b[i] == 0.0:
             mk = BRepBuilderAPI_MakeEdge(v0, v1)
         else:
-            mk = BRepBuilderAPI_MakeEdge(GC_MakeArcOfCircle(_pnt(*v[i]), _pnt(*mid[i]), _pnt(*e[i])).Value(), v0, v1)
+            arc = GC_MakeArcOfCircle(_pnt(*v[i], z), _pnt(*mid[i], z), _pnt(*e[i], z)).Value()
+            mk = BRepBuilderAPI_MakeEdge(arc, v0, v1)
         if not mk.IsDone():
             raise GeometryError(f"segment {i} of a closed path is degenerate")
         bld.Add(wire, mk.Edge())
@@ -147,6 +148,32 @@ def prism(outer, holes=(), height: float = 1.0, z0: float = 0.0):
         t.SetTranslation(gp_Vec(0.0, 0.0, float(z0)))
         solid = BRepBuilderAPI_Transform(solid, t, True).Shape()
     return solid
+
+
+def loft(wires):
+    """A solid lofted through closed wires (bottom to top) by ruled faces between their corresponding edges.
+
+    The wires must have the same number of edges in the same order (sections of one outline whose parts move
+    linearly along the loft: then the ruled faces are the exact surfaces, docs/models.md 13.4).
+    """
+    from OCP.BRepOffsetAPI import BRepOffsetAPI_ThruSections
+
+    mk = BRepOffsetAPI_ThruSections(True, True, 1e-6)
+    mk.CheckCompatibility(False)  # the edges already correspond one to one
+    for w in wires:
+        mk.AddWire(w)
+    mk.Build()
+    if not mk.IsDone():
+        raise GeometryError("loft of the face-modified outline failed")
+    return mk.Shape()
+
+
+def cylinder(radius: float, z0: float, z1: float):
+    """A solid cylinder about the z axis from ``z0`` to ``z1``."""
+    from OCP.BRepPrimAPI import BRepPrimAPI_MakeCylinder
+    from OCP.gp import gp_Ax2, gp_Dir
+
+    return BRepPrimAPI_MakeCylinder(gp_Ax2(_pnt(0.0, 0.0, z0), gp_Dir(0, 0, 1)), float(radius), float(z1 - z0)).Shape()
 
 
 def revolve_profile(rz):

@@ -142,12 +142,18 @@ class Law(abc.ABC):
         Neutral-line radius, mm.
     n_waves : int
         Number of deformation waves.
+    tooth_offset : float
+        mm: the teeth of this cross-section stand this far out along their
+        centre lines from the undeformed tooth form (a flexspline modified
+        along the face, docs/models.md 13.4); 0 unless the design modifies
+        it. It moves the teeth, not the neutral line: :meth:`state` ignores it.
     """
 
     name: ClassVar[str]
     w0: float
     r_m: float
     n_waves: int
+    tooth_offset: float
 
     def state(self, phi) -> RimState:
         """Neutral-line state at the angles `phi`.

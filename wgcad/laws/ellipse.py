@@ -93,6 +93,7 @@ class Ellipse(_TwoWaveLaw):
     w0: float
     r_m: float
     offset: float = 0.0
+    tooth_offset: float = 0.0
     n_waves: int = field(default=2, init=False)
     a: float = field(init=False)
     b: float = field(init=False)

@@ -43,6 +43,7 @@ class Harmonic(Law):
     w0: float
     r_m: float
     n_waves: int = 2
+    tooth_offset: float = 0.0
 
     def __post_init__(self):
         w0, r_m = _check_w0_rm(self.w0, self.r_m)

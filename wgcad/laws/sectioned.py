@@ -85,6 +85,7 @@ class _DiscShape(_SectionedLaw):
     w0: float
     r_m: float
     beta: float
+    tooth_offset: float = 0.0
     n_waves: int = field(default=2, init=False)
     _A: float = field(init=False, repr=False, compare=False)
     _B: float = field(init=False, repr=False, compare=False)
@@ -221,6 +222,7 @@ class FourForce(_SectionedLaw):
     w0: float
     r_m: float
     beta: float
+    tooth_offset: float = 0.0
     n_waves: int = field(default=2, init=False)
     _D: float = field(init=False, repr=False, compare=False)
 

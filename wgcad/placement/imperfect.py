@@ -304,12 +304,15 @@ def flex_poses_batch(drive, imp: Imperfections, phi_h: np.ndarray, k: np.ndarray
     out = []
     for z in sections:
         if shared:
-            f = 1.0 if z is None else drive.law_at(z).w0 / base.w0
-            rot, shift = pose_from_displacements(phi, f * st.w, f * st.v, f * st.theta, drive.r_m, phi_h)
+            law = base if z is None else drive.law_at(z)
+            f = law.w0 / base.w0
+            rot, shift = pose_from_displacements(
+                phi, f * st.w, f * st.v, f * st.theta, drive.r_m, phi_h, law.tooth_offset
+            )
         else:
             law = base if z is None else drive.law_at(z)
             s2 = law.state(phi)
-            rot, shift = pose_from_displacements(phi, s2.w, s2.v, s2.theta, drive.r_m, phi_h)
+            rot, shift = pose_from_displacements(phi, s2.w, s2.v, s2.theta, drive.r_m, phi_h, law.tooth_offset)
         shift = shift + drho[:, None] * np.stack([np.cos(rot), np.sin(rot)], axis=-1)
         shift += coning_factor(drive, z) * E
         out.append((rot, shift))

@@ -80,8 +80,12 @@ def transform(local: np.ndarray, rot, shift) -> np.ndarray:
     return out
 
 
-def pose_from_displacements(phi, w, v, theta, r_m: float, frame_angle=0.0):
-    """:func:`tooth_pose` from the neutral-line displacements ``w, v, theta`` at ``phi`` (arrays of one shape)."""
+def pose_from_displacements(phi, w, v, theta, r_m: float, frame_angle=0.0, offset=0.0):
+    """:func:`tooth_pose` from the neutral-line displacements ``w, v, theta`` at ``phi`` (arrays of one shape).
+
+    ``offset`` (mm, broadcast against ``phi``): the tooth stands that much further out along its centre line
+    (the law's ``tooth_offset``), i.e. the tooth frame's point ``p`` is placed as ``p + (offset, 0)``.
+    """
     phi = np.asarray(phi, dtype=float)
     c, s = np.cos(phi), np.sin(phi)
     rad = r_m + w
@@ -89,8 +93,9 @@ def pose_from_displacements(phi, w, v, theta, r_m: float, frame_angle=0.0):
     fa = np.broadcast_to(np.asarray(frame_angle, dtype=float), phi.shape)
     rot = fa + phi + theta
     c, s = np.cos(fa), np.sin(fa)
-    ox = c * ox0 - s * oy0 - r_m * np.cos(rot)
-    oy = s * ox0 + c * oy0 - r_m * np.sin(rot)
+    lever = r_m - np.asarray(offset, dtype=float)
+    ox = c * ox0 - s * oy0 - lever * np.cos(rot)
+    oy = s * ox0 + c * oy0 - lever * np.sin(rot)
     return rot, np.stack([ox, oy], axis=-1)
 
 
@@ -100,7 +105,9 @@ def tooth_pose(law: Law, phi, r_m: float, frame_angle=0.0):
     A tooth point ``p`` sits at height ``d = p_x - r_m`` above the neutral
     line and tangential offset ``s = p_y``; it goes to
     ``R(fa) [origin + R(phi + theta) (d, s)]`` (docs/models.md 3.1), i.e.
-    ``rot = fa + phi + theta`` and ``shift = R(fa) origin - R(rot) (r_m, 0)``.
+    ``rot = fa + phi + theta`` and ``shift = R(fa) origin - R(rot) (r_m, 0)``;
+    a section whose teeth are offset along their centre lines (``law.tooth_offset``,
+    docs/models.md 13.4) takes ``r_m - tooth_offset`` there.
 
     Returns
     -------
@@ -109,7 +116,7 @@ def tooth_pose(law: Law, phi, r_m: float, frame_angle=0.0):
     """
     phi = np.atleast_1d(np.asarray(phi, dtype=float))
     st = law.state(phi)
-    return pose_from_displacements(phi, st.w, st.v, st.theta, r_m, frame_angle)
+    return pose_from_displacements(phi, st.w, st.v, st.theta, r_m, frame_angle, law.tooth_offset)
 
 
 def place_points(local: np.ndarray, law: Law, phi, r_m: float, frame_angle=0.0) -> np.ndarray:
@@ -147,9 +154,10 @@ def place_points_first_order(local: np.ndarray, law: Law, phi, r_m: float, centr
     """
     phi = np.atleast_1d(np.asarray(phi, dtype=float))
     st = law.state(phi)
-    d = local[:, 0] - r_m
+    px = local[:, 0] + law.tooth_offset  # the section's teeth as offset along their centre lines
+    d = px - r_m
     s_off = local[:, 1]
-    x = local[:, 0][None, :] + st.w[:, None]
+    x = px[None, :] + st.w[:, None]
     if not centreline:
         x = x - s_off[None, :] * st.theta[:, None]
     y = s_off[None, :] + st.v[:, None] + d[None, :] * st.theta[:, None]

@@ -97,14 +97,17 @@ def band_outline(pieces, tol: float) -> np.ndarray:
     return np.ascontiguousarray(np.concatenate(parts))
 
 
-def gear_band_outline(gear, tol: float | None = None) -> np.ndarray:
+def gear_band_outline(gear, tol: float | None = None, offset: float = 0.0) -> np.ndarray:
     """The whole toothed boundary of ``gear`` in a symmetric band ``tol`` (default the gear's chord tolerance).
 
     Same order, start and orientation as :attr:`wgcad.profiles.gear.Gear.outline`
     (one pitch from the exact pieces, turned by ``k 2 pi/z + phase``), so an
     export can use either; vertices closer than
     :data:`wgcad.constants.MIN_VERTEX_SPACING` to the previous one are dropped
-    (they would merge in a float32 STL).
+    (they would merge in a float32 STL). ``offset`` (mm): every pitch moved
+    that far out along its tooth's centre line (a face-modified section,
+    docs/models.md 13.4; consecutive pitches are then joined by a chord of
+    ``2 offset sin(pi/z)`` at the middle of the root).
     """
     from .. import constants
 
@@ -112,6 +115,8 @@ def gear_band_outline(gear, tol: float | None = None) -> np.ndarray:
     one = band_outline(gear.pieces, tol)
     step = np.hypot(*np.diff(np.vstack([one, one[:1]]), axis=0).T)
     one = one[np.concatenate([[True], step[:-1] > constants.MIN_VERTEX_SPACING])] if len(one) > 2 else one
+    if offset:
+        one = one + np.array([float(offset), 0.0])
     z = gear.spec.z
     ang = np.arange(z) * 2.0 * np.pi / z + gear.spec.phase
     c, s = np.cos(ang)[:, None], np.sin(ang)[:, None]

@@ -36,7 +36,7 @@ class ToothSpec:
     z: int
     module: float
     internal: bool
-    form: str = "involute"  # "involute" | "cycloidal"
+    form: str = "involute"  # "involute" | "cycloidal" | "double_arc" | "conjugate" (built by wgcad.envelope)
     alpha: float = np.deg2rad(20.0)
     addendum_coef: float = 1.0
     clearance_coef: float = 0.25
@@ -49,6 +49,12 @@ class ToothSpec:
     #: where the *tooth* centre sits at the reference position (rad): 0 for the
     #: flexspline, half a pitch for the rigid gear (its space is on +x)
     phase: float = 0.0
+    #: double-arc teeth (docs/models.md 2.4): convex and concave arc radii (mm), the common tangent's
+    #: inclination (rad) and length (mm)
+    convex_radius: float = 0.0
+    concave_radius: float = 0.0
+    tangent_angle: float = 0.0
+    tangent_length: float = 0.0
 
 
 @dataclass(frozen=True)
@@ -89,6 +95,8 @@ class Gear:
     outline: np.ndarray = field(repr=False)
     tol: float = constants.CHORD_TOL
     pieces: tuple = field(default=(), repr=False)
+    #: radii (lo, hi) between which the outline is flank, where the form has no closed form for them (double arc)
+    flank_radii: tuple | None = None
 
     def outline_pieces(self) -> list:
         """The exact pieces of the whole :attr:`outline` (``z`` pitches turned by ``k 2 pi/z + phase``), in its order."""
@@ -108,6 +116,10 @@ class Gear:
         """Half the tooth's angular thickness at ``radius`` (flank zone, no fillet), rad."""
         sp = self.spec
         radius = np.asarray(radius, dtype=float)
+        if sp.form == "double_arc":  # exact: where the circle of each radius meets the flank's arcs and tangent
+            from .double_arc import half_angle_at
+
+            return half_angle_at(self, radius)
         if sp.form == "conjugate":  # the flank as built (docs/models.md 13): its polyline, angle against radius
             hp = self.half_period
             r = np.hypot(hp[:, 0], hp[:, 1])
@@ -170,7 +182,7 @@ def _involute_base_angle(sp: ToothSpec) -> float:
 
 def tooth_radii(sp: ToothSpec) -> tuple[float, float]:
     m, r = sp.module, sp.module * sp.z / 2.0
-    if sp.form == "involute":
+    if sp.form in ("involute", "double_arc"):  # both from the shifted datum, h_a* and c* (docs/models.md 2.4)
         if sp.internal:
             r_a = r + m * (sp.shift - sp.addendum_coef)
             r_f = r + m * (sp.shift + sp.addendum_coef + sp.clearance_coef)
@@ -215,15 +227,20 @@ def make_gear(sp: ToothSpec, tol: float = constants.CHORD_TOL) -> Gear:
     if r_f <= 0 or r_a <= 0:
         raise DesignError(f"{f}.root_radius", f"radii must be positive (tip {r_a:.4f} mm, root {r_f:.4f} mm)")
     # the field that sets the tip and how to blunt it: cycloidal teeth have no shift, c* truncates them (docs/models.md 2.2)
-    if sp.form == "involute":
+    if sp.form in ("involute", "double_arc"):
         tip_field = f"{f}.tip_radius" if sp.tip_radius is not None else f"{f}.shift"
         fix = "lower the shift or truncate the tip"
     elif sp.tip_radius is not None:
         tip_field, fix = f"{f}.tip_radius", "truncate the tip: tip_radius nearer the pitch circle"
     else:
         tip_field, fix = "tooth.clearance_coef", "truncate the tip: larger tooth.clearance_coef (or a tip_radius)"
+    flank_radii = None
     if sp.form == "involute":
         half, tip_thk, r_base, hp = _involute_half_period(sp, r, r_a, r_f, tol, tip_field)
+    elif sp.form == "double_arc":
+        from .double_arc import double_arc_half_period
+
+        half, tip_thk, r_base, hp, flank_radii = double_arc_half_period(sp, r, r_a, r_f, tol, tip_field)
     else:
         half, tip_thk, r_base, hp = _cycloid_half_period(sp, r, r_a, r_f, tol, tip_field, fix)
     s_min = constants.MIN_TIP_THICKNESS_COEF * sp.module
@@ -245,7 +262,7 @@ def make_gear(sp: ToothSpec, tol: float = constants.CHORD_TOL) -> Gear:
     outline = polar(np.broadcast_to(rad, ang.shape), ang).reshape(-1, 2)
     for arr in (half, period, outline):
         arr.setflags(write=False)
-    return Gear(sp, r, r_a, r_f, r_base, float(tip_thk), half, period, outline, tol, pieces)
+    return Gear(sp, r, r_a, r_f, r_base, float(tip_thk), half, period, outline, tol, pieces, flank_radii)
 
 
 def _fillet_fits(sp: ToothSpec, rho: float) -> bool:

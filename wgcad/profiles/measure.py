@@ -76,7 +76,12 @@ SENSITIVITY_STEP = 1e-3
 
 
 #: how the numerical measurements name the outline they sample
-_FORM_OUTLINE = {"involute": "involute outline", "cycloidal": "cycloidal outline", "conjugate": "conjugate outline"}
+_FORM_OUTLINE = {
+    "involute": "involute outline",
+    "cycloidal": "cycloidal outline",
+    "conjugate": "conjugate outline",
+    "double_arc": "double-arc outline",
+}
 
 
 def flank_zone(gear: Gear) -> tuple[float, float]:
@@ -86,6 +91,8 @@ def flank_zone(gear: Gear) -> tuple[float, float]:
     circle; the involute also starts no lower than the base circle.
     """
     sp = gear.spec
+    if sp.form == "double_arc":  # convex arc, tangent and concave arc (docs/models.md 2.4)
+        return gear.flank_radii
     if sp.form == "cycloidal":
         return tuple(sorted((gear.r_a, gear.r_f)))
     if sp.form == "conjugate":  # the conjugate flank as built (docs/models.md 13): tip circle to its last point
@@ -348,6 +355,11 @@ def concave_radii(gear: Gear) -> dict:
     if sp.form == "conjugate":
         # the radial wall above the conjugate flank meets the root circle in a corner (docs/models.md 13)
         return {"root_corner": 0.0, "root_circle": gear.r_f} if sp.internal else {"root_corner": 0.0}
+    if sp.form == "double_arc":  # the concave arc and the fillet curve into the space (docs/models.md 2.4)
+        out = {"concave_flank": sp.concave_radius, "root_fillet": sp.fillet_coef * sp.module}
+        if sp.internal:
+            out["root_circle"] = gear.r_f
+        return out
     if sp.form == "involute":
         rho = sp.fillet_coef * sp.module
         out["root_fillet"] = rho  # 0: the flank meets the root in a sharp corner
@@ -387,7 +399,11 @@ def workshop_figures(gear: Gear, measure_diameter: float | None = None, pin_diam
     radii = concave_radii(gear)
     out["concave_radii_mm"] = radii
     out["smallest_concave_radius_mm"] = min(radii.values())
-    out["thickness_method"] = "closed form" if gear.spec.form != "conjugate" else "the conjugate flank as built"
+    out["thickness_method"] = (
+        "the conjugate flank as built"
+        if gear.spec.form == "conjugate"
+        else ("exact (the circle met by the arcs and the tangent)" if gear.spec.form == "double_arc" else "closed form")
+    )
     return out
 
 

@@ -32,6 +32,6 @@ def engagement_depth(state) -> np.ndarray:
         best = -np.inf
         for law in state.laws:
             w = law.state(phi).w
-            best = max(best, float(np.max(flex.r_a + w - rigid.r_a)))
+            best = max(best, float(np.max(flex.r_a + law.tooth_offset + w - rigid.r_a)))
         out.append(best)
     return np.array(out)

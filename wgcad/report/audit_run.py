@@ -59,6 +59,7 @@ def audit_document(
     plot: bool = False,
     progress=None,
     on_stage=None,
+    by_section: bool = False,
 ) -> AuditRun:
     """Audit a design and shape the document ``wgcad audit --json`` writes.
 
@@ -78,6 +79,9 @@ def audit_document(
         ``progress(done, total, stage)`` of the 2D engine.
     on_stage : callable, optional
         ``on_stage(name)`` before the 3D check (a progress bar's label).
+    by_section : bool
+        Audit each section of a coned cup on its own as well (``doc["by_section"]``: tooth offset, depth of
+        engagement, smallest clearance; :mod:`wgcad.report.sections`). Perfect drives only.
     """
     drive, result = run_audit(design_path, rs, progress=progress)
     doc = audit_json(result)
@@ -87,6 +91,20 @@ def audit_document(
     doc["not_checked"] = not_modelled(drive.design, "this audit", imperfections=imperfect)
     if imperfect:
         doc["not_checked"] += imperfect_not_checked(doc["settings"], plot=plot)
+    if by_section:
+        if imperfect:
+            doc["not_checked"].append(
+                "--by-section: the sections of the imperfect drive (it audits the perfect one only)"
+            )
+        else:
+            from ..audit import audit_settings
+            from .sections import balanced_taper, section_rows
+
+            if on_stage is not None:
+                on_stage("section by section")
+            settings = audit_settings(drive, rs)
+            doc["by_section"] = section_rows(drive, settings)
+            doc["balanced_taper"] = balanced_taper(drive, settings)
     if engine in ("fcl", "both"):
         if on_stage is not None:
             on_stage("3D check (fcl)")

@@ -79,6 +79,8 @@ def gear_figures(gear, rim_radius: float, gs=None) -> dict:
     """Radii, thicknesses and the workshop's measurements of one gear (docs/models.md 2); ``gs`` its design table."""
     sp = gear.spec
     within = bool(min(gear.r_a, gear.r_f) <= gear.r <= max(gear.r_a, gear.r_f))
+    # involute and cycloidal flanks extend beyond the teeth (virtual figures); a double arc's end at its arcs
+    extends = within or sp.form != "double_arc"
     out = {
         "teeth": sp.z,
         "internal_teeth": sp.internal,
@@ -94,12 +96,18 @@ def gear_figures(gear, rim_radius: float, gs=None) -> dict:
         "pitch_circle_within_teeth": within,
         # virtual when the pitch circle lies outside the teeth (then one of them is negative): kept as
         # design figures of the extended flanks, not shown as measurements
-        "tooth_thickness_pitch_mm": _r(gear.tooth_thickness(gear.r)),
-        "space_width_pitch_mm": _r(gear.space_width(gear.r)),
+        "tooth_thickness_pitch_mm": _r(gear.tooth_thickness(gear.r)) if extends else None,
+        "space_width_pitch_mm": _r(gear.space_width(gear.r)) if extends else None,
         # said next to the values: a consumer of the JSON must not take them for measurements
-        "pitch_figures": "measured" if within else "virtual (extended flanks; the pitch circle lies outside the teeth)",
+        "pitch_figures": "measured"
+        if within
+        else (
+            "virtual (extended flanks; the pitch circle lies outside the teeth)"
+            if extends
+            else "none (the pitch circle lies outside the teeth, and double-arc flanks do not extend)"
+        ),
         "tip_thickness_mm": _r(gear.tip_thickness),
-        "fillet_radius_mm": _r(sp.fillet_coef * sp.module) if sp.form == "involute" else None,
+        "fillet_radius_mm": _r(sp.fillet_coef * sp.module) if sp.form in ("involute", "double_arc") else None,
         "outline_vertices": int(len(gear.outline)),
         "outline_area_mm2": _r(gear.area(), 4),
     }

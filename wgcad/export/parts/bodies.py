@@ -11,20 +11,27 @@ from wgcad.export.arcs import fit_gear, path_area
 from wgcad.export.dxf import DxfLayer
 from wgcad.export.gear_data import data_lines, gear_data
 from wgcad.plane import signed_area
+from wgcad.profiles.band import gear_band_outline
 
 from .part import Part
-from .solids import bolt_circle, circle_points, holes_m, n_segments, prism_m, revolve_m, to_mesh
+from .solids import bolt_circle, circle_points, holes_m, loft_m, n_segments, prism_m, revolve_m, to_mesh
 
 __all__ = ["flexspline", "plug", "rigid", "plug_outline", "data_layer"]
 
 PI = math.pi
 
 
-def data_layer(name: str, gear, tol: float, x: float, y: float, height: float, sectored: dict | None = None) -> tuple:
+def data_layer(
+    name: str, gear, tol: float, x: float, y: float, height: float, sectored: dict | None = None, face=None
+) -> tuple:
     """The GEAR_DATA text layer (one TEXT per line, top line at ``y``) and the data dict (with ``sectored``: the
-    sectors and every tooth's height, which the lines summarise per sector)."""
+    sectors and every tooth's height, which the lines summarise per sector; with ``face``, a drive whose flexspline
+    is modified along the face: how its teeth move from the reference section the figures hold at)."""
     data = gear_data(gear, tol)
     lines = data_lines(name, data)
+    if face is not None:
+        data["face_modification"] = face_modification(face)
+        lines[3:3] = face_lines(face)
     if sectored is not None:
         lay, built, full = sectored["layout"], np.asarray(sectored["built"], float), float(sectored["full"])
         kind_of = [str(lay.kinds[int(s)]) for s in lay.sector]  # each tooth's sector kind
@@ -87,7 +94,8 @@ def flexspline(drive, sizes, style: str, tol: float) -> Part:
     r_rim = drive.flex_rim_radius
     tip_r = float(np.hypot(*g.outline.T).max())
     text_h = max(0.5, round(0.02 * 2 * tip_r, 1))
-    gl, data, lines = data_layer("flexspline", g, tol, 1.15 * tip_r, tip_r, text_h)
+    face = drive if drive.face_taper else None
+    gl, data, lines = data_layer("flexspline", g, tol, 1.15 * tip_r, tip_r, text_h, face=face)
     layers = [_teeth_layer("FLEXSPLINE", g, path, style, 5, band)]
     info = {"gear_data": data}
     if drive.external:
@@ -108,7 +116,7 @@ def flexspline(drive, sizes, style: str, tol: float) -> Part:
     r_bore = 0.5 * sizes.hub_bore_diameter
     holes = bolt_circle(sizes.cup_bolt_circle_diameter, sizes.cup_bolt_count, sizes.cup_bolt_hole_diameter)
     rz = np.array([[r_rim, bw], [r_rim + ts, bw], [r_rim + ts, L], [r_bore, L], [r_bore, L - td], [r_rim, L - td]])
-    vol = (area - PI * r_rim**2) * bw + _pappus(rz) - len(holes) * PI * (0.5 * sizes.cup_bolt_hole_diameter) ** 2 * td
+    shell = _pappus(rz) - len(holes) * PI * (0.5 * sizes.cup_bolt_hole_diameter) ** 2 * td
     layers += [
         DxfLayer("FLEXSPLINE_BORE", circles=((0.0, 0.0, r_rim),), color=5),
         DxfLayer("CUP_SHELL", circles=((0.0, 0.0, r_rim + ts),), color=8),
@@ -116,6 +124,9 @@ def flexspline(drive, sizes, style: str, tol: float) -> Part:
         DxfLayer("CUP_BOLT_HOLES", circles=tuple((x, y, 0.5 * h) for x, y, h in holes), color=3),
         gl,
     ]
+    if drive.face_taper:
+        return _modified_cup(drive, sizes, tol, (layers, info), rz, holes, shell)
+    vol = (area - PI * r_rim**2) * bw + shell
 
     def solid():
         # holes first, in the small shell: booleans cost grows with the faces involved
@@ -127,18 +138,82 @@ def flexspline(drive, sizes, style: str, tol: float) -> Part:
         n = n_segments(r_rim + ts, tol)
         return to_mesh(ring + (revolve_m(rz, n) - holes_m(holes, L - td, L, tol)))
 
-    info.update(
-        {
-            "kind": "cup flexspline",
-            "cup_length_mm": L,
-            "shell_thickness_mm": ts,
-            "diaphragm_thickness_mm": td,
-            "hub_bore_diameter_mm": 2 * r_bore,
-            "bolt_circle_diameter_mm": sizes.cup_bolt_circle_diameter,
-            "bolt_count": sizes.cup_bolt_count,
-            "bolt_hole_diameter_mm": sizes.cup_bolt_hole_diameter,
-        }
-    )
+    info.update(_cup_info(sizes, r_bore))
+    return Part("flexspline", layers, solid, mesh, vol, ((-tip_r, -tip_r, 0.0), (tip_r, tip_r, L)), info)
+
+
+def face_modification(drive) -> dict:
+    """How a face-modified flexspline's teeth move along the face (docs/models.md 13.4), units in the keys."""
+    bw = drive.design.drive.face_width
+    return {
+        "kind": drive.design.flexspline.face_modification,
+        "reference_z_mm": drive.face_reference_z,
+        "taper_um_per_mm": round(1e3 * drive.face_taper, 4),
+        "tooth_offset_um": {f"z_{z:g}_mm": round(1e3 * drive.tooth_offset(z), 3) for z in (0.0, bw)},
+    }
+
+
+def face_lines(drive) -> list[str]:
+    """The data block's lines of a face-modified flexspline."""
+    bw = drive.design.drive.face_width
+    o0, o1 = (1e3 * drive.tooth_offset(z) for z in (0.0, bw))
+    return [
+        f"FACE-MODIFIED teeth: moved out along their centre lines by {1e3 * drive.face_taper:.4f} um per mm of z,",
+        f"  {o0:+.1f} um at z = 0 (open end), {o1:+.1f} um at z = {bw:g} mm; the figures below hold at",
+        f"  z = {drive.face_reference_z:g} mm (offset 0); tip and root diameters move with the offset",
+    ]
+
+
+def _cup_info(sizes, r_bore: float) -> dict:
+    return {
+        "kind": "cup flexspline",
+        "cup_length_mm": sizes.cup_length,
+        "shell_thickness_mm": sizes.shell_thickness,
+        "diaphragm_thickness_mm": sizes.diaphragm_thickness,
+        "hub_bore_diameter_mm": 2 * r_bore,
+        "bolt_circle_diameter_mm": sizes.cup_bolt_circle_diameter,
+        "bolt_count": sizes.cup_bolt_count,
+        "bolt_hole_diameter_mm": sizes.cup_bolt_hole_diameter,
+    }
+
+
+def _modified_cup(drive, sizes, tol: float, drawn: tuple, rz, holes, shell: float) -> Part:
+    """The cup flexspline whose teeth are offset along the face (docs/models.md 13.4): the toothed ring lofted.
+
+    The offset is linear in z and moves each tooth rigidly, so every point of the outline moves on a straight
+    line: the ruled loft between the outlines at both ends of the face is the exact ring (STEP: ruled faces
+    between corresponding arcs; mesh: the band outlines joined vertex to vertex). The drawing shows the
+    reference section, where the offset is zero, and says how the teeth move from it.
+    """
+    from wgcad.export import step as S
+
+    g = drive.flex
+    bw = drive.design.drive.face_width
+    layers, info = drawn
+    r_rim, L = drive.flex_rim_radius, sizes.cup_length
+    ends = (0.0, bw)
+    offs = [drive.tooth_offset(z) for z in ends]
+    # the section's area is quadratic in the offset, the offset linear in z: Simpson's rule is exact
+    areas = [abs(path_area(fit_gear(g, tol, drive.tooth_offset(z)))) for z in (0.0, 0.5 * bw, bw)]
+    vol = bw * (areas[0] + 4 * areas[1] + areas[2]) / 6.0 - PI * r_rim**2 * bw + shell
+
+    def solid():
+        wires = [S.wire_from_path(p.vertices, p.bulges, z) for p, z in zip((fit_gear(g, tol, o) for o in offs), ends)]
+        ring = S.cut(S.loft(wires), S.cylinder(r_rim, -1.0, bw + 1.0))
+        return S.fuse(ring, S.drill(S.revolve_profile(rz), holes, L - sizes.diaphragm_thickness, L), touching=True)
+
+    def mesh():
+        bands = [gear_band_outline(g, offset=o) for o in offs]
+        n = n_segments(r_rim + sizes.shell_thickness, tol)
+        # the bore cut by a solid of revolution with the shell's own segments: where the ring meets the
+        # shell their vertices are then the same numbers (a bore polygon of its own leaves 2e-9 mm slivers)
+        bore = revolve_m(np.array([[0.0, -1.0], [r_rim, -1.0], [r_rim, bw + 1.0], [0.0, bw + 1.0]]), n)
+        ring = loft_m(bands[0], bands[1], 0.0, bw) - bore
+        return to_mesh(ring + (revolve_m(rz, n) - holes_m(holes, L - sizes.diaphragm_thickness, L, tol)))
+
+    info.update(_cup_info(sizes, 0.5 * sizes.hub_bore_diameter))
+    info["face_modification"] = face_modification(drive)
+    tip_r = float(np.hypot(*g.outline.T).max()) + max(0.0, *offs)
     return Part("flexspline", layers, solid, mesh, vol, ((-tip_r, -tip_r, 0.0), (tip_r, tip_r, L)), info)
 
 

@@ -39,6 +39,39 @@ def prism_m(outer, holes, z0: float, z1: float):
     return manifold3d.Manifold.extrude(sec, z1 - z0).translate((0.0, 0.0, z0))
 
 
+def loft_m(outer0, outer1, z0: float, z1: float):
+    """manifold3d solid lofted from the outline ``outer0`` at ``z0`` to ``outer1`` at ``z1``.
+
+    The outlines have the same vertices in the same order (one outline whose teeth move linearly with z,
+    docs/models.md 13.4); each side face joins vertex ``i`` of both, the caps are triangulated separately.
+    """
+    import manifold3d
+
+    a, b = np.asarray(outer0, dtype=float), np.asarray(outer1, dtype=float)
+    if a.shape != b.shape:
+        raise ValueError("lofted outlines need the same vertex count")
+    if signed_area(a) < 0:
+        a, b = a[::-1], b[::-1]
+    n = len(a)
+    verts = np.concatenate([np.column_stack([a, np.full(n, z0)]), np.column_stack([b, np.full(n, z1)])])
+    i = np.arange(n)
+    j = (i + 1) % n
+    tris = np.concatenate(
+        [
+            np.column_stack([i, j, n + j]),
+            np.column_stack([i, n + j, n + i]),
+            np.asarray(manifold3d.triangulate([a]), dtype=np.int64)[:, ::-1],  # the bottom cap faces -z
+            n + np.asarray(manifold3d.triangulate([b]), dtype=np.int64),
+        ]
+    )
+    out = manifold3d.Manifold(
+        manifold3d.Mesh64(vert_properties=np.ascontiguousarray(verts), tri_verts=tris.astype(np.uint32))
+    )
+    if out.status() != manifold3d.Error.NoError:
+        raise ValueError(f"lofted solid is not a closed manifold ({out.status()})")
+    return out
+
+
 def revolve_m(rz, n: int):
     """manifold3d solid of revolution about z of a closed (r, z) polygon, ``n`` segments."""
     import manifold3d
