@@ -1,4 +1,5 @@
-"""Benchmark of conjugate teeth (issue 25): the rigid gear conjugate to D1's 200-tooth flexspline and its audit.
+"""Benchmark of conjugate teeth (issue 25): the rigid gear conjugate to D1's 200-tooth flexspline (involute,
+cycloidal, double arc) and its audit, and the search for the balanced face taper of a coned cup.
 
 Run from the repository root (not part of the test run):
 
@@ -38,9 +39,13 @@ def main() -> None:
     ap.add_argument("--quick", action="store_true")
     n = 1 if ap.parse_args().quick else 3
     rows, doc = [], {}
-    for name in ("d1_involute", "d1_cycloidal"):
+    for name in ("d1_involute", "d1_cycloidal", "d1_double_arc"):
         design = load_design(ROOT / "templates" / f"{name}.toml")
-        d = build_drive(design)
+        # the baseline: the design's own rigid gear (the double arc's template asks for a conjugate one)
+        own_design = dataclasses.replace(
+            design, rigid=dataclasses.replace(design.rigid, flanks="form", conjugate_clearance_um=0.0)
+        )
+        d = build_drive(own_design)
         z = design.generator.generator_z
         st = AuditSettings(angles=np.deg2rad(np.arange(720) * 0.5), sections=[z], interference_tol=1e-3, refine=True)
         t_base, own = best_of(lambda d=d, st=st: audit(d, st), n)
@@ -48,7 +53,7 @@ def main() -> None:
         # polygons: a gear swapped into a built drive would be refined against the design's own)
         conj_design = dataclasses.replace(design, rigid=dataclasses.replace(design.rigid, flanks="conjugate"))
         t_env, conj = best_of(lambda cd=conj_design: build_drive(cd), n)
-        t_own_build, _ = best_of(lambda des=design: build_drive(des), n)
+        t_own_build, _ = best_of(lambda des=own_design: build_drive(des), n)
         t_aud, res = best_of(lambda conj=conj, st=st: audit(conj, st), n)
         rows += [
             (f"{name}: audit of the design's rigid gear (baseline)", t_base, 1.0, 1e3 * own.min_clearance),
@@ -57,6 +62,22 @@ def main() -> None:
             (f"{name}: audit of the conjugate pair", t_aud, t_aud / t_base, 1e3 * res.min_clearance),
         ]
         doc[name] = {"min_clearance_um": 1e3 * res.min_clearance}
+    # the spatial modification's search (docs/models.md 13.4): the balanced face taper of D1's conjugate pair,
+    # polygon audits of both face ends, then both ends exactly
+    from wgcad.report.sections import balanced_taper
+
+    d = build_drive(load_design(ROOT / "templates" / "d1_conjugate.toml"))
+    st = AuditSettings(angles=np.deg2rad(np.arange(720) * 0.5), sections=np.array([0.0, 30.0]), refine=True)
+    t_bal, bal = best_of(lambda: balanced_taper(d, st), n)
+    rows.append(
+        (
+            "d1_conjugate: balanced face taper (search, exact check; x the d1_involute baseline)",
+            t_bal,
+            t_bal / rows[0][1],
+            None,
+        )
+    )
+    doc["balanced_taper"] = bal
     print("| what | s | x baseline | smallest clearance, um |\n|---|---|---|---|")
     for what, t, r, c in rows:
         print(f"| {what} | {t:.3f} | {r:.2f} | {'-' if c is None else f'{c:.6f}'} |")
