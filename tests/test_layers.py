@@ -30,6 +30,7 @@ FLOORS = [
     {"rating"},
     {"audit", "regression"},
     {"sweep"},
+    {"synthesis"},
     {"report"},
     {"export", "testing"},
     {"cli"},

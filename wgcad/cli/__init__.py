@@ -14,7 +14,7 @@ for _var in ("OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
 
 from .. import __version__
 from ..errors import WgcadError
-from . import audit, generate, ke, kinematics, parts, rating, sector, sweep
+from . import audit, design, generate, ke, kinematics, parts, rating, sector, sweep
 from .common import (  # noqa: F401
     EPILOG,
     EXIT_INPUT,
@@ -50,9 +50,9 @@ def build_parser() -> argparse.ArgumentParser:
         required=True,
         parser_class=Parser,
         metavar="COMMAND",
-        help="generate, audit, kinematics, ke, rating, sector, parts or sweep; wgcad COMMAND --help for its flags",
+        help="generate, audit, kinematics, ke, rating, sector, parts, sweep or design; wgcad COMMAND --help for its flags",
     )
-    for mod in (generate, audit, kinematics, ke, rating, sector, parts, sweep):
+    for mod in (generate, audit, kinematics, ke, rating, sector, parts, sweep, design):
         mod.register(sub)
     # accepted after the subcommand too (wgcad audit D --traceback): users put it where the other flags are
     for sp in sub.choices.values():

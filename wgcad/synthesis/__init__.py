@@ -1,0 +1,1 @@
+"""Design synthesis: from requirements to a drive (``wgcad design``, docs/models.md 14)."""

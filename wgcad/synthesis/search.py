@@ -1,0 +1,253 @@
+"""The design search: optuna chooses the free keys, :mod:`wgcad.synthesis.evaluate` judges each candidate, Dask runs
+them side by side, a journal file makes it resumable (docs/models.md 14).
+
+- Sampler: optuna's TPE with constraints (one objective) or NSGA-II with constraints (two objectives: a Pareto
+  front); when every free key is a whole number and the grid of their values is no larger than the trial budget,
+  every combination is enqueued (exhaustive: nothing left to chance).
+- Constraints: each :class:`~wgcad.synthesis.evaluate.Evaluation` margin, negated, set on the trial
+  (``Trial.set_constraint``: <= 0 is met); a constraint a candidate never reached counts as violated by 1.
+- Evaluation: in this process with one worker, else on a Dask cluster (the sweep's local cluster of single-threaded
+  processes, or ``--scheduler``), ``workers`` candidates at a time, asked of the sampler together.
+- Resumable: the study lives in ``<out>/study.journal``; a second run with the same output folder continues it, and
+  the trials already done count toward the budget.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass, field
+from itertools import product
+
+from ..design import load_design
+from ..design.requirements import OBJECTIVES, Requirements
+from ..errors import WgcadError
+from .evaluate import PEAK, RATED, STAGES, Evaluation, evaluate
+
+__all__ = ["SearchResult", "run_search", "constraint_names"]
+
+
+def constraint_names(req: Requirements) -> list[str]:
+    """The constraints of a requirements file, in a fixed order (the optuna constraint vector)."""
+    names = []
+    if req.ratio is not None:
+        names.append("ratio")
+    names.append("design rules")
+    if req.max_outside_diameter_mm is not None:
+        names.append("outside diameter")
+    names.append("clearance")
+    if req.max_backlash_arcmin is not None:
+        names.append("backlash")
+    if req.rated_torque_nm is not None:
+        names += [f"{k} at rated torque" for k in RATED]
+    if req.peak_torque_nm is not None:
+        names += [f"{k} at peak torque" for k in PEAK]
+    return names
+
+
+@dataclass
+class SearchResult:
+    """Every candidate judged (resumed ones included), the feasible ones ranked, and how the search ran."""
+
+    req: Requirements
+    evaluations: list
+    ranked: list
+    pareto: list
+    constraints: list
+    executor: str
+    sampler: str
+    seconds: float
+    resumed: int = 0
+    notes: list = field(default_factory=list)
+
+    @property
+    def best(self) -> Evaluation | None:
+        return self.ranked[0] if self.ranked else None
+
+    def never_met(self) -> list[str]:
+        """Constraints no candidate met (of those some candidate reached)."""
+        out = []
+        for c in self.constraints:
+            seen = [ev.margins[c] for ev in self.evaluations if ev.margins.get(c) is not None]
+            if seen and max(seen) < 0:
+                out.append(c)
+        return out
+
+    def closest(self) -> Evaluation | None:
+        """The candidate nearest to feasible: the furthest stage reached, then the largest smallest margin."""
+        if not self.evaluations:
+            return None
+
+        def key(ev):
+            reached = STAGES.index(ev.stage) if ev.stage in STAGES else len(STAGES)
+            worst = ev.worst
+            return (reached, -math.inf if worst is None else worst[1])
+
+        return max(self.evaluations, key=key)
+
+
+def _sense(name: str) -> float:
+    return 1.0 if OBJECTIVES[name][0] == "max" else -1.0
+
+
+def _rank(req: Requirements, feasible: list) -> tuple[list, list]:
+    """Feasible candidates best first (by the first objective), and the non-dominated ones (two objectives)."""
+    objs = req.objectives
+
+    def score(ev, o):
+        v = ev.objectives.get(o)
+        return -math.inf if v is None else _sense(o) * v
+
+    ranked = sorted(feasible, key=lambda ev: tuple(-score(ev, o) for o in objs))
+    if len(objs) < 2:
+        return ranked, ranked[:1]
+    front = []
+    for ev in ranked:
+        s = [score(ev, o) for o in objs]
+        dominated = any(
+            all(score(o2, o) >= v for o, v in zip(objs, s)) and any(score(o2, o) > v for o, v in zip(objs, s))
+            for o2 in ranked
+        )
+        if not dominated:
+            front.append(ev)
+    return ranked, front
+
+
+def _sampler(req: Requirements):
+    import optuna
+
+    n_grid = grid_size(req)
+    if n_grid is not None and n_grid <= req.trials:
+        # every combination enqueued (run_search): the sampler only stands by
+        return optuna.samplers.RandomSampler(seed=req.seed), f"grid (all {n_grid} combinations)", n_grid
+
+    if len(req.objectives) == 1:
+        startup = min(10, max(4, req.trials // 4))
+        s = optuna.samplers.TPESampler(seed=req.seed, multivariate=True, n_startup_trials=startup)
+        return s, f"optuna TPE with constraints ({startup} random trials first)", None
+    pop = max(4, min(20, req.trials // 3))
+    s = optuna.samplers.NSGAIISampler(seed=req.seed, population_size=pop)
+    return s, f"optuna NSGA-II with constraints (population {pop})", None
+
+
+def _distributions(req: Requirements) -> dict:
+    from optuna.distributions import FloatDistribution, IntDistribution
+
+    return {
+        fk.name: IntDistribution(int(fk.low), int(fk.high)) if fk.integer else FloatDistribution(fk.low, fk.high)
+        for fk in req.free
+    }
+
+
+def _from_trial(ft) -> Evaluation | None:
+    a = ft.user_attrs
+    if "stage" not in a:
+        return None
+    return Evaluation(
+        values=dict(ft.params),
+        margins=dict(a.get("margins", {})),
+        objectives=dict(a.get("objectives", {})),
+        stage=a["stage"],
+        feasible=bool(a.get("feasible")),
+        message=a.get("message", ""),
+        seconds=float(a.get("seconds", 0.0)),
+    )
+
+
+def _tell(study, trial, ev: Evaluation, req: Requirements, names: list) -> None:
+    for c in names:  # optuna: <= 0 is met; a constraint the candidate never reached counts as violated by 1
+        trial.set_constraint(c, -ev.margins[c] if ev.margins.get(c) is not None else 1.0)
+    for k in ("margins", "objectives", "stage", "feasible", "message", "seconds"):
+        trial.set_user_attr(k, getattr(ev, k))
+    # an objective a candidate never reached: the worst value any candidate can have (constraints rank it anyway)
+    vals = [ev.objectives.get(o, -1e30 if OBJECTIVES[o][0] == "max" else 1e30) for o in req.objectives]
+    study.tell(trial, vals if len(vals) > 1 else vals[0])
+
+
+def _client(workers: int, scheduler):
+    """``(client, cluster, description)``: None for one worker in this process."""
+    if scheduler is None and workers <= 1:
+        return None, None, "this process"
+    from distributed import Client
+
+    if scheduler is not None:
+        try:
+            return Client(scheduler, timeout="20s"), None, f"Dask scheduler {scheduler}"
+        except (OSError, TimeoutError) as e:
+            raise WgcadError(f"--scheduler {scheduler}: cannot reach the Dask scheduler ({e})") from None
+    from ..sweep.runner import local_cluster
+
+    cluster = local_cluster(workers)
+    return Client(cluster), cluster, f"Dask LocalCluster, {workers} processes on loopback"
+
+
+def run_search(req: Requirements, out_dir=None, workers: int = 1, scheduler=None, progress=None) -> SearchResult:
+    """Search the free keys of ``req`` (module docstring); ``progress(done, total)`` after every candidate."""
+    import optuna
+
+    optuna.logging.set_verbosity(optuna.logging.WARNING)
+    t0 = time.perf_counter()
+    base = load_design(req.base)
+    names = constraint_names(req)
+    sampler, sampler_text, n_grid = _sampler(req)
+    budget = req.trials if n_grid is None else min(req.trials, n_grid)
+    storage = None
+    if out_dir is not None:
+        from optuna.storages import JournalStorage
+        from optuna.storages.journal import JournalFileBackend
+
+        storage = JournalStorage(JournalFileBackend(str(out_dir / "study.journal")))
+    directions = ["maximize" if OBJECTIVES[o][0] == "max" else "minimize" for o in req.objectives]
+    study = optuna.create_study(
+        study_name="wgcad-design", storage=storage, load_if_exists=True, directions=directions, sampler=sampler
+    )
+    done = [t for t in study.trials if t.state == optuna.trial.TrialState.COMPLETE]
+    evaluations = [ev for ev in map(_from_trial, done) if ev is not None]
+    resumed = len(evaluations)
+    dist = _distributions(req)
+    if n_grid is not None:
+        seen = {tuple(ev.values[fk.name] for fk in req.free) for ev in evaluations}
+        ranges = [range(int(fk.low), int(fk.high) + 1) for fk in req.free]
+        for combo in product(*ranges):
+            if combo not in seen:
+                study.enqueue_trial({fk.name: v for fk, v in zip(req.free, combo)})
+    client, cluster, executor = _client(workers, scheduler)
+    try:
+        while len(evaluations) < budget:
+            n = min(max(1, workers), budget - len(evaluations))
+            trials = [study.ask(dist) for _ in range(n)]
+            cands = [dict(t.params) for t in trials]
+            if client is None:
+                evs = [evaluate(base, req.free, c, req) for c in cands]
+            else:
+                futs = client.map(evaluate, [base] * n, [req.free] * n, cands, [req] * n, pure=False)
+                evs = client.gather(futs)
+            for t, ev in zip(trials, evs):
+                _tell(study, t, ev, req, names)
+                evaluations.append(ev)
+                if progress is not None:
+                    progress(len(evaluations), budget)
+    finally:
+        if client is not None:
+            client.close()
+        if cluster is not None:
+            cluster.close()
+    ranked, front = _rank(req, [ev for ev in evaluations if ev.feasible])
+    return SearchResult(
+        req=req,
+        evaluations=evaluations,
+        ranked=ranked,
+        pareto=front,
+        constraints=names,
+        executor=executor,
+        sampler=sampler_text,
+        seconds=time.perf_counter() - t0,
+        resumed=resumed,
+    )
+
+
+def grid_size(req: Requirements) -> int | None:
+    """Combinations of the whole-number free keys, or None when some key is real-valued."""
+    if not all(fk.integer for fk in req.free):
+        return None
+    return math.prod(int(fk.high) - int(fk.low) + 1 for fk in req.free)
