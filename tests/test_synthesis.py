@@ -106,3 +106,37 @@ def test_the_bundled_example_gives_a_drive_that_passes_audit_and_rating(tmp_path
     assert main(["rating", str(best), "--json", str(tmp_path / "r.json")]) == 0
     assert json.loads((tmp_path / "r.json").read_text())["rated_torque_nm"] >= 300.0
     assert (out / "d1_ratio100_search.png").stat().st_size > 10_000
+    # and a KE sweep of it under run-out tolerances (4 samples here), every sample within 60 arcsec
+    spec = tmp_path / "ke.toml"
+    spec.write_text(
+        f'[sweep]\nname = "KE of the chosen drive"\ndesign = "{best}"\nsamples = 4\nseed = 3\n'
+        '[figures]\nrecord = ["ke_pp_arcsec"]\n'
+        '[parameters.imperfections.flex_runout_um]\ndistribution = "uniform"\nlo = 0.0\nhi = 20.0\n'
+        '[parameters.imperfections.rigid_runout_um]\ndistribution = "uniform"\nlo = 0.0\nhi = 20.0\n'
+        "[limits]\nke_pp_arcsec = { max = 60.0 }\n"
+    )
+    assert main(["sweep", str(spec), "--workers", "0", "--out", str(tmp_path / "ke"), "--no-plots"]) == 0
+    summary = json.loads((tmp_path / "ke" / "summary.json").read_text())
+    assert "YIELD 100.00 %" in capsys.readouterr().out, summary
+
+
+def test_two_objectives_give_a_pareto_front(tmp_path, capsys):
+    """D1 with its flexspline's thinning free and two objectives that pull apart (largest smallest clearance,
+    smallest backlash: thinning buys one with the other): every member of the front written is non-dominated
+    among the feasible candidates, each gets a design file, and the front's CSV lists them."""
+    p = _req(
+        tmp_path,
+        'objective = ["min_clearance", "backlash"]\ntrials = 8\nseed = 2\n[free]\n"flexspline.thinning" = [0.0, 0.06]\n',
+    )
+    out = tmp_path / "out"
+    assert main(["design", str(p), "--out", str(out)]) == 0
+    doc = json.loads((out / "req_search.json").read_text())
+    front = doc["pareto"]
+    assert front and "NSGA-II" in doc["sampler"]
+    feas = [r for r in csv.DictReader((out / "req_trials.csv").open()) if r["feasible"] == "True"]
+    pts = [(float(r["min_clearance"]), float(r["backlash"])) for r in feas]
+    for m in front:
+        c, b = m["objectives"]["min_clearance"], m["objectives"]["backlash"]
+        assert not any(c2 >= c and b2 <= b and (c2 > c or b2 < b) for c2, b2 in pts)
+    assert len(list(out.glob("req_pareto_*.toml"))) == len(front)
+    assert len(list(csv.DictReader((out / "req_pareto.csv").open()))) == len(front)
