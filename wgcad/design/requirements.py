@@ -12,6 +12,8 @@ A requirements file names a base design (every key the search leaves alone is th
     max_outside_diameter_mm = 200.0   # the rigid gear's body
     max_backlash_arcmin = 3.0         # no-load audit
     min_clearance_um = 0.0            # no-load audit: no interference
+    entry_gap_closes_below_nm = 3000  # the loaded entry gap closes below this torque (a source's observation)
+    cam_offset_um = 40.0              # the cam offset the drive is rated with (default the base's [load])
     objective = "rated_torque"        # what ranks the feasible drives (one, or two for a Pareto front)
     trials = 40
     seed = 1
@@ -53,6 +55,8 @@ _KEYS = {
     "max_outside_diameter_mm": float,
     "max_backlash_arcmin": float,
     "min_clearance_um": float,
+    "entry_gap_closes_below_nm": float,
+    "cam_offset_um": float,
     "objective": (str, list),
     "trials": int,
     "seed": int,
@@ -88,6 +92,8 @@ class Requirements:
     max_outside_diameter_mm: float | None = None
     max_backlash_arcmin: float | None = None
     min_clearance_um: float | None = 0.0
+    entry_gap_closes_below_nm: float | None = None
+    cam_offset_um: float | None = None
     trials: int = 40
     seed: int = 0
     source: str = "<memory>"
@@ -98,6 +104,7 @@ class Requirements:
         return (
             self.rated_torque_nm is not None
             or self.peak_torque_nm is not None
+            or self.entry_gap_closes_below_nm is not None
             or any(o in ("rated_torque", "stiffness") for o in self.objectives)
         )
 
@@ -159,7 +166,14 @@ def parse_requirements(data: dict, path: Path) -> Requirements:
     base_path = (path.parent / req["base"]).resolve()
     base = load_design(base_path)
     vals = {}
-    for k in ("ratio", "rated_torque_nm", "peak_torque_nm", "max_outside_diameter_mm", "max_backlash_arcmin"):
+    for k in (
+        "ratio",
+        "rated_torque_nm",
+        "peak_torque_nm",
+        "max_outside_diameter_mm",
+        "max_backlash_arcmin",
+        "entry_gap_closes_below_nm",
+    ):
         if k in req:
             v = _number(f"requirements.{k}", req[k], float)
             if not v > 0:
@@ -167,6 +181,11 @@ def parse_requirements(data: dict, path: Path) -> Requirements:
             vals[k] = v
     if "min_clearance_um" in req:
         vals["min_clearance_um"] = _number("requirements.min_clearance_um", req["min_clearance_um"], float)
+    if "cam_offset_um" in req:
+        v = _number("requirements.cam_offset_um", req["cam_offset_um"], float)
+        if not 0 <= v <= 1000:
+            raise DesignError("requirements.cam_offset_um", f"must be in [0, 1000] um, got {v:g}")
+        vals["cam_offset_um"] = v
     obj = req.get("objective", "rated_torque")
     objectives = tuple(obj) if isinstance(obj, list) else (obj,)
     if (

@@ -155,8 +155,9 @@ def _audit(drive, ev: Evaluation, req) -> bool:
 def _rating(drive, ev: Evaluation, req) -> bool:
     from ..rating import rate_drive
 
+    offset = None if req.cam_offset_um is None else (req.cam_offset_um, drive.design.load.cam_offset_deg)
     try:
-        sheet = rate_drive(drive)
+        sheet = rate_drive(drive, cam_offset=offset)
     except (DesignError, ModelError) as e:
         ev.margins["rating"] = -1.0
         ev.message = f"rating: {e}"
@@ -173,6 +174,12 @@ def _rating(drive, ev: Evaluation, req) -> bool:
         for k in PEAK:
             if k in lim:
                 ev.margins[f"{k} at peak torque"] = lim[k].torque_nm / req.peak_torque_nm - 1.0
+    if req.entry_gap_closes_below_nm is not None:
+        # an upper bound on a limit: the gap must close (tip interference at entry) below the torque given; a gap
+        # still open where the model stopped ('above') is not shown to close at all: violated
+        eg = lim["entry_gap"]
+        ev.objectives["entry_gap_closes_nm"] = float(eg.torque_nm)
+        ev.margins["entry gap closes below"] = -1.0 if eg.above else 1.0 - eg.torque_nm / req.entry_gap_closes_below_nm
     short = [k for k, v in ev.margins.items() if v is not None and v < 0]
     if short:
         ev.message = "rating: " + ", ".join(short)

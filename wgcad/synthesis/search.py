@@ -42,6 +42,8 @@ def constraint_names(req: Requirements) -> list[str]:
         names += [f"{k} at rated torque" for k in RATED]
     if req.peak_torque_nm is not None:
         names += [f"{k} at peak torque" for k in PEAK]
+    if req.entry_gap_closes_below_nm is not None:
+        names.append("entry gap closes below")
     return names
 
 
