@@ -94,6 +94,9 @@ def summary_lines(res) -> list[str]:
     bind = _binding(best)
     if bind:
         out.append("  binding: " + ", ".join(f"{b['constraint']} (margin {b['margin']:+.3f})" for b in bind))
+    rest = sorted((v, k) for k, v in best.margins.items() if v is not None and k not in ("ratio", "design rules"))
+    if len(rest) > len(bind):
+        out.append("  the others keep: " + ", ".join(f"{k} {v:+.3f}" for v, k in rest[len(bind) :]))
     if len(req.objectives) > 1:
         out.append(f"  Pareto front: {len(res.pareto)} designs")
     return out
