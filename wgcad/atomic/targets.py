@@ -42,8 +42,9 @@ def _reason(exc: OSError) -> str:
 
 
 def _kind(mode: int) -> str:
-    """Name of a non-regular file type, for messages."""
+    """Name of a file type, for messages."""
     for test, name in (
+        (stat.S_ISREG, "a regular file"),
         (stat.S_ISLNK, "a symbolic link"),
         (stat.S_ISDIR, "a folder"),
         (stat.S_ISCHR, "a character device"),

@@ -12,9 +12,9 @@ __all__ = ["register", "cmd_design"]
 def cmd_design(args) -> int:
     from ..atomic import ensure_writable_dir
     from ..design.files import read_design_text
-    from ..design.requirements import load_requirements
     from ..export.synthesis_files import write_search_files
     from ..report.synthesis import summary_lines
+    from ..synthesis.requirements import load_requirements
     from ..synthesis.search import run_search
     from .common import Progress, want_progress
 

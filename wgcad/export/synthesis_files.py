@@ -8,8 +8,8 @@ import io
 import json
 from pathlib import Path
 
-from ..design.requirements import OBJECTIVES
 from ..report.synthesis import design_text, search_json, trial_rows
+from ..synthesis.requirements import OBJECTIVES
 from .mpl import png_bytes, pyplot
 
 __all__ = ["write_search_files", "search_figure"]

@@ -5,8 +5,8 @@ from __future__ import annotations
 import math
 import re
 
-from ..design.requirements import OBJECTIVES
 from ..synthesis.evaluate import STAGES
+from ..synthesis.requirements import OBJECTIVES
 
 __all__ = ["search_json", "summary_lines", "design_text", "trial_rows"]
 

@@ -10,6 +10,9 @@ Stages, each run only when the ones before it passed (a candidate that fails one
 4. ``audit``: the no-load clearance audit (0.5 deg, 3 sections, exact): smallest clearance and backlash.
 5. ``rating``: the datasheet (:func:`wgcad.rating.rate_drive`): at the rated torque fatigue, yield and bearing
    life hold; up to the peak torque the entry gap stays open, no ratcheting, the bearing within its static limit.
+6. ``ke budget``: ``ke_samples`` drives drawn from the tolerances (the sweep's own sample runner, in this
+   process): the share whose KE stays within ``ke_max_arcsec`` at least ``ke_yield_min`` (the sample share: a
+   point estimate; the summary gives its Clopper-Pearson interval).
 
 Every constraint is a margin, >= 0 when met, scaled so that a margin of -0.1 is "10 % short"; a stage that stops a
 candidate leaves the later constraints unknown (None). Internal units (mm, N m, rad); the record's keys say which.
@@ -29,7 +32,7 @@ from ..errors import DesignError, ModelError
 
 __all__ = ["Evaluation", "evaluate", "apply", "STAGES"]
 
-STAGES = ("ratio", "design rules", "outside diameter", "audit", "rating")
+STAGES = ("ratio", "design rules", "outside diameter", "audit", "rating", "ke budget")
 
 #: the continuous-duty criteria of the datasheet (they must hold at the rated torque) and the momentary ones (up to
 #: the peak torque): wgcad.rating.datasheet's limit names
@@ -122,6 +125,10 @@ def _run(base, free, ev: Evaluation, req) -> None:
         ev.stage = "rating"
         if not _rating(drive, ev, req):
             return
+    if req.ke_max_arcsec is not None:
+        ev.stage = "ke budget"
+        if not _ke_budget(free, ev, req):
+            return
     ev.stage, ev.feasible = "done", True
 
 
@@ -148,6 +155,45 @@ def _audit(drive, ev: Evaluation, req) -> bool:
         ev.message = f"no-load audit: smallest clearance {c_um:+.2f} um" + (
             f", backlash {bl:.2f} arcmin" if bl is not None else ", no backlash (interference)"
         )
+        return False
+    return True
+
+
+def candidate_data(base_data: dict, free, values: dict) -> dict:
+    """The base design's TOML data with the free keys set (what a sweep of the candidate starts from)."""
+    import copy
+
+    data = copy.deepcopy(base_data)
+    for fk in free:
+        v = values[fk.name]
+        data.setdefault(fk.table, {})[fk.key] = int(round(v)) if fk.integer else float(v)
+    return data
+
+
+def _ke_budget(free, ev: Evaluation, req) -> bool:
+    from ..sweep.tasks import run_batch
+    from .requirements import ke_spec
+
+    spec = ke_spec(
+        req.tolerances,
+        candidate_data(req.base_data, free, ev.values),
+        req.ke_samples,
+        req.seed,
+        req.ke_max_arcsec,
+        "candidate",
+    )
+    cols = run_batch(spec.payload(), 0, spec.total)["columns"]
+    within = [
+        s == "ok" and math.isfinite(k) and k <= req.ke_max_arcsec for k, s in zip(cols["ke_pp_arcsec"], cols["status"])
+    ]
+    share = sum(within) / len(within)
+    kes = sorted(k for k, s in zip(cols["ke_pp_arcsec"], cols["status"]) if s == "ok" and math.isfinite(k))
+    ev.objectives["ke_yield"] = share
+    if kes:
+        ev.objectives["ke_max_sampled_arcsec"] = kes[-1]
+    ev.margins["ke budget"] = share - req.ke_yield_min
+    if ev.margins["ke budget"] < 0:
+        ev.message = f"KE budget: {sum(within)} of {len(within)} drawn drives within {req.ke_max_arcsec:g} arcsec"
         return False
     return True
 

@@ -20,9 +20,9 @@ from dataclasses import dataclass, field
 from itertools import product
 
 from ..design import load_design
-from ..design.requirements import OBJECTIVES, Requirements
 from ..errors import WgcadError
 from .evaluate import PEAK, RATED, STAGES, Evaluation, evaluate
+from .requirements import OBJECTIVES, Requirements
 
 __all__ = ["SearchResult", "run_search", "constraint_names"]
 
@@ -44,6 +44,8 @@ def constraint_names(req: Requirements) -> list[str]:
         names += [f"{k} at peak torque" for k in PEAK]
     if req.entry_gap_closes_below_nm is not None:
         names.append("entry gap closes below")
+    if req.ke_max_arcsec is not None:
+        names.append("ke budget")
     return names
 
 

@@ -31,9 +31,9 @@ import math
 from dataclasses import dataclass, fields
 from pathlib import Path
 
+from ..design.files import parse_toml
+from ..design.schema import Design
 from ..errors import DesignError
-from .files import parse_toml
-from .schema import Design
 
 __all__ = ["FreeKey", "Requirements", "OBJECTIVES", "load_requirements", "parse_requirements"]
 
@@ -57,6 +57,9 @@ _KEYS = {
     "min_clearance_um": float,
     "entry_gap_closes_below_nm": float,
     "cam_offset_um": float,
+    "ke_max_arcsec": float,
+    "ke_yield_min": float,
+    "ke_samples": int,
     "objective": (str, list),
     "trials": int,
     "seed": int,
@@ -94,6 +97,15 @@ class Requirements:
     min_clearance_um: float | None = 0.0
     entry_gap_closes_below_nm: float | None = None
     cam_offset_um: float | None = None
+    #: the KE budget under tolerances: the largest KE (peak to peak over a flexspline turn, arcsec) that a share
+    #: ``ke_yield_min`` of ``ke_samples`` drives drawn from ``tolerances`` may not exceed
+    ke_max_arcsec: float | None = None
+    ke_yield_min: float = 0.99
+    ke_samples: int = 40
+    #: ``[tolerances.TABLE.KEY]`` as a sweep spec's ``[parameters...]`` (distributions of the imperfections)
+    tolerances: dict | None = None
+    #: the base design as TOML data (a candidate's KE sweep starts from it)
+    base_data: dict | None = None
     trials: int = 40
     seed: int = 0
     source: str = "<memory>"
@@ -148,13 +160,58 @@ def _free_keys(data, base: Design) -> tuple:
     return tuple(out)
 
 
+def _ke_budget(req: dict, tolerances, base_data: dict, base_path: Path) -> dict:
+    """``ke_max_arcsec``, ``ke_yield_min``, ``ke_samples`` and the ``[tolerances]`` they are drawn from, checked (the
+    tolerances as a sweep spec's parameters would be)."""
+    if "ke_max_arcsec" not in req:
+        for k in ("ke_yield_min", "ke_samples"):
+            if k in req:
+                raise DesignError(f"requirements.{k}", "is used only with ke_max_arcsec (the KE budget)")
+        if tolerances is not None:
+            raise DesignError("tolerances", "is used only with requirements.ke_max_arcsec (the KE budget)")
+        return {}
+    ke_max = _number("requirements.ke_max_arcsec", req["ke_max_arcsec"], float)
+    if not 0 < ke_max <= 3600:
+        raise DesignError("requirements.ke_max_arcsec", f"must be in (0, 3600] arcsec, got {ke_max:g}")
+    y = _number("requirements.ke_yield_min", req.get("ke_yield_min", 0.99), float)
+    if not 0 < y <= 1:
+        raise DesignError("requirements.ke_yield_min", f"must be a share in (0, 1], got {y:g}")
+    n = int(_number("requirements.ke_samples", req.get("ke_samples", 40), int))
+    if not 4 <= n <= 10000:
+        raise DesignError("requirements.ke_samples", f"must be in [4, 10000], got {n}")
+    if not isinstance(tolerances, dict) or not tolerances:
+        raise DesignError("tolerances", "the KE budget needs the tolerances its drives are drawn from")
+    # checked as the sweep checks its parameters; its messages name [parameters...], this file [tolerances...]
+    try:
+        ke_spec(tolerances, base_data, n, 0, ke_max, str(base_path))
+    except DesignError as e:
+        field = e.field.replace("parameters", "tolerances", 1) if e.field.startswith("parameters") else e.field
+        raise DesignError(field, e.rule) from None
+    return {"ke_max_arcsec": ke_max, "ke_yield_min": y, "ke_samples": n, "tolerances": tolerances}
+
+
+def ke_spec(tolerances: dict, design_data: dict, samples: int, seed: int, ke_max: float, source: str):
+    """The sweep spec of a candidate's KE budget: ``samples`` drives drawn from ``tolerances``, KE recorded."""
+    from ..sweep.spec import parse_spec
+
+    data = {
+        "sweep": {"name": "KE budget", "design": source, "samples": samples, "seed": seed},
+        "figures": {"record": ["ke_pp_arcsec"]},
+        "parameters": tolerances,
+        "limits": {"ke_pp_arcsec": {"max": ke_max}},
+    }
+    return parse_spec(data, source=source, design_data=design_data)
+
+
 def parse_requirements(data: dict, path: Path) -> Requirements:
     """Check a requirements file's tables (see the module docstring) and load its base design."""
-    from .files import load_design
+    from ..design.files import load_design
 
-    unknown = set(data) - {"requirements", "free"}
+    unknown = set(data) - {"requirements", "free", "tolerances"}
     if unknown:
-        raise DesignError(sorted(unknown)[0], "unknown table (a requirements file has [requirements] and [free])")
+        raise DesignError(
+            sorted(unknown)[0], "unknown table (a requirements file has [requirements], [free] and [tolerances])"
+        )
     req = data.get("requirements")
     if not isinstance(req, dict):
         raise DesignError("requirements", "the table is missing")
@@ -165,6 +222,9 @@ def parse_requirements(data: dict, path: Path) -> Requirements:
         raise DesignError("requirements.base", "the design file the search starts from (a path relative to this file)")
     base_path = (path.parent / req["base"]).resolve()
     base = load_design(base_path)
+    from ..design.files import read_design_text
+
+    base_data = parse_toml(read_design_text(base_path), base_path, "design file")
     vals = {}
     for k in (
         "ratio",
@@ -181,6 +241,8 @@ def parse_requirements(data: dict, path: Path) -> Requirements:
             vals[k] = v
     if "min_clearance_um" in req:
         vals["min_clearance_um"] = _number("requirements.min_clearance_um", req["min_clearance_um"], float)
+    ke = _ke_budget(req, data.get("tolerances"), base_data, base_path)
+    vals.update(ke)
     if "cam_offset_um" in req:
         v = _number("requirements.cam_offset_um", req["cam_offset_um"], float)
         if not 0 <= v <= 1000:
@@ -211,14 +273,16 @@ def parse_requirements(data: dict, path: Path) -> Requirements:
         trials=trials,
         seed=seed,
         source=str(path),
+        base_data=base_data,
         **vals,
     )
 
 
 def load_requirements(path) -> Requirements:
     """Read and check a requirements file (regular file, size-limited like a design file)."""
-    from .files import read_design_text
+    from ..design.files import MAX_DESIGN_BYTES
+    from ..userfiles import read_user_text
 
     path = Path(path)
-    text = read_design_text(path)
+    text = read_user_text(path, "requirements file", MAX_DESIGN_BYTES, "TOML")
     return parse_requirements(parse_toml(text, path, "requirements file"), path)
