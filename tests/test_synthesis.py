@@ -189,3 +189,22 @@ def test_bad_tolerances_name_the_requirements_table(tmp_path):
     with pytest.raises(DesignError) as e:
         load_requirements(p)
     assert e.value.field.startswith("tolerances.imperfections.flex_runout_um"), e.value.field
+
+
+def test_length_and_lost_motion_limits(tmp_path, capsys):
+    """D1 (its cup 160 mm long, lost motion 2.75 arcmin at +-4 % of its rated torque): a 150 mm limit on the
+    flexspline's length stops its one candidate of ratio 100 at the body stage; a lost-motion range of 2-3.5
+    arcmin is met (margin: the distance to the nearer end over the range, 0.5 here within the datasheet's rounding),
+    one of 0.1-1 arcmin is not."""
+    body = 'ratio = 100.0\nobjective = "min_clearance"\ntrials = 9\n[free]\n"drive.z_flex" = [196, 204]\n'
+    p = _req(tmp_path, "max_length_mm = 150.0\n" + body, name="len.toml")
+    assert main(["design", str(p), "--out", str(tmp_path / "a"), "--no-plots"]) == 1
+    assert "no candidate met: length" in capsys.readouterr().out
+    p = _req(tmp_path, "lost_motion_arcmin = [2.0, 3.5]\n" + body, name="lm.toml")
+    assert main(["design", str(p), "--out", str(tmp_path / "b"), "--no-plots"]) == 0
+    doc = json.loads((tmp_path / "b" / "lm_search.json").read_text())
+    assert doc["best"]["objectives"]["lost_motion"] == pytest.approx(2.75, abs=0.01)
+    assert doc["best"]["margins"]["lost motion"] == pytest.approx(0.5, abs=0.01)
+    p = _req(tmp_path, "lost_motion_arcmin = [0.1, 1.0]\n" + body, name="lm2.toml")
+    assert main(["design", str(p), "--out", str(tmp_path / "c"), "--no-plots"]) == 1
+    assert "no candidate met: lost motion" in capsys.readouterr().out

@@ -6,7 +6,7 @@ Stages, each run only when the ones before it passed (a candidate that fails one
    ``z_rigid / (z_rigid - z_flex)``) against the required ratio; tooth counts only.
 2. ``design rules``: the design's own field rules and derived geometry (:func:`wgcad.drive.build_drive`: pointed or
    undercut teeth, fillets that do not fit, teeth that never meet).
-3. ``outside diameter``: the rigid gear's body (its rim) within the envelope.
+3. ``outside diameter``: the rigid gear's body (its rim) within the envelope, and the flexspline's length.
 4. ``audit``: the no-load clearance audit (0.5 deg, 3 sections, exact): smallest clearance and backlash.
 5. ``rating``: the datasheet (:func:`wgcad.rating.rate_drive`): at the rated torque fatigue, yield and bearing
    life hold; up to the peak torque the entry gap stays open, no ratcheting, the bearing within its static limit.
@@ -118,6 +118,14 @@ def _run(base, free, ev: Evaluation, req) -> None:
         if ev.margins["outside diameter"] < 0:
             ev.message = f"rigid gear body {od:.1f} mm across, allowed {req.max_outside_diameter_mm:g}"
             return
+    if req.max_length_mm is not None:
+        g = drive.design.generator
+        length = g.cone_length if g.cone_length is not None else drive.design.drive.face_width
+        ev.objectives["length"] = float(length)
+        ev.margins["length"] = (req.max_length_mm - length) / req.max_length_mm
+        if ev.margins["length"] < 0:
+            ev.message = f"flexspline {length:g} mm long, allowed {req.max_length_mm:g}"
+            return
     ev.stage = "audit"
     if not _audit(drive, ev, req):
         return
@@ -220,6 +228,12 @@ def _rating(drive, ev: Evaluation, req) -> bool:
         for k in PEAK:
             if k in lim:
                 ev.margins[f"{k} at peak torque"] = lim[k].torque_nm / req.peak_torque_nm - 1.0
+    if req.lost_motion_arcmin is not None:
+        lo, hi = req.lost_motion_arcmin
+        lm = None if sheet.lost_motion is None else 60.0 * math.degrees(sheet.lost_motion)
+        ev.objectives["lost_motion"] = lm
+        # inside [lo, hi]: the margin is the distance to the nearer end over the range's width
+        ev.margins["lost motion"] = -1.0 if lm is None else min(lm - lo, hi - lm) / (hi - lo)
     if req.entry_gap_closes_below_nm is not None:
         # an upper bound on a limit: the gap must close (tip interference at entry) below the torque given; a gap
         # still open where the model stopped ('above') is not shown to close at all: violated

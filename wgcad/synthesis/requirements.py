@@ -10,6 +10,8 @@ A requirements file names a base design (every key the search leaves alone is th
     rated_torque_nm = 300.0           # fatigue, yield and bearing life hold at it (wgcad rating)
     peak_torque_nm = 800.0            # the entry gap stays open, no ratcheting, the bearing's static limit
     max_outside_diameter_mm = 200.0   # the rigid gear's body
+    max_length_mm = 170.0             # the flexspline's axial length (a cup: open end to diaphragm)
+    lost_motion_arcmin = [0.5, 3.0]   # the datasheet's lost motion at +-4 % of the rated torque
     max_backlash_arcmin = 3.0         # no-load audit
     min_clearance_um = 0.0            # no-load audit: no interference
     entry_gap_closes_below_nm = 3000  # the loaded entry gap closes below this torque (a source's observation)
@@ -54,6 +56,8 @@ _KEYS = {
     "peak_torque_nm": float,
     "max_outside_diameter_mm": float,
     "max_backlash_arcmin": float,
+    "max_length_mm": float,
+    "lost_motion_arcmin": list,
     "min_clearance_um": float,
     "entry_gap_closes_below_nm": float,
     "cam_offset_um": float,
@@ -94,6 +98,10 @@ class Requirements:
     peak_torque_nm: float | None = None
     max_outside_diameter_mm: float | None = None
     max_backlash_arcmin: float | None = None
+    #: the flexspline's axial length (a cup: generator.cone_length, open end to diaphragm; a ring: the face width)
+    max_length_mm: float | None = None
+    #: ``(low, high)``: the datasheet's lost motion at +-4 % of the rated torque, arcmin
+    lost_motion_arcmin: tuple | None = None
     min_clearance_um: float | None = 0.0
     entry_gap_closes_below_nm: float | None = None
     cam_offset_um: float | None = None
@@ -117,6 +125,7 @@ class Requirements:
             self.rated_torque_nm is not None
             or self.peak_torque_nm is not None
             or self.entry_gap_closes_below_nm is not None
+            or self.lost_motion_arcmin is not None
             or any(o in ("rated_torque", "stiffness") for o in self.objectives)
         )
 
@@ -232,6 +241,7 @@ def parse_requirements(data: dict, path: Path) -> Requirements:
         "peak_torque_nm",
         "max_outside_diameter_mm",
         "max_backlash_arcmin",
+        "max_length_mm",
         "entry_gap_closes_below_nm",
     ):
         if k in req:
@@ -241,6 +251,14 @@ def parse_requirements(data: dict, path: Path) -> Requirements:
             vals[k] = v
     if "min_clearance_um" in req:
         vals["min_clearance_um"] = _number("requirements.min_clearance_um", req["min_clearance_um"], float)
+    if "lost_motion_arcmin" in req:
+        lm = req["lost_motion_arcmin"]
+        if not (isinstance(lm, list) and len(lm) == 2):
+            raise DesignError("requirements.lost_motion_arcmin", f"must be [low, high] arcmin, got {lm!r}")
+        lo, hi = (_number("requirements.lost_motion_arcmin", v, float) for v in lm)
+        if not 0 <= lo < hi:
+            raise DesignError("requirements.lost_motion_arcmin", f"must be 0 <= low < high, got [{lo:g}, {hi:g}]")
+        vals["lost_motion_arcmin"] = (lo, hi)
     ke = _ke_budget(req, data.get("tolerances"), base_data, base_path)
     vals.update(ke)
     if "cam_offset_um" in req:

@@ -35,6 +35,8 @@ def constraint_names(req: Requirements) -> list[str]:
     names.append("design rules")
     if req.max_outside_diameter_mm is not None:
         names.append("outside diameter")
+    if req.max_length_mm is not None:
+        names.append("length")
     names.append("clearance")
     if req.max_backlash_arcmin is not None:
         names.append("backlash")
@@ -42,6 +44,8 @@ def constraint_names(req: Requirements) -> list[str]:
         names += [f"{k} at rated torque" for k in RATED]
     if req.peak_torque_nm is not None:
         names += [f"{k} at peak torque" for k in PEAK]
+    if req.lost_motion_arcmin is not None:
+        names.append("lost motion")
     if req.entry_gap_closes_below_nm is not None:
         names.append("entry gap closes below")
     if req.ke_max_arcsec is not None:
