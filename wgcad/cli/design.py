@@ -29,7 +29,12 @@ def cmd_design(args) -> int:
     bar = Progress(want_progress(args.progress) and (args.progress or not args.quiet))
     bar.start("candidates")
     res = run_search(
-        req, out_dir=out, workers=args.workers, scheduler=args.scheduler, progress=lambda d, n: bar.set(d / n)
+        req,
+        out_dir=out,
+        workers=args.workers,
+        scheduler=args.scheduler,
+        progress=lambda d, n: bar.set(d / n),
+        explain=not args.no_explain,
     )
     bar.close()
     files = write_search_files(res, out, Path(args.requirements).stem, base_text, plot=not args.no_plots)
@@ -74,6 +79,12 @@ def register(sub) -> None:
         help="candidates to judge in all (default the file's requirements.trials; resumed ones count)",
     )
     d.add_argument("--out", help="results folder (default output/design_REQNAME); reused to resume")
+    d.add_argument(
+        "--no-explain",
+        action="store_true",
+        help="do not judge the best design's neighbours (each free key moved a twentieth of its range each way, "
+        "two more candidates per key) to say which requirement holds each chosen value",
+    )
     d.add_argument("--no-plots", action="store_true", help="no PNG")
     d.add_argument("--progress", action="store_true", help="draw the progress bar even when stderr is not a terminal")
     d.add_argument("--quiet", action="store_true", help="no summary on stdout")

@@ -48,7 +48,9 @@ def search_json(res) -> dict:
         "resumed_trials": res.resumed,
         "feasible": len(res.ranked),
         "seconds": _r(res.seconds, 2),
-        "best": None if res.best is None else {**_candidate(res.best), "binding": _binding(res.best)},
+        "best": None
+        if res.best is None
+        else {**_candidate(res.best), "binding": _binding(res.best), "held_by": res.held},
         "pareto": [_candidate(ev) for ev in res.pareto] if len(req.objectives) > 1 else None,
     }
     if res.best is None:
@@ -97,6 +99,8 @@ def summary_lines(res) -> list[str]:
     rest = sorted((v, k) for k, v in best.margins.items() if v is not None and k not in ("ratio", "design rules"))
     if len(rest) > len(bind):
         out.append("  the others keep: " + ", ".join(f"{k} {v:+.3f}" for v, k in rest[len(bind) :]))
+    for name, h in res.held.items():
+        out.append(f"  {name}: " + _held(h, "no margin measured"))
     if len(req.objectives) > 1:
         out.append(f"  Pareto front: {len(res.pareto)} designs")
     return out
@@ -126,6 +130,17 @@ def _set_key(text: str, table: str, key: str, value: str, comment: str) -> str:
     return "\n".join(out) + "\n"
 
 
+def _held(h: dict | None, why: str) -> str:
+    """What a key's comment says holds it: the constraint its moves violate, else the objective, else the margins."""
+    if not h:
+        return why
+    if h.get("constraint") is None:
+        return h["note"]
+    return (
+        f"held by {h['constraint']} (moved {h['direction']} to {h['value_tried']:g}: margin {h['margin_there']:+.3f})"
+    )
+
+
 def design_text(base_text: str, res, ev, label: str = "best") -> str:
     """The base design's text with the free keys set to ``ev``'s values, each commented with the constraint that
     binds hardest, and a header saying where the file came from."""
@@ -142,10 +157,17 @@ def design_text(base_text: str, res, ev, label: str = "best") -> str:
         "",
     ]
     text = base_text
+    held = res.held if ev is res.best else {}
     for fk in req.free:
         v = ev.values[fk.name]
         value = str(int(round(v))) if fk.integer else repr(round(float(v), 6))
-        text = _set_key(text, fk.table, fk.key, value, f"chosen by wgcad design in [{fk.low:g}, {fk.high:g}]; {why}")
+        text = _set_key(
+            text,
+            fk.table,
+            fk.key,
+            value,
+            f"chosen by wgcad design in [{fk.low:g}, {fk.high:g}]; " + _held(held.get(fk.name), why),
+        )
     return "\n".join(head) + text
 
 

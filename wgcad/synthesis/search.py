@@ -67,6 +67,8 @@ class SearchResult:
     seconds: float
     resumed: int = 0
     notes: list = field(default_factory=list)
+    #: for each free key of the best design, what holds it where it is (:func:`_what_holds`)
+    held: dict = field(default_factory=dict)
 
     @property
     def best(self) -> Evaluation | None:
@@ -189,8 +191,13 @@ def _client(workers: int, scheduler):
     return Client(cluster), cluster, f"Dask LocalCluster, {workers} processes on loopback"
 
 
-def run_search(req: Requirements, out_dir=None, workers: int = 1, scheduler=None, progress=None) -> SearchResult:
-    """Search the free keys of ``req`` (module docstring); ``progress(done, total)`` after every candidate."""
+def run_search(
+    req: Requirements, out_dir=None, workers: int = 1, scheduler=None, progress=None, explain: bool = True
+) -> SearchResult:
+    """Search the free keys of ``req`` (module docstring); ``progress(done, total)`` after every candidate.
+
+    ``explain``: judge the best candidate's neighbours too, to say what holds each chosen key
+    (:func:`_what_holds`: two more candidates per key, not counted in the budget)."""
     import optuna
 
     optuna.logging.set_verbosity(optuna.logging.WARNING)
@@ -220,27 +227,29 @@ def run_search(req: Requirements, out_dir=None, workers: int = 1, scheduler=None
             if combo not in seen:
                 study.enqueue_trial({fk.name: v for fk, v in zip(req.free, combo)})
     client, cluster, executor = _client(workers, scheduler)
+
+    def judge(cands: list) -> list:
+        if client is None:
+            return [evaluate(base, req.free, c, req) for c in cands]
+        n = len(cands)
+        return client.gather(client.map(evaluate, [base] * n, [req.free] * n, cands, [req] * n, pure=False))
+
     try:
         while len(evaluations) < budget:
             n = min(max(1, workers), budget - len(evaluations))
             trials = [study.ask(dist) for _ in range(n)]
-            cands = [dict(t.params) for t in trials]
-            if client is None:
-                evs = [evaluate(base, req.free, c, req) for c in cands]
-            else:
-                futs = client.map(evaluate, [base] * n, [req.free] * n, cands, [req] * n, pure=False)
-                evs = client.gather(futs)
-            for t, ev in zip(trials, evs):
+            for t, ev in zip(trials, judge([dict(t.params) for t in trials])):
                 _tell(study, t, ev, req, names)
                 evaluations.append(ev)
                 if progress is not None:
                     progress(len(evaluations), budget)
+        ranked, front = _rank(req, [ev for ev in evaluations if ev.feasible])
+        held = _what_holds(req, ranked[0], judge) if ranked and explain else {}
     finally:
         if client is not None:
             client.close()
         if cluster is not None:
             cluster.close()
-    ranked, front = _rank(req, [ev for ev in evaluations if ev.feasible])
     return SearchResult(
         req=req,
         evaluations=evaluations,
@@ -251,7 +260,43 @@ def run_search(req: Requirements, out_dir=None, workers: int = 1, scheduler=None
         sampler=sampler_text,
         seconds=time.perf_counter() - t0,
         resumed=resumed,
+        held=held,
     )
+
+
+def _what_holds(req: Requirements, best: Evaluation, judge) -> dict:
+    """For each free key of the best candidate, the constraint that holds it there: the key is moved by a twentieth
+    of its range (one, for whole numbers) each way it can go, the other keys kept, the moved candidates judged; the
+    constraint with the smallest margin among them (a violated one first) is what stops the key moving, and its
+    margin there is given. A key whose moves violate nothing is held by the objective alone."""
+    moves = []
+    for fk in req.free:
+        step = 1.0 if fk.integer else 0.05 * (fk.high - fk.low)
+        for sgn in (-1.0, 1.0):
+            v = best.values[fk.name] + sgn * step
+            if fk.low - 1e-12 <= v <= fk.high + 1e-12:
+                moves.append((fk, sgn, v, {**best.values, fk.name: v}))
+    evs = judge([m[3] for m in moves])
+    out = {}
+    for fk in req.free:
+        tried = [(m, ev) for m, ev in zip(moves, evs) if m[0] is fk]
+        worst = None
+        for (_, sgn, v, _), ev in tried:
+            for c, margin in ev.margins.items():
+                if margin is not None and (worst is None or margin < worst[2]):
+                    worst = (c, sgn, margin, v)
+        if worst is None:
+            out[fk.name] = {"constraint": None, "note": "at both ends of its range: no move tried"}
+        elif worst[2] >= 0:
+            out[fk.name] = {"constraint": None, "note": "moving it violates nothing: the objective holds it"}
+        else:
+            out[fk.name] = {
+                "constraint": worst[0],
+                "direction": "up" if worst[1] > 0 else "down",
+                "value_tried": worst[3],
+                "margin_there": worst[2],
+            }
+    return out
 
 
 def grid_size(req: Requirements) -> int | None:
