@@ -277,6 +277,39 @@ def _positive(where: str, value: float) -> None:
         raise DesignError(where, f"must be > 0, got {value:g}")
 
 
+def _validate_gear(d: Design, name: str) -> None:
+    """The field rules of ``[flexspline]`` or ``[rigid]`` (``name``)."""
+    dr, g = d.drive, d.generator
+    gs: GearSpec = getattr(d, name)
+    if gs.conjugate_z is not None and gs.flanks != "conjugate":
+        raise DesignError(f"{name}.conjugate_z", "is used only with flanks = 'conjugate'")
+    if gs.conjugate_clearance_um and gs.flanks != "conjugate":
+        raise DesignError(f"{name}.conjugate_clearance_um", "is used only with flanks = 'conjugate'")
+    _choice(f"{name}.face_modification", gs.face_modification, ("none", "depth", "linear"))
+    if gs.face_modification != "none":
+        if name != "flexspline":
+            raise DesignError(f"{name}.face_modification", "only the flexspline's teeth are modified along the face")
+        if g.cone_length is None or dr.deformation != "internal":
+            raise DesignError(
+                f"{name}.face_modification",
+                "needs a coned cup (generator.cone_length) and internal deformation: it compensates coning",
+            )
+    if (gs.face_taper_um_per_mm is None) != (gs.face_modification != "linear"):
+        raise DesignError(f"{name}.face_taper_um_per_mm", "is given exactly when face_modification = 'linear'")
+    _positive(f"{name}.rim_thickness", gs.rim_thickness)
+    if gs.fillet_coef < 0:
+        raise DesignError(f"{name}.fillet_coef", f"must be >= 0, got {gs.fillet_coef:g}")
+    for key in ("tip_radius", "root_radius"):
+        val = getattr(gs, key)
+        if val is not None:
+            _positive(f"{name}.{key}", val)
+    if abs(gs.thinning) >= 0.5 * math.pi * dr.module:
+        raise DesignError(
+            f"{name}.thinning",
+            f"must be smaller than half the pitch ({0.5 * math.pi * dr.module:.4f} mm), got {gs.thinning:g}",
+        )
+
+
 def validate(d: Design) -> Design:
     """Check every field rule of a design; return it unchanged or raise :class:`DesignError`.
 
@@ -320,36 +353,7 @@ def validate(d: Design) -> Design:
     if d.rigid.flanks == "conjugate" and dr.deformation != "internal":
         raise DesignError("rigid.flanks", "conjugate flanks are built for internal deformation only")
     for name in ("flexspline", "rigid"):
-        gs: GearSpec = getattr(d, name)
-        if gs.conjugate_z is not None and gs.flanks != "conjugate":
-            raise DesignError(f"{name}.conjugate_z", "is used only with flanks = 'conjugate'")
-        if gs.conjugate_clearance_um and gs.flanks != "conjugate":
-            raise DesignError(f"{name}.conjugate_clearance_um", "is used only with flanks = 'conjugate'")
-        _choice(f"{name}.face_modification", gs.face_modification, ("none", "depth", "linear"))
-        if gs.face_modification != "none":
-            if name != "flexspline":
-                raise DesignError(
-                    f"{name}.face_modification", "only the flexspline's teeth are modified along the face"
-                )
-            if g.cone_length is None or dr.deformation != "internal":
-                raise DesignError(
-                    f"{name}.face_modification",
-                    "needs a coned cup (generator.cone_length) and internal deformation: it compensates coning",
-                )
-        if (gs.face_taper_um_per_mm is None) != (gs.face_modification != "linear"):
-            raise DesignError(f"{name}.face_taper_um_per_mm", "is given exactly when face_modification = 'linear'")
-        _positive(f"{name}.rim_thickness", gs.rim_thickness)
-        if gs.fillet_coef < 0:
-            raise DesignError(f"{name}.fillet_coef", f"must be >= 0, got {gs.fillet_coef:g}")
-        for key in ("tip_radius", "root_radius"):
-            val = getattr(gs, key)
-            if val is not None:
-                _positive(f"{name}.{key}", val)
-        if abs(gs.thinning) >= 0.5 * math.pi * dr.module:
-            raise DesignError(
-                f"{name}.thinning",
-                f"must be smaller than half the pitch ({0.5 * math.pi * dr.module:.4f} mm), got {gs.thinning:g}",
-            )
+        _validate_gear(d, name)
     laws = ("external_ring",) if dr.deformation == "external" else tuple(x for x in LAW_NAMES if x != "external_ring")
     _choice("generator.law", g.law, laws)
     if g.law != "harmonic" and dr.waves != 2:

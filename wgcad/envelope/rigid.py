@@ -82,6 +82,20 @@ def _tip_wall(drive, cf, side: int = 1, clearance: float = 0.0, last=None) -> np
     return np.array([[r_last * np.cos(a_wall), r_last * np.sin(a_wall)]])
 
 
+def _flank_points(cf, clearance: float) -> tuple[np.ndarray, np.ndarray]:
+    """The flank's exact points (set back by ``clearance`` along their normals into the rigid tooth: the flank bounds
+    space 0 from above, the tooth lies at larger polar angles) and normals, 0.1 um apart at least (the ends are found
+    finely), from the tip (inner) outward."""
+    fp, fn = np.asarray(cf.points, float), np.asarray(cf.normal, float)
+    if clearance:
+        e_t = np.stack([-fp[:, 1], fp[:, 0]], -1) / np.hypot(*fp.T)[:, None]
+        fp = fp + clearance * np.sign(np.einsum("ij,ij->i", fn, e_t))[:, None] * fn
+    keep = np.concatenate([[True], np.hypot(*np.diff(fp, axis=0).T) > 1e-4])
+    fp, fn = fp[keep], fn[keep]
+    o = np.argsort(np.hypot(*fp.T))
+    return fp[o], fn[o]
+
+
 def conjugate_rigid_gear(drive, z: float | None = None, clearance: float = 0.0) -> tuple[Gear, object]:
     """The rigid gear conjugate to ``drive``'s flexspline at section ``z`` (default: the generator's centre
     section), and the :class:`~wgcad.envelope.space.ConjugateFlank` it was made from.
@@ -97,17 +111,8 @@ def conjugate_rigid_gear(drive, z: float | None = None, clearance: float = 0.0) 
     half = pi / zr
     # the flank bounds space 0 (centred on +x) from above; in the tooth frame (rigid tooth centred on +x) it is
     # the tooth's lower flank: turn by -pi/z, then mirror for the upper flank that the half period runs along
-    # flank points 0.1 um apart at least (the ends are found finely), with their tangents
-    fp, fn = np.asarray(cf.points, float), np.asarray(cf.normal, float)
-    if clearance:
-        # into the rigid tooth: the flank bounds space 0 from above, the tooth lies at larger polar angles
-        e_t = np.stack([-fp[:, 1], fp[:, 0]], -1) / np.hypot(*fp.T)[:, None]
-        fp = fp + clearance * np.sign(np.einsum("ij,ij->i", fn, e_t))[:, None] * fn
-    wall = _tip_wall(drive, cf, clearance=clearance, last=fp[np.argmax(np.hypot(*fp.T))])
-    keep = np.concatenate([[True], np.hypot(*np.diff(fp, axis=0).T) > 1e-4])
-    fp, fn = fp[keep], fn[keep]
-    o = np.argsort(np.hypot(*fp.T))  # from the tip (inner) outward, then the wall's step beyond the last point
-    fp, fn = fp[o], fn[o]
+    fp, fn = _flank_points(cf, clearance)
+    wall = _tip_wall(drive, cf, clearance=clearance, last=fp[-1])
     n_flank = len(fp)
     up = _turn(np.concatenate([fp, wall]), -half) * np.array([1.0, -1.0])
     tan = _turn(np.stack([-fn[:, 1], fn[:, 0]], -1), -half) * np.array([1.0, -1.0])
