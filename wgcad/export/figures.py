@@ -72,27 +72,13 @@ def _strip_rows(x_total_mm: float, y_span_mm: float) -> int:
     return int(min(12, max(1, ceil(x_total_mm / per_row - 1e-9))))
 
 
-def assembly_figure(scene: dict, title: str, entry_deg: float = 50.0, rows: int | None = None):
-    """A deformed state as a matplotlib figure (see :func:`assembly_png`)."""
-    plt = _pyplot()
+def _schematic(ax0, scene: dict) -> None:
+    """The whole drive, schematic: the neutral line with its deformation exaggerated (at true scale W0 is ~1 % of the
+    radius and the oval cannot be seen), the axes named, and the legend of the whole figure beneath."""
     from matplotlib.lines import Line2D
-    from matplotlib.patches import Patch, Polygon
+    from matplotlib.patches import Patch
 
-    r_ref, sgn, a = scene["r_ref"], scene["entry_sign"], scene["major_axis"]
-    span = np.deg2rad(entry_deg)
-    lo_ang = -np.deg2rad(4.0)
-    y_lo, y_hi = scene["y_range"]
-    if rows is None:
-        rows = _strip_rows(r_ref * (span - lo_ang), y_hi - y_lo)
-    x_row = r_ref * (span - lo_ang) / rows
-    strip_h = _STRIP_WIDTH_IN * (y_hi - y_lo) / x_row  # true scale
-    fig_h = max(7.0, rows * (strip_h + 0.8) + 1.3)
-    fig = plt.figure(figsize=(16, fig_h), layout="constrained", dpi=DPI)
-    gs = fig.add_gridspec(rows, 2, width_ratios=[1, 2.6])
-
-    # schematic of the whole drive: the neutral line with its deformation exaggerated
-    # (at true scale W0 is ~1 % of the radius and the oval cannot be seen)
-    ax0 = fig.add_subplot(gs[:, 0])
+    a = scene["major_axis"]
     r_m, w0 = scene["r_m"], abs(scene["w0"])
     k = max(1.0, round(0.12 * r_m / w0))
     t = np.linspace(0, 2 * pi, 721)
@@ -128,6 +114,26 @@ def assembly_figure(scene: dict, title: str, entry_deg: float = 50.0, rows: int 
     ]
     ax0.legend(handles=hand, fontsize=_LEGEND_PT, loc="upper center", bbox_to_anchor=(0.5, 0.0))
     ax0.axis("off")
+
+
+def assembly_figure(scene: dict, title: str, entry_deg: float = 50.0, rows: int | None = None):
+    """A deformed state as a matplotlib figure (see :func:`assembly_png`)."""
+    plt = _pyplot()
+    from matplotlib.patches import Polygon
+
+    r_ref, sgn, a = scene["r_ref"], scene["entry_sign"], scene["major_axis"]
+    span = np.deg2rad(entry_deg)
+    lo_ang = -np.deg2rad(4.0)
+    y_lo, y_hi = scene["y_range"]
+    if rows is None:
+        rows = _strip_rows(r_ref * (span - lo_ang), y_hi - y_lo)
+    x_row = r_ref * (span - lo_ang) / rows
+    strip_h = _STRIP_WIDTH_IN * (y_hi - y_lo) / x_row  # true scale
+    fig_h = max(7.0, rows * (strip_h + 0.8) + 1.3)
+    fig = plt.figure(figsize=(16, fig_h), layout="constrained", dpi=DPI)
+    gs = fig.add_gridspec(rows, 2, width_ratios=[1, 2.6])
+
+    _schematic(fig.add_subplot(gs[:, 0]), scene)
 
     # close-up: unrolled strips from just behind the major axis to the entry side
     teeth, phi = scene["flex_teeth"], scene["flex_phi"]

@@ -165,86 +165,103 @@ def audit_summary(name: str, res: dict) -> str:
         lines.append("  no interference")
     e = res["entry"]
     if st.get("imperfections"):
-        sh = st["shortcuts_that_hold"]
-        held = [k.replace("_", " ") for k, v in sh.items() if v and k != "one_generator_turn"]
-        turns = st.get("generator_turns", 1.0)
-        cyc = (
-            f"{turns:g} generator turn{'s' if turns != 1 else ''} of the {st['full_cycle_turns']}-turn cycle swept"
-            if st.get("full_cycle_turns")
-            else ""
-        )
-        if sh.get("one_generator_turn") and cyc:
-            cyc += " (no flexspline-borne errors: one turn holds every state)"
-        lines.append(
-            "  imperfect parts ([imperfections]): every tooth posed with its errors"
-            + (f", {cyc}" if cyc else "")
-            + "; shortcuts that still hold: "
-            + (", ".join(held) if held else "none")
-            + " (none used)"
-        )
+        lines.append(_imperfect_line(st))
     if e.get("note"):
         pass  # not computed (imperfect parts): the caller's NOT CHECKED lines say so
     elif res["entry_gap_um"] is not None:
-        sec = "" if e["section_z_mm"] is None else f", section z = {e['section_z_mm']:g} mm"
-        what = (
-            "the pinch where the tips pass each other"
-            if e["kind"] == "pinch"
-            else "at the tip crossing (no pinch: the smallest gap of the entry)"
+        lines += _entry_lines(res, e)
+    else:
+        lines.append("  entry gap: none (the tips never cross the rigid tip circle)")
+    lines.append(_backlash_line(res))
+    lines += _method_lines(res, st)
+    return "\n".join(lines)
+
+
+def _imperfect_line(st: dict) -> str:
+    """What an imperfect drive's audit swept and which shortcuts still hold."""
+    sh = st["shortcuts_that_hold"]
+    held = [k.replace("_", " ") for k, v in sh.items() if v and k != "one_generator_turn"]
+    turns = st.get("generator_turns", 1.0)
+    cyc = (
+        f"{turns:g} generator turn{'s' if turns != 1 else ''} of the {st['full_cycle_turns']}-turn cycle swept"
+        if st.get("full_cycle_turns")
+        else ""
+    )
+    if sh.get("one_generator_turn") and cyc:
+        cyc += " (no flexspline-borne errors: one turn holds every state)"
+    return (
+        "  imperfect parts ([imperfections]): every tooth posed with its errors"
+        + (f", {cyc}" if cyc else "")
+        + "; shortcuts that still hold: "
+        + (", ".join(held) if held else "none")
+        + " (none used)"
+    )
+
+
+def _entry_lines(res: dict, e: dict) -> list[str]:
+    """The entry gap Delta of [S1], the tip crossing and the pinch."""
+    sec = "" if e["section_z_mm"] is None else f", section z = {e['section_z_mm']:g} mm"
+    what = (
+        "the pinch where the tips pass each other"
+        if e["kind"] == "pinch"
+        else "at the tip crossing (no pinch: the smallest gap of the entry)"
+    )
+    lines = [
+        f"  entry gap Delta [S1]: {res['entry_gap_um']:.3f} um by the {e['edge']} edge ({e['location']}) at tooth angle "
+        f"{e['tooth_angle_deg']:+.3f} deg{sec}, {what}" + ("  TIP-TO-TIP RISK" if e["tip_to_tip_risk"] else "")
+    ]
+    csec = "" if e["crossing_section_z_mm"] is None else f", section z = {e['crossing_section_z_mm']:g} mm"
+    lines.append(
+        f"  tip crossing: {e['crossing_um']:.3f} um by the {e['crossing_edge']} edge at tooth angle "
+        f"{e['crossing_tooth_angle_deg']:+.3f} deg{csec} (flexspline tip circle meeting the rigid tip circle)"
+        + (
+            f"; tooth {e['tooth']} at generator angle {e['generator_angle_deg']:.3f} deg, the smallest of "
+            f"{e['passages']} passages (they spread over {e['spread_um']:.3f} um)"
+            if "tooth" in e
+            else ""
         )
+    )
+    if e["pinch_um"] is None:
         lines.append(
-            f"  entry gap Delta [S1]: {res['entry_gap_um']:.3f} um by the {e['edge']} edge ({e['location']}) at tooth angle "
-            f"{e['tooth_angle_deg']:+.3f} deg{sec}, {what}" + ("  TIP-TO-TIP RISK" if e["tip_to_tip_risk"] else "")
+            "  entry pinch: none (after the crossing the gaps never dip and rise again before the flanks engage)"
         )
-        csec = "" if e["crossing_section_z_mm"] is None else f", section z = {e['crossing_section_z_mm']:g} mm"
+    else:
+        psec = "" if e["pinch_section_z_mm"] is None else f", section z = {e['pinch_section_z_mm']:g} mm"
         lines.append(
-            f"  tip crossing: {e['crossing_um']:.3f} um by the {e['crossing_edge']} edge at tooth angle "
-            f"{e['crossing_tooth_angle_deg']:+.3f} deg{csec} (flexspline tip circle meeting the rigid tip circle)"
+            f"  entry pinch: {e['pinch_um']:.3f} um by the {e['pinch_edge']} edge at tooth angle "
+            f"{e['pinch_tooth_angle_deg']:+.3f} deg{psec}, {e['pinch_location']}"
             + (
-                f"; tooth {e['tooth']} at generator angle {e['generator_angle_deg']:.3f} deg, the smallest of "
-                f"{e['passages']} passages (they spread over {e['spread_um']:.3f} um)"
-                if "tooth" in e
+                f"; tooth {e['pinch_tooth']} at generator angle {e['pinch_generator_angle_deg']:.3f} deg"
+                if "pinch_tooth" in e
                 else ""
             )
         )
-        if e["pinch_um"] is None:
-            lines.append(
-                "  entry pinch: none (after the crossing the gaps never dip and rise again before the flanks engage)"
-            )
-        else:
-            psec = "" if e["pinch_section_z_mm"] is None else f", section z = {e['pinch_section_z_mm']:g} mm"
-            lines.append(
-                f"  entry pinch: {e['pinch_um']:.3f} um by the {e['pinch_edge']} edge at tooth angle "
-                f"{e['pinch_tooth_angle_deg']:+.3f} deg{psec}, {e['pinch_location']}"
-                + (
-                    f"; tooth {e['pinch_tooth']} at generator angle {e['pinch_generator_angle_deg']:.3f} deg"
-                    if "pinch_tooth" in e
-                    else ""
-                )
-            )
-    else:
-        lines.append("  entry gap: none (the tips never cross the rigid tip circle)")
+    return lines
+
+
+def _backlash_line(res: dict) -> str:
     b = res["backlash_at"]
     if res["backlash_arcmin"] is None:
         if res.get("backlash_unbounded"):
-            lines.append(
-                f"  backlash: unbounded (no flexspline tooth engages at generator angle {b['generator_angle_deg']:g} deg)"
-            )
-        elif res["interference"]:
-            lines.append(f"  backlash: none, teeth interfere at generator angle {b['generator_angle_deg']:g} deg")
-        else:
-            lines.append(f"  backlash: none (the teeth touch at generator angle {b['generator_angle_deg']:g} deg)")
-    else:
-        lines.append(
-            f"  backlash: {res['backlash_arcmin']:.4f} arcmin = {res['backlash_um_at_pitch']:.2f} um at the rigid pitch circle "
-            f"(generator angle {b['generator_angle_deg']:g} deg)"
-        )
+            return f"  backlash: unbounded (no flexspline tooth engages at generator angle {b['generator_angle_deg']:g} deg)"
+        if res["interference"]:
+            return f"  backlash: none, teeth interfere at generator angle {b['generator_angle_deg']:g} deg"
+        return f"  backlash: none (the teeth touch at generator angle {b['generator_angle_deg']:g} deg)"
+    return (
+        f"  backlash: {res['backlash_arcmin']:.4f} arcmin = {res['backlash_um_at_pitch']:.2f} um at the rigid pitch circle "
+        f"(generator angle {b['generator_angle_deg']:g} deg)"
+    )
+
+
+def _method_lines(res: dict, st: dict) -> list[str]:
+    """How the figures were found: exact or polygon, the face ends, what was computed and how long it took."""
     if st.get("refined"):
-        lines.append(
+        lines = [
             f"  figures refined on the exact tooth curves (to {st['refine_tol_um']:g} um either side; "
             f"outlines at {st['chord_tol_um']:g} um chords find where)"
-        )
+        ]
     else:
-        lines.append(f"  polygon figures: within 2 x {st['chord_tol_um']:g} um of the exact curves' (either side)")
+        lines = [f"  polygon figures: within 2 x {st['chord_tol_um']:g} um of the exact curves' (either side)"]
     if st.get("face_ends_checked") is False:
         lines.append(f"  WARNING: coned flexspline, sections {st['sections_z_mm']} mm: the face ends were not checked")
     c = res["counts"]
@@ -259,4 +276,4 @@ def audit_summary(name: str, res: dict) -> str:
             f"  computed {c['evaluated']} of {c['samples']} tooth samples on polygons, {c.get('refined', 0)} on the exact curves "
             f"({c['unique_tooth_angles']} distinct tooth angles, {c['culled']} culled by radius) in {res['elapsed_s']:.3f} s"
         )
-    return "\n".join(lines)
+    return lines

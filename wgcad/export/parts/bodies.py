@@ -375,6 +375,34 @@ def plug(drive, sizes, tol: float) -> Part:
     return Part(name, layers, solid, mesh, vol, ((-rmax, -rmax, z0), (rmax, rmax, z1)), info)
 
 
+def _rigid_teeth(drive, style: str, tol: float, sectored: dict | None) -> tuple:
+    """The rigid gear's toothed outline: ``(arc path or None, band, area, STEP wire builder, DXF layer builder)``,
+    of the design's gear or of the sectored one."""
+    from wgcad.export import step as S
+
+    g = drive.rigid
+    if sectored is None:
+        path = fit_gear(g, tol)
+        band = _band(g)
+        return (
+            path,
+            band,
+            abs(path_area(path)),
+            lambda: S.wire_from_path(path.vertices, path.bulges),
+            lambda: _teeth_layer("RIGID", g, path, style, 1, band),
+        )
+    if drive.external:
+        raise DesignError("sectors", "a sectored rigid gear is built for internal deformation only")
+    band = np.asarray(sectored["outline"], dtype=float)
+    return (
+        None,
+        band,
+        abs(signed_area(band)),
+        lambda: S.wire_from_polygon(band),
+        lambda: DxfLayer("RIGID", outlines=(band,), color=1),
+    )
+
+
 def rigid(drive, sizes, style: str, tol: float, sectored: dict | None = None) -> Part:
     """The rigid gear: internal teeth in a ring with a bolted mounting flange (internal deformation) or external teeth on a bolted hub.
 
@@ -386,28 +414,7 @@ def rigid(drive, sizes, style: str, tol: float, sectored: dict | None = None) ->
 
     g = drive.rigid
     bw = drive.design.drive.face_width
-    if sectored is None:
-        path = fit_gear(g, tol)
-        band = _band(g)
-        area = abs(path_area(path))
-
-        def teeth_wire():
-            return S.wire_from_path(path.vertices, path.bulges)
-
-        def teeth_layer():
-            return _teeth_layer("RIGID", g, path, style, 1, band)
-    else:
-        if drive.external:
-            raise DesignError("sectors", "a sectored rigid gear is built for internal deformation only")
-        band = np.asarray(sectored["outline"], dtype=float)
-        area = abs(signed_area(band))
-
-        def teeth_wire():
-            return S.wire_from_polygon(band)
-
-        def teeth_layer():
-            return DxfLayer("RIGID", outlines=(band,), color=1)
-
+    path, band, area, teeth_wire, teeth_layer = _rigid_teeth(drive, style, tol, sectored)
     R = drive.rigid_rim_radius
     dh = sizes.flange_bolt_hole_diameter
     holes = bolt_circle(
