@@ -26,24 +26,33 @@ def audit_plot_data(drive, result) -> dict:
     """What the audit's pictures show, computed once for every renderer (PNG, the interactive page): ``profile``
     (data, title), ``vs_angle`` ("passages" or "curve", the arguments of its figure), ``tightest`` (teeth, labels,
     rigid teeth, overlaps, title), all in um and degrees."""
-    import numpy as np
-    import shapely
-
-    from ..clearance.engine import Scene, clearance_profile, clearance_vs_angle
-    from ..placement import tooth_pose, transform
-
-    out = {}
+    from ..clearance.engine import Scene, clearance_profile
+    from ..report.audit import audit_json
 
     scene = Scene(drive)
     imperfect = bool(result.settings.get("imperfections"))
-    perfect_note = " (perfect drive)" if imperfect else ""
     secs = [None] if not drive.coned else [s for s in result.settings["sections_z_mm"]]
     prof = clearance_profile(scene, secs)
-    from ..report.audit import audit_json
-
     doc = audit_json(result)
-    w, e = doc["worst"], doc["entry"]
     name = drive.design.drive.name
+    perfect_note = " (perfect drive)" if imperfect else ""
+    out = {
+        "profile": (
+            _profile_data(scene, secs, prof, result, doc, imperfect),
+            f"{name}: clearance of a flexspline tooth along its passage (every tooth follows it){perfect_note}",
+        )
+    }
+    out["vs_angle"] = _vs_angle(drive, result, scene, prof, secs, imperfect)
+    out["tightest"] = _tightest(drive, scene, doc["worst"], imperfect)
+    return out
+
+
+def _profile_data(scene, secs, prof, result, doc, imperfect: bool) -> dict:
+    """The passage profile's curves per section, the entry gap (the perfect drive's, and the imperfect parts' beside
+    it) and the tightest spot."""
+    import numpy as np
+
+    w, e = doc["worst"], doc["entry"]
     ent = result.findings["entry_crossing"].details
     extra = {}
     if imperfect and "perfect_gaps" in ent:
@@ -64,7 +73,7 @@ def audit_plot_data(drive, result) -> dict:
             }
     else:
         entry_deg, entry_um, entry_label = e["tooth_angle_deg"], 1e3 * result.entry_gap, "entry gap Delta"
-    data = {
+    return {
         "phi_deg": np.rad2deg(prof["phi"]),
         "sections": [
             {"z": s["z"], "working_um": 1e3 * s["working"], "nonworking_um": 1e3 * s["nonworking"]}
@@ -79,15 +88,22 @@ def audit_plot_data(drive, result) -> dict:
         "worst_um": w["clearance_um"],
         "tol_um": 1e3 * result.interference_tol,
     }
-    out["profile"] = (
-        data,
-        f"{name}: clearance of a flexspline tooth along its passage (every tooth follows it){perfect_note}",
-    )
+
+
+def _vs_angle(drive, result, scene, prof, secs, imperfect: bool) -> tuple:
+    """The smallest clearance against the generator angle (three mesh periods), or, where the errors break the mesh
+    period, the entry gap of every passage."""
+    import numpy as np
+
+    from ..clearance.engine import clearance_vs_angle
+
+    name = drive.design.drive.name
+    ent = result.findings["entry_crossing"].details
     mesh = 360.0 / drive.design.drive.z_rigid
     if imperfect and "all_passages" in ent:
         # the errors break the mesh period: every passage of a tooth through the entry has its own gap
         a = ent["all_passages"]
-        out["vs_angle"] = (
+        return (
             "passages",
             (
                 np.rad2deg(a["phi_h"]),
@@ -100,20 +116,29 @@ def audit_plot_data(drive, result) -> dict:
                 f"({result.settings.get('generator_turns', 1):g} generator turn(s); the audit's smallest is refined on the exact curves)",
             ),
         )
-    else:
-        ang = np.deg2rad(np.linspace(0.0, 3 * mesh, 601))
-        wv, nv = clearance_vs_angle(scene, prof, ang)
-        out["vs_angle"] = (
-            "curve",
-            (
-                np.rad2deg(ang),
-                1e3 * wv,
-                1e3 * nv,
-                1e3 * result.interference_tol,
-                f"{name}: smallest clearance over all teeth; periodic with the mesh period {mesh:.4f} deg (3 shown){perfect_note}",
-            ),
-        )
-    # the teeth around the tightest spot, at the worst sample's generator angle and section
+    perfect_note = " (perfect drive)" if imperfect else ""
+    ang = np.deg2rad(np.linspace(0.0, 3 * mesh, 601))
+    wv, nv = clearance_vs_angle(scene, prof, ang)
+    return (
+        "curve",
+        (
+            np.rad2deg(ang),
+            1e3 * wv,
+            1e3 * nv,
+            1e3 * result.interference_tol,
+            f"{name}: smallest clearance over all teeth; periodic with the mesh period {mesh:.4f} deg (3 shown){perfect_note}",
+        ),
+    )
+
+
+def _tightest(drive, scene, w: dict, imperfect: bool) -> tuple:
+    """The teeth around the tightest spot, at the worst sample's generator angle and section, and their overlaps."""
+    import numpy as np
+    import shapely
+
+    from ..placement import tooth_pose, transform
+
+    name = drive.design.drive.name
     phi_h = np.deg2rad(w["generator_angle_deg"])
     z = w["section_z_mm"]
     d = drive.design.drive
@@ -143,7 +168,7 @@ def audit_plot_data(drive, result) -> dict:
                     overlaps.append(np.asarray(g.exterior.coords))
     labels = [f"{np.rad2deg(((p + np.pi) % (2 * np.pi)) - np.pi):.1f} deg" for p in (mat - phi_h)]
     sec = "" if z is None else f", section z = {z:g} mm"
-    out["tightest"] = (
+    return (
         teeth,
         labels,
         rig,
@@ -151,4 +176,3 @@ def audit_plot_data(drive, result) -> dict:
         f"{name}{' (imperfect parts)' if imperfect else ''}: tightest spot, tooth {w['tooth']} at generator angle {w['generator_angle_deg']:g} deg{sec}: "
         f"{w['clearance_um']:.2f} um ({w['location']})",
     )
-    return out
