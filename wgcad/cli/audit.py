@@ -48,6 +48,37 @@ def _check_outputs(args) -> None:
         check_output_file(path, flag=flag, inputs=inputs, stdout_ok=flag not in ("--plot", "--html"))
 
 
+def _run_settings(args, base: dict | None):
+    """The run's settings: a baseline's (its figures are only comparable at its own), else the flags'."""
+    from ..audit import RunSettings
+
+    if base is not None:
+        st = base["settings"]
+        return RunSettings(
+            step_deg=float(st["step_deg"]),
+            sections=int(st["sections"]),
+            chord_tol_um=float(st["chord_tol_um"]),
+            interference_tol_um=float(st["interference_tol_um"]),
+            max_memory_mb=args.max_memory_mb,
+        )
+    step = 360.0 / args.angles if args.angles else args.step_deg
+    off = args.no_shortcuts
+    return RunSettings(
+        step_deg=step,
+        sections=args.sections,
+        chord_tol_um=args.chord_tol_um,
+        interference_tol_um=args.interference_tol_um,
+        use_period=not (off or args.no_mesh_period),
+        use_waves=not (off or args.no_wave_symmetry),
+        use_mirror=not (off or args.no_mirror),
+        cull=not (off or args.no_culling),
+        bound=not (off or args.no_bound),
+        max_memory_mb=args.max_memory_mb,
+        refine=not args.no_refine,
+        turns=args.turns,
+    )
+
+
 def cmd_audit(args) -> int:
     if args.torque_nm is not None:  # under load: cli/load.py
         from .load import run_load
@@ -63,7 +94,7 @@ def cmd_audit(args) -> int:
     bar = Progress(want_progress(args.progress) and (args.progress or not args.quiet))
     bar.start("loading modules")
     _check_outputs(args)
-    from ..audit import FLAGS, RunSettings
+    from ..audit import FLAGS
 
     bar.set(0.0, "reading the design")
 
@@ -72,32 +103,7 @@ def cmd_audit(args) -> int:
         from ..regression import load_baseline
 
         base = load_baseline(args.baseline)
-    if base is not None:
-        st = base["settings"]
-        rs = RunSettings(
-            step_deg=float(st["step_deg"]),
-            sections=int(st["sections"]),
-            chord_tol_um=float(st["chord_tol_um"]),
-            interference_tol_um=float(st["interference_tol_um"]),
-            max_memory_mb=args.max_memory_mb,
-        )
-    else:
-        step = 360.0 / args.angles if args.angles else args.step_deg
-        off = args.no_shortcuts
-        rs = RunSettings(
-            step_deg=step,
-            sections=args.sections,
-            chord_tol_um=args.chord_tol_um,
-            interference_tol_um=args.interference_tol_um,
-            use_period=not (off or args.no_mesh_period),
-            use_waves=not (off or args.no_wave_symmetry),
-            use_mirror=not (off or args.no_mirror),
-            cull=not (off or args.no_culling),
-            bound=not (off or args.no_bound),
-            max_memory_mb=args.max_memory_mb,
-            refine=not args.no_refine,
-            turns=args.turns,
-        )
+    rs = _run_settings(args, base)
     rs.check(FLAGS)
     # the engine reports (done, total, stage); it fills the bar up to 90 % (95 % without pictures)
     work_end = 0.6 if args.plot else (0.9 if args.engine == "2d" else 0.8)

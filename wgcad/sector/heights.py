@@ -193,6 +193,34 @@ class SimulatedHeights:
     elapsed_s: float = 0.0
 
 
+def _bisect_heights(pairs, lo: dict, hi: dict, violations, tip_clearance: float, tol: float) -> None:
+    """Bisect every tooth's height between ``lo`` and ``hi`` (updated in place) to ``tol``: the largest that keeps
+    ``tip_clearance`` to all its facing pairs (``violations(trial heights, pair indices)``, their clearances).
+
+    A pair whose clearance at the trial height is at least tip_clearance plus the rest of the interval can no longer
+    decide anything: moving the tip by dh changes the clearance by at most dh (the shorter tooth lies inside the
+    taller), so it is dropped."""
+    alive = np.isin(pairs.rigid, list(lo))
+    while True:
+        todo = [i for i in lo if hi[i] - lo[i] > tol]
+        if not todo:
+            break
+        mid = {i: 0.5 * (lo[i] + hi[i]) for i in todo}
+        sel = np.nonzero(alive & np.isin(pairs.rigid, todo))[0]
+        c = violations(mid, sel)
+        owner = pairs.rigid[sel]
+        for i in todo:
+            mine = owner == i
+            ok = not mine.any() or c[mine].min() >= tip_clearance
+            if ok:
+                lo[i] = mid[i]
+                slack = hi[i] - mid[i]
+            else:
+                hi[i] = mid[i]
+                slack = 0.0
+            alive[sel[mine & (c >= tip_clearance + slack)]] = False
+
+
 def simulated_heights(
     drive,
     layout: SectorLayout,
@@ -248,27 +276,7 @@ def simulated_heights(
             unreachable[i] = True
     lo = {i: h_min for i in bad if not unreachable[i]}
     hi = {i: H for i in bad if not unreachable[i]}
-    # a pair whose clearance at the trial height is at least tip_clearance plus the rest of the interval can no longer
-    # decide anything: moving the tip by dh changes the clearance by at most dh (the shorter tooth lies inside the taller)
-    alive = np.isin(pairs.rigid, list(lo))
-    while True:
-        todo = [i for i in lo if hi[i] - lo[i] > tol]
-        if not todo:
-            break
-        mid = {i: 0.5 * (lo[i] + hi[i]) for i in todo}
-        sel = np.nonzero(alive & np.isin(pairs.rigid, todo))[0]
-        c = violations(mid, sel)
-        owner = pairs.rigid[sel]
-        for i in todo:
-            mine = owner == i
-            ok = not mine.any() or c[mine].min() >= tip_clearance
-            if ok:
-                lo[i] = mid[i]
-                slack = hi[i] - mid[i]
-            else:
-                hi[i] = mid[i]
-                slack = 0.0
-            alive[sel[mine & (c >= tip_clearance + slack)]] = False
+    _bisect_heights(pairs, lo, hi, violations, tip_clearance, tol)
     for i in bad:
         heights[i] = lo[i] if not unreachable[i] else h_min
     # where each lowered tooth is limited: its closest facing sample at the height found
