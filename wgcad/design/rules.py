@@ -19,7 +19,10 @@ from dataclasses import MISSING, dataclass, field, fields
 
 from ..errors import DesignError
 
-__all__ = ["Rel", "key", "key_meta", "check_bounds", "show", "context"]
+__all__ = ["Rel", "key", "key_meta", "check_bounds", "show", "context", "WHEN_BUILT"]
+
+#: the rule suffix of a key checked by build_drive (it needs the tooth geometry), not when the file is read
+WHEN_BUILT = " (checked when the gears are built)"
 
 
 @dataclass(frozen=True)

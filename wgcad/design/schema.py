@@ -11,7 +11,7 @@ from ..errors import DesignError
 from ..numbers import read_float, read_int
 from .imperfections import ImperfectionsSpec
 from .load import BearingSpec, LoadSpec, MaterialSpec
-from .rules import Rel, check_bounds, show
+from .rules import WHEN_BUILT, Rel, check_bounds, show
 from .rules import key as _key
 from .sectors import SectorsSpec, validate_sectors
 from .teeth import GearSpec, ToothFormSpec
@@ -32,9 +32,6 @@ __all__ = [
 #: deformation accepts all but ``external_ring``, external deformation only it
 LAW_NAMES = ("harmonic", "disc", "four_force", "ellipse", "external_ring")
 _BETA_LAWS = ("disc", "four_force", "external_ring")
-
-
-_P = " (checked when the gears are built)"
 
 
 @dataclass(frozen=True)
@@ -71,7 +68,7 @@ class DriveSpec:
         lo=8,
         hi=3000,
         rule="z_rigid - z_flex (external deformation: z_flex - z_rigid) a positive multiple of waves; "
-        "the teeth must meet on the major axis" + _P,
+        "the teeth must meet on the major axis" + WHEN_BUILT,
         why="as z_flex; a rigid gear so much larger than the flexspline that the teeth never "
         "meet is refused when the drive is built",
     )

@@ -5,12 +5,10 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from .rules import Rel
+from .rules import WHEN_BUILT, Rel
 from .rules import key as _key
 
 __all__ = ["ToothFormSpec", "GearSpec"]
-
-_P = " (checked when the gears are built)"
 
 
 @dataclass(frozen=True)
@@ -52,7 +50,7 @@ class ToothFormSpec:
         hi=10.0,
         default=None,
         default_doc="1.0 (double_arc)",
-        rule="only with form = double_arc; it must reach the tip circle" + _P,
+        rule="only with form = double_arc; it must reach the tip circle" + WHEN_BUILT,
         why="below 0.1 m the arc is sharper than the tooth is deep; beyond 10 m it is a straight flank",
     )
     concave_radius_coef: float | None = _key(
@@ -61,7 +59,7 @@ class ToothFormSpec:
         hi=10.0,
         default=None,
         default_doc="1.2 (double_arc)",
-        rule="only with form = double_arc; it must reach the root circle with the space open" + _P,
+        rule="only with form = double_arc; it must reach the root circle with the space open" + WHEN_BUILT,
         why="as convex_radius_coef",
     )
     tangent_angle_deg: float | None = _key(
@@ -80,7 +78,7 @@ class ToothFormSpec:
         hi=2.0,
         default=None,
         default_doc="0.2 (double_arc)",
-        rule="only with form = double_arc; inside the tip circle" + _P,
+        rule="only with form = double_arc; inside the tip circle" + WHEN_BUILT,
         why="0: the arcs meet at the datum; beyond 2 m the tangent is longer than any tooth is deep",
     )
 
@@ -103,7 +101,7 @@ class GearSpec:
         lo=-5.0,
         hi=10.0,
         default=0.0,
-        rule="involute: no undercut, tip thickness >= 0.2 m" + _P,
+        rule="involute: no undercut, tip thickness >= 0.2 m" + WHEN_BUILT,
         why="harmonic drives use x up to about 4 (D1: 3.1/3.2); beyond these limits the teeth are "
         "pointed or the space closed anyway",
     )
@@ -114,7 +112,7 @@ class GearSpec:
         hi=Rel("r + 15 m", lambda c: c["r"] + 15 * c["m"]),
         default=None,
         default_doc="standard (docs/models.md 2.1, 2.2)",
-        rule="> 0; external teeth: outside the root; internal: inside" + _P,
+        rule="> 0; external teeth: outside the root; internal: inside" + WHEN_BUILT,
         why="the band the shift, addendum and clearance bounds allow around the pitch radius r",
     )
     root_radius: float | None = _key(
@@ -124,7 +122,7 @@ class GearSpec:
         hi=Rel("r + 15 m", lambda c: c["r"] + 15 * c["m"]),
         default=None,
         default_doc="standard (docs/models.md 2.1, 2.2)",
-        rule="> 0" + _P,
+        rule="> 0" + WHEN_BUILT,
         why="as tip_radius",
     )
     thinning: float = _key(
@@ -139,7 +137,7 @@ class GearSpec:
         lo=0.0,
         hi=2.0,
         default=0.25,
-        rule="the fillet must fit the root space" + _P,
+        rule="the fillet must fit the root space" + WHEN_BUILT,
         why="usual 0.25-0.38; the largest fillet that fits is searched in [0, 2]",
     )
     measure_diameter: float | None = _key(
