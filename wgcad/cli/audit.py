@@ -229,6 +229,30 @@ def register(sub) -> None:
         metavar="UM",
         help="penetration still reported as contact, not interference, um, 0..1000 (default 1)",
     )
+    _output_flags(a)
+    _shortcut_flags(a)
+    a.add_argument(
+        "--progress",
+        action="store_true",
+        help="progress bar (fraction, ETA) on stderr even when it is not a terminal or with --quiet; "
+        "by default it is drawn only on a terminal",
+    )
+    a.add_argument(
+        "--by-section",
+        action="store_true",
+        help="also audit every section of a coned cup on its own: its tooth offset (face modification), depth of "
+        "engagement and smallest clearance side by side (one more exact audit per section; JSON by_section)",
+    )
+    a.add_argument("--quiet", action="store_true", help="print no summary")
+    add_memory_flag(a)
+    from .load import register_args
+
+    register_args(a)
+    a.set_defaults(func=cmd_audit)
+
+
+def _output_flags(a) -> None:
+    """The audit's files: JSON, plots, page, baselines."""
     a.add_argument(
         "--json",
         metavar="PATH",
@@ -250,6 +274,10 @@ def register(sub) -> None:
         help="record the key figures with their tolerances (- for standard output)",
     )
     a.add_argument("--baseline", metavar="BASE.json", help="recompute with the baseline's settings; exit 1 on drift")
+
+
+def _shortcut_flags(a) -> None:
+    """The switches that turn the audit's shortcuts and its refinement off."""
     a.add_argument(
         "--no-shortcuts",
         action="store_true",
@@ -284,21 +312,3 @@ def register(sub) -> None:
         action="store_true",
         help="evaluate every sample (no branch and bound on the Lipschitz lower bound)",
     )
-    a.add_argument(
-        "--progress",
-        action="store_true",
-        help="progress bar (fraction, ETA) on stderr even when it is not a terminal or with --quiet; "
-        "by default it is drawn only on a terminal",
-    )
-    a.add_argument(
-        "--by-section",
-        action="store_true",
-        help="also audit every section of a coned cup on its own: its tooth offset (face modification), depth of "
-        "engagement and smallest clearance side by side (one more exact audit per section; JSON by_section)",
-    )
-    a.add_argument("--quiet", action="store_true", help="print no summary")
-    add_memory_flag(a)
-    from .load import register_args
-
-    register_args(a)
-    a.set_defaults(func=cmd_audit)

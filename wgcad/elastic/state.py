@@ -261,95 +261,127 @@ def solve_load(
     (:mod:`wgcad.accuracy.ke_load` builds them from the run-out and
     eccentricities); the cam offset stays the physical input above.
     """
-    if not (np.isfinite(torque_nm) and torque_nm >= 0):
-        raise DesignError("torque_nm", f"must be >= 0 N m, got {torque_nm:g}")
-    if not (np.isfinite(cam_offset_um) and cam_offset_um >= 0):
-        raise DesignError("cam_offset_um", f"must be >= 0 um, got {cam_offset_um:g}")
-    if not tol > 0:
-        raise DesignError("tol", f"must be > 0 mm, got {tol:g}")
+    _check_load_inputs(torque_nm, cam_offset_um, tol)
     e = _cam_offset(cam_offset_um, cam_offset_deg)
-    M_rim = model.torque_sign * 1e3 * torque_nm
-    f_ext = np.array([0.0, 0.0, M_rim, 0.0, 0.0])
-    tab = model.tables
-    n_ang = len(tab.angles)
+    f_ext = np.array([0.0, 0.0, model.torque_sign * 1e3 * torque_nm, 0.0, 0.0])
     Z = len(model.bearing.psi)
-    n_keys = len(model.zs) * tab.z_g * 2
+    n_keys = len(model.zs) * model.tables.z_g * 2
     loads, rigid, F_ball, pairs = _start(model, e, warm)
-    prev_active = np.zeros(n_keys, dtype=bool)
-    F_teeth_prev = np.zeros(n_keys)
+    state = _Iterate(
+        loads, rigid, F_ball, np.zeros(n_keys), np.zeros(n_keys, dtype=bool), Anderson(model.drive.r_m, ANDERSON_DEPTH)
+    )
     times = {"geometry": 0.0, "solver": 0.0}
     pivots = 0
-    omega, last_change = 1.0, np.inf
-    acc = Anderson(model.drive.r_m, ANDERSON_DEPTH)
-    settled, relaxed = 0, False
     change = 0.0
     for it in range(_MAX_LINEARISATIONS):
         lin = _linearise(
-            model, torque_nm, e, f_ext, pairs, loads, rigid, F_ball, F_teeth_prev, prev_active, it, tooth_errors
+            model,
+            torque_nm,
+            e,
+            f_ext,
+            pairs,
+            state.loads,
+            state.rigid,
+            state.F_ball,
+            state.F_teeth,
+            state.active,
+            it,
+            tooth_errors,
         )
-        keys, F, sol, idx, b, f, origin, cam_shift = (
-            lin.keys,
-            lin.F,
-            lin.sol,
-            lin.idx,
-            lin.b,
-            lin.f,
-            lin.origin,
-            lin.cam_shift,
-        )
+        keys, F, sol = lin.keys, lin.F, lin.sol
         pivots += lin.pivots
         times["geometry"] += lin.t_geo
         times["solver"] += lin.t_sol
-        last = (keys, F, sol, idx, b, f, pairs.point[keys], pairs.normal[keys], cam_shift)
-        # under-relaxed update once the plain iteration stops contracting: the exact gaps are piecewise
-        # smooth in the poses (polygon vertices), which can leave a 2-cycle of sub-micrometre amplitude
-        loads_new = _dense_loads(n_ang, idx, F, f, b)
+        last = (keys, F, sol, lin.idx, lin.b, lin.f, pairs.point[keys], pairs.normal[keys], lin.cam_shift)
+        loads_new = _dense_loads(len(model.tables.angles), lin.idx, F, lin.f, lin.b)
         F_t_new = np.zeros(n_keys)
         F_t_new[keys] = F[Z:]
         # convergence: the largest move of an engaging tooth from the linearisation's poses to the solution's
         # (the fixed-point residual itself, from the tables: no engine call)
         o_new = _origins(model, loads_new, sol.a, tooth_errors)
         k2 = keys // 2
-        d = np.hypot(*(o_new[k2] - origin[k2]).T)
-        change = max(float(d.max()) if d.size else 0.0, abs(float(sol.a[2] - rigid[2])) * model.drive.r_m)
+        d = np.hypot(*(o_new[k2] - lin.origin[k2]).T)
+        change = max(float(d.max()) if d.size else 0.0, abs(float(sol.a[2] - state.rigid[2])) * model.drive.r_m)
         if _TRACE is not None:
-            _TRACE.append((it, change, omega, len(keys), int((F > 0).sum())))
+            _TRACE.append((it, change, state.omega, len(keys), int((F > 0).sum())))
         if change < tol:
             break
-        # a contact toggling between passes (a linearisation that closes a pair the exact geometry
-        # opens) has no fixed point: the relaxed passes settle where it switches; the residual of the
-        # nonlinear contact law on the exact geometry is then reported (linearisation_mm)
-        settled = settled + 1 if (omega < 1.0 and change * omega < 0.25 * tol) else 0
-        if settled >= 3:
-            relaxed = True
+        if state.settled_after(change, tol):
             break
-        cycling = it >= 5 and change > 0.95 * last_change  # a cycle, not a slow contraction
-        # once relaxing: a step not yet settled while the change does not halve per pass relaxes further
-        # (a 2-cycle's change stays near its amplitude; halving only on the passes where it grows took twice the passes)
-        unsettled = omega < 1.0 and change > 0.5 * last_change and change * omega >= 0.25 * tol
-        if cycling or unsettled:
-            omega = max(omega * 0.5, _OMEGA_MIN)
-            acc.reset()
-        last_change = change
-        if omega < 1.0:
-            loads = (1 - omega) * loads + omega * loads_new
-            rigid = (1 - omega) * rigid + omega * sol.a
-            F_ball = (1 - omega) * F_ball + omega * F[:Z]
-            F_teeth_prev = (1 - omega) * F_teeth_prev + omega * F_t_new
-        else:
-            loads, rigid = acc.step(loads, rigid, loads_new, sol.a, change)
-            F_ball = F[:Z].copy()
-            F_teeth_prev = F_t_new
-        prev_active = np.zeros(n_keys, dtype=bool)
-        prev_active[keys] = F[Z:] > 0
+        state.advance(it, change, tol, loads_new, sol.a, F[:Z], F_t_new, keys, F[Z:] > 0)
     else:
         raise ContactSolveError(
             f"the elastic model did not converge at {torque_nm:g} N m: tooth positions still moving by "
             f"{1e3 * change:.3g} um after {_MAX_LINEARISATIONS} re-linearisations; a looser tolerance, "
             "a nearby torque or more side clearance may let it settle"
         )
-    progress = {"iterations": it + 1, "pivots": pivots, "position_change_mm": change, "settled_by_relaxation": relaxed}
+    progress = {
+        "iterations": it + 1,
+        "pivots": pivots,
+        "position_change_mm": change,
+        "settled_by_relaxation": state.relaxed,
+    }
     return _report(model, torque_nm, e, pairs, last, progress, times, tooth_errors)
+
+
+def _check_load_inputs(torque_nm, cam_offset_um, tol) -> None:
+    if not (np.isfinite(torque_nm) and torque_nm >= 0):
+        raise DesignError("torque_nm", f"must be >= 0 N m, got {torque_nm:g}")
+    if not (np.isfinite(cam_offset_um) and cam_offset_um >= 0):
+        raise DesignError("cam_offset_um", f"must be >= 0 um, got {cam_offset_um:g}")
+    if not tol > 0:
+        raise DesignError("tol", f"must be > 0 mm, got {tol:g}")
+
+
+@dataclass
+class _Iterate:
+    """The fixed-point iteration's state between linearisations: the loads on the rim, the rim's rigid-body
+    position, the ball and tooth forces, which teeth carried load, and the relaxation."""
+
+    loads: np.ndarray
+    rigid: np.ndarray
+    F_ball: np.ndarray
+    F_teeth: np.ndarray
+    active: np.ndarray
+    acc: Anderson
+    omega: float = 1.0
+    last_change: float = np.inf
+    settled: int = 0
+    relaxed: bool = False
+
+    def settled_after(self, change: float, tol: float) -> bool:
+        """A contact toggling between passes (a linearisation that closes a pair the exact geometry opens) has no
+        fixed point: the relaxed passes settle where it switches (three in a row below a quarter of the tolerance
+        once scaled by the relaxation); the residual of the nonlinear contact law on the exact geometry is then
+        reported (linearisation_mm)."""
+        self.settled = self.settled + 1 if (self.omega < 1.0 and change * self.omega < 0.25 * tol) else 0
+        self.relaxed = self.settled >= 3
+        return self.relaxed
+
+    def advance(self, it, change, tol, loads_new, rigid_new, F_ball_new, F_teeth_new, keys, loaded) -> None:
+        """The next iterate: Anderson-accelerated, or under-relaxed once the plain iteration stops contracting (the
+        exact gaps are piecewise smooth in the poses, polygon vertices, which can leave a 2-cycle of sub-micrometre
+        amplitude)."""
+        cycling = it >= 5 and change > 0.95 * self.last_change  # a cycle, not a slow contraction
+        # once relaxing: a step not yet settled while the change does not halve per pass relaxes further
+        # (a 2-cycle's change stays near its amplitude; halving only on the passes where it grows took twice the passes)
+        unsettled = self.omega < 1.0 and change > 0.5 * self.last_change and change * self.omega >= 0.25 * tol
+        if cycling or unsettled:
+            self.omega = max(self.omega * 0.5, _OMEGA_MIN)
+            self.acc.reset()
+        self.last_change = change
+        w = self.omega
+        if w < 1.0:
+            self.loads = (1 - w) * self.loads + w * loads_new
+            self.rigid = (1 - w) * self.rigid + w * rigid_new
+            self.F_ball = (1 - w) * self.F_ball + w * F_ball_new
+            self.F_teeth = (1 - w) * self.F_teeth + w * F_teeth_new
+        else:
+            self.loads, self.rigid = self.acc.step(self.loads, self.rigid, loads_new, rigid_new, change)
+            self.F_ball = F_ball_new.copy()
+            self.F_teeth = F_teeth_new
+        self.active = np.zeros(len(self.active), dtype=bool)
+        self.active[keys] = loaded
 
 
 def _start(model: ElasticModel, e: np.ndarray, warm: LoadState | None):

@@ -305,21 +305,7 @@ def parse_spec(
         raise DesignError("sweep.name", "must be 1 to 200 characters, one line")
     seed = _whole("sweep.seed", sw["seed"], 0, 2**63 - 1)
     batch = _whole("sweep.batch", sw.get("batch", 0), 0, 1_000_000)
-    dpath = sw["design"]
-    if not isinstance(dpath, str) or not dpath:
-        raise DesignError("sweep.design", f"must be the path of a design file, got {dpath!r}")
-    if design_data is None:
-        from ..design.files import read_design_text
-
-        p = Path(dpath)
-        if not p.is_absolute() and base_dir is not None:
-            p = base_dir / p
-        text = read_design_text(p)
-        try:
-            design_data = tomllib.loads(text)
-        except (tomllib.TOMLDecodeError, RecursionError) as e:
-            raise InputFileError(f"{p}: not valid TOML ({e})") from None
-        dpath = str(p)
+    dpath, design_data = _base_design(sw["design"], base_dir, design_data)
     base = parse_design(design_data, source=dpath)  # the base design must pass the rules itself
     params = _parameters(data.get("parameters"))
     seen = set()
@@ -327,24 +313,7 @@ def parse_spec(
         if (p.table, p.key) in seen:
             raise DesignError(f"parameters.{p.name}", "given twice")
         seen.add((p.table, p.key))
-    has_random = any(p.random for p in params)
-    if has_random and "samples" not in sw:
-        # how many drives to draw is the study's first decision: not a default taken silently
-        raise DesignError("sweep.samples", "required when a parameter has a distribution (random draws per grid point)")
-    samples = sw.get("samples", 1)
-    samples = _whole("sweep.samples", samples, 1, MAX_SAMPLES)
-    if not has_random and samples != 1:
-        raise DesignError(
-            "sweep.samples", f"no parameter has a distribution, so every grid point has one sample; got {samples}"
-        )
-    npts = 1
-    for p in params:
-        if not p.random:
-            npts *= len(p.values)
-    if npts * samples > MAX_SAMPLES:
-        raise DesignError(
-            "sweep.samples", f"{npts} grid points x {samples} samples = {npts * samples} exceeds {MAX_SAMPLES}"
-        )
+    samples = _samples(sw, params)
     fig = data.get("figures")
     if not isinstance(fig, dict):
         raise DesignError("figures", "table [figures] is required (record = [...])")
@@ -378,14 +347,60 @@ def parse_spec(
         source=source,
     )
     check_figures(spec, base)
-    lim = data.get("limits", {})
+    limits = _limits(data.get("limits", {}), spec.record)
+    return SweepSpec(**{**spec.__dict__, "limits": limits})
+
+
+def _base_design(dpath, base_dir: Path | None, design_data: dict | None) -> tuple[str, dict]:
+    """The base design's path and TOML dict: read from ``sweep.design`` (relative to ``base_dir``) unless given."""
+    if not isinstance(dpath, str) or not dpath:
+        raise DesignError("sweep.design", f"must be the path of a design file, got {dpath!r}")
+    if design_data is not None:
+        return dpath, design_data
+    from ..design.files import read_design_text
+
+    p = Path(dpath)
+    if not p.is_absolute() and base_dir is not None:
+        p = base_dir / p
+    text = read_design_text(p)
+    try:
+        return str(p), tomllib.loads(text)
+    except (tomllib.TOMLDecodeError, RecursionError) as e:
+        raise InputFileError(f"{p}: not valid TOML ({e})") from None
+
+
+def _samples(sw: dict, params) -> int:
+    """``sweep.samples``: random draws per grid point, required with a distribution, 1 without; within MAX_SAMPLES
+    in all."""
+    has_random = any(p.random for p in params)
+    if has_random and "samples" not in sw:
+        # how many drives to draw is the study's first decision: not a default taken silently
+        raise DesignError("sweep.samples", "required when a parameter has a distribution (random draws per grid point)")
+    samples = _whole("sweep.samples", sw.get("samples", 1), 1, MAX_SAMPLES)
+    if not has_random and samples != 1:
+        raise DesignError(
+            "sweep.samples", f"no parameter has a distribution, so every grid point has one sample; got {samples}"
+        )
+    npts = 1
+    for p in params:
+        if not p.random:
+            npts *= len(p.values)
+    if npts * samples > MAX_SAMPLES:
+        raise DesignError(
+            "sweep.samples", f"{npts} grid points x {samples} samples = {npts * samples} exceeds {MAX_SAMPLES}"
+        )
+    return samples
+
+
+def _limits(lim, record) -> dict:
+    """The ``[limits]`` table: ``{figure: (min or None, max or None)}`` of recorded figures."""
     if not isinstance(lim, dict):
         raise DesignError("limits", "must be a table of FIGURE = { min = ..., max = ... }")
     limits = {}
     for k, v in lim.items():
         where = f"limits.{k}"
-        if k not in spec.record:
-            near = difflib.get_close_matches(k, spec.record, n=1)
+        if k not in record:
+            near = difflib.get_close_matches(k, record, n=1)
             raise DesignError(
                 where, "not a recorded figure (figures.record)" + (f"; did you mean '{near[0]}'?" if near else "")
             )
@@ -397,7 +412,7 @@ def parse_spec(
         if lo is not None and hi is not None and not hi > lo:
             raise DesignError(f"{where}.max", f"must be > min = {lo:g}, got {hi:g}")
         limits[k] = (lo, hi)
-    return SweepSpec(**{**spec.__dict__, "limits": limits})
+    return limits
 
 
 def load_spec(path) -> SweepSpec:

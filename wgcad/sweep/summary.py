@@ -151,96 +151,107 @@ def _summarize(spec, cols: dict, conf: float) -> dict:
             else ("monte carlo" if all(p.random for p in spec.parameters) else "grid with random draws")
         ),
     }
-    fail = None
+    fail = _limits(spec, cols, ok, n, conf, out) if spec.limits else None
+    _sensitivity(spec, cols, ok, fail, out)
+    if any(not p.random for p in spec.parameters):
+        out["grid"] = _grid(spec, cols, ok, conf)
+    return out
+
+
+def _limits(spec, cols: dict, ok, n: int, conf: float, out: dict):
+    """Each limit's pass count and the yield (with its intervals) into ``out``; the failures of the valid samples
+    (1.0 where a sample fails a limit) for the sensitivity."""
+    pas = passes(cols, spec.limits)
+    k, m = int(pas[ok].sum()), int(ok.sum())
+    for name, (lo, hi) in spec.limits.items():
+        v = cols[name][ok]
+        inside = np.isfinite(v) & (v >= (lo if lo is not None else -np.inf)) & (v <= (hi if hi is not None else np.inf))
+        out["limits"][name] = {
+            "min": lo,
+            "max": hi,
+            "pass": int(inside.sum()),
+            "of": m,
+            "fraction": float(inside.mean()) if m else None,
+        }
+    lo_, hi_ = clopper_pearson(k, m, conf)
+    out["yield"] = {
+        "pass": k,
+        "of": m,
+        "fraction": k / m if m else None,
+        "ci": [lo_, hi_],
+        "method": "Clopper-Pearson",
+        "wilson": list(wilson(k, m, conf)),
+        "counting_refused_as_failures": k / n if n else None,
+    }
+    return (~pas[ok]).astype(float)
+
+
+def _sensitivity(spec, cols: dict, ok, fail, out: dict) -> None:
+    """Each random parameter's association with failing and with every figure, strongest first, into ``out``."""
+    rand = [p for p in spec.parameters if p.random]
+    if not rand or ok.sum() < 3:
+        return
+    for p in rand:
+        x = np.asarray(cols[p.name][ok], dtype=float)
+        row = {
+            "parameter": p.name,
+            "phase": p.phase,
+            "failure": _assoc(p, x, fail) if fail is not None and 0 < fail.sum() < len(fail) else None,
+            "figures": {},
+        }
+        for f in spec.limits or spec.record:
+            y = cols[f][ok]
+            good = np.isfinite(y)
+            row["figures"][f] = _assoc(p, x[good], y[good]) if good.sum() >= 3 else None
+        out["sensitivity"].append(row)
+    key = (
+        (lambda r: -abs(r["failure"] or 0.0))
+        if fail is not None
+        else (lambda r: -max([abs(v) for v in r["figures"].values() if v is not None] or [0.0]))
+    )
+    out["sensitivity"].sort(key=key)
+
+
+def _grid(spec, cols: dict, ok, conf: float) -> dict:
+    """The grid's surfaces (each figure's mean, smallest and largest per grid point) and yields per point."""
+    grid = [p for p in spec.parameters if not p.random]
+    shape = tuple(len(p.values) for p in grid)
+    G = int(np.prod(shape))
+    gp = cols["grid_point"]
+    surf = {}
+    for f in spec.record:
+        v = cols[f]
+        sel = ok & np.isfinite(v)
+        cnt = np.bincount(gp[sel], minlength=G)
+        mean = np.full(G, np.nan)
+        has = cnt > 0
+        mean[has] = np.bincount(gp[sel], weights=v[sel], minlength=G)[has] / cnt[has]
+        lo = np.full(G, np.inf)
+        hi = np.full(G, -np.inf)
+        np.minimum.at(lo, gp[sel], v[sel])
+        np.maximum.at(hi, gp[sel], v[sel])
+        lo[~has], hi[~has] = np.nan, np.nan
+        surf[f] = {
+            "mean": mean.reshape(shape).tolist(),
+            "min": lo.reshape(shape).tolist(),
+            "max": hi.reshape(shape).tolist(),
+        }
+    ylds = None
     if spec.limits:
         pas = passes(cols, spec.limits)
-        k, m = int(pas[ok].sum()), int(ok.sum())
-        for name, (lo, hi) in spec.limits.items():
-            v = cols[name][ok]
-            inside = (
-                np.isfinite(v) & (v >= (lo if lo is not None else -np.inf)) & (v <= (hi if hi is not None else np.inf))
-            )
-            out["limits"][name] = {
-                "min": lo,
-                "max": hi,
-                "pass": int(inside.sum()),
-                "of": m,
-                "fraction": float(inside.mean()) if m else None,
-            }
-        lo_, hi_ = clopper_pearson(k, m, conf)
-        out["yield"] = {
-            "pass": k,
-            "of": m,
-            "fraction": k / m if m else None,
-            "ci": [lo_, hi_],
-            "method": "Clopper-Pearson",
-            "wilson": list(wilson(k, m, conf)),
-            "counting_refused_as_failures": k / n if n else None,
-        }
-        fail = (~pas[ok]).astype(float)
-    rand = [p for p in spec.parameters if p.random]
-    if rand and ok.sum() >= 3:
-        for p in rand:
-            x = np.asarray(cols[p.name][ok], dtype=float)
-            row = {
-                "parameter": p.name,
-                "phase": p.phase,
-                "failure": _assoc(p, x, fail) if fail is not None and 0 < fail.sum() < len(fail) else None,
-                "figures": {},
-            }
-            for f in spec.limits or spec.record:
-                y = cols[f][ok]
-                good = np.isfinite(y)
-                row["figures"][f] = _assoc(p, x[good], y[good]) if good.sum() >= 3 else None
-            out["sensitivity"].append(row)
-        key = (
-            (lambda r: -abs(r["failure"] or 0.0))
-            if fail is not None
-            else (lambda r: -max([abs(v) for v in r["figures"].values() if v is not None] or [0.0]))
-        )
-        out["sensitivity"].sort(key=key)
-    grid = [p for p in spec.parameters if not p.random]
-    if grid:
-        shape = tuple(len(p.values) for p in grid)
-        G = int(np.prod(shape))
-        gp = cols["grid_point"]
-        surf = {}
-        for f in spec.record:
-            v = cols[f]
-            sel = ok & np.isfinite(v)
-            cnt = np.bincount(gp[sel], minlength=G)
-            mean = np.full(G, np.nan)
-            has = cnt > 0
-            mean[has] = np.bincount(gp[sel], weights=v[sel], minlength=G)[has] / cnt[has]
-            lo = np.full(G, np.inf)
-            hi = np.full(G, -np.inf)
-            np.minimum.at(lo, gp[sel], v[sel])
-            np.maximum.at(hi, gp[sel], v[sel])
-            lo[~has], hi[~has] = np.nan, np.nan
-            surf[f] = {
-                "mean": mean.reshape(shape).tolist(),
-                "min": lo.reshape(shape).tolist(),
-                "max": hi.reshape(shape).tolist(),
-            }
-        ylds = None
-        if spec.limits:
-            pas = passes(cols, spec.limits)
-            ylds = []
-            m_all = np.bincount(gp[ok], minlength=G)
-            k_all = np.bincount(gp[ok & pas], minlength=G)
-            for g in range(G):
-                k, m = int(k_all[g]), int(m_all[g])
-                ylds.append(
-                    {"pass": k, "of": m, "fraction": k / m if m else None, "ci": list(clopper_pearson(k, m, conf))}
-                )
-        out["grid"] = {
-            "parameters": [p.name for p in grid],
-            "values": [list(p.values) for p in grid],
-            "shape": list(shape),
-            "surfaces": surf,
-            "yield": ylds,
-        }
-    return out
+        ylds = []
+        m_all = np.bincount(gp[ok], minlength=G)
+        k_all = np.bincount(gp[ok & pas], minlength=G)
+        for g in range(G):
+            k, m = int(k_all[g]), int(m_all[g])
+            ylds.append({"pass": k, "of": m, "fraction": k / m if m else None, "ci": list(clopper_pearson(k, m, conf))})
+    return {
+        "parameters": [p.name for p in grid],
+        "values": [list(p.values) for p in grid],
+        "shape": list(shape),
+        "surfaces": surf,
+        "yield": ylds,
+    }
 
 
 def _fmt(x, nd=3) -> str:
