@@ -9,6 +9,7 @@ and any package on a lower floor, never one on its own floor or above.
 from __future__ import annotations
 
 import ast
+import re
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parent.parent / "wgcad"
@@ -80,6 +81,17 @@ def test_every_unit_has_a_floor():
     files, _ = _graph()
     units = {_unit(m) for m in files} - {None}
     assert units <= set(FLOOR), f"units without a floor in tests/test_layers.py: {sorted(units - set(FLOOR))}"
+
+
+def test_architecture_doc_lists_the_floors_in_order():
+    """docs/architecture.md describes the floors this test enforces: one numbered entry per floor, in order, naming
+    exactly its packages (a floor added here and not described there, or described in another place, fails)."""
+    text = (ROOT.parent / "docs" / "architecture.md").read_text()
+    entries = re.findall(r"^(\d+)\. \*\*(.+?)\*\*", text, flags=re.M)
+    doc = [(int(n), set(re.findall(r"`([^`]+)`", names))) for n, names in entries]
+    assert doc == list(enumerate(FLOORS)), "docs/architecture.md floors differ from FLOORS:\n" + "\n".join(
+        f"{n}: {sorted(u)}" for n, u in doc
+    )
 
 
 def test_imports_point_down():
