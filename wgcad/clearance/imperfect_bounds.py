@@ -146,16 +146,7 @@ class ErrorBound:
             self.cz.append(coning_factor(drive, z))
         # second order: the rigid frame's own turn applied to the displacement (|dev| |Delta|), bounded
         # with the largest displacement the amplitudes allow
-        amp = (
-            0.5 * imp.flex_runout
-            + 2 * abs(imp.flex_ecc)
-            + abs(imp.cam_cam)
-            + abs(imp.cam_flex)
-            + abs(imp.cam_fixed)
-            + abs(imp.rigid_ecc)
-            + 0.5 * imp.rigid_runout
-        )
-        self.second = self.a_b * amp
+        self.second = self.a_b * imp.amplitude
 
     def bound(self, k, phi_h) -> np.ndarray:
         """Largest relative displacement (mm) of teeth ``k`` (Kk,) at generator angles ``phi_h`` (B,), every section, ``(S, Kk, B)``."""

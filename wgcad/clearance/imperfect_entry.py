@@ -231,15 +231,7 @@ def _pinch(drive, imp, isc, scene, perfect_gaps, perfect_pinch, shifts, refine):
     # tooth angle a window can reach, times |c|, plus how fast the errors move it (each first-harmonic term turns
     # at most once per generator turn relative to the tooth, so by at most its amplitude per radian)
     reach = np.linspace(p_pin - CROSS_WINDOW - PINCH_HALF, p_pin + CROSS_WINDOW + PINCH_HALF, 321)
-    amp = (
-        0.5 * imp.flex_runout
-        + 2 * abs(imp.flex_ecc)
-        + abs(imp.cam_cam)
-        + abs(imp.cam_flex)
-        + abs(imp.cam_fixed)
-        + abs(imp.rigid_ecc)
-        + 0.5 * imp.rigid_runout
-    ) * (1.0 + abs(c))
+    amp = imp.amplitude * (1.0 + abs(c))
     speed = {si: isc.speed_bound(reach, perfect_gaps[si][1]) * abs(c) + amp for si in shifts}
     cand = []
     for si, (ph0, k, dph) in shifts.items():

@@ -125,6 +125,20 @@ class Imperfections:
     def gear_errors(self) -> bool:
         return any(v != 0.0 for v in (self.flex_runout, self.rigid_runout, self.flex_ecc, self.rigid_ecc))
 
+    @property
+    def amplitude(self) -> float:
+        """The largest displacement of a tooth relative to its rigid tooth the errors allow, mm: every first-harmonic
+        term at its full amplitude (half a run-out, twice the flexspline's eccentricity: its gear and its cam)."""
+        return (
+            0.5 * self.flex_runout
+            + 2 * abs(self.flex_ecc)
+            + abs(self.cam_cam)
+            + abs(self.cam_flex)
+            + abs(self.cam_fixed)
+            + abs(self.rigid_ecc)
+            + 0.5 * self.rigid_runout
+        )
+
 
 def shortcuts(imp: Imperfections) -> dict:
     """Which work-skipping facts of docs/models.md 7 still hold with these errors, and why.
