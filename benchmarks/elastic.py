@@ -117,9 +117,9 @@ def main() -> int:
             t_sweep, c_sweep, sw = cpu_best_of(
                 lambda: torque_sweep(model, np.arange(0.0, 3000.1, 250.0), cam_offset_um=e_um), 3
             )
-            geo = sum(s.timing["geometry"] for s in sw["states"])
-            sol = sum(s.timing["solver"] for s in sw["states"])
-            passes = sum(s.residuals["iterations"] for s in sw["states"])
+            geo = sum(s.timing["geometry"] for s in [lv.state for lv in sw.levels])
+            sol = sum(s.timing["solver"] for s in [lv.state for lv in sw.levels])
+            passes = sum(s.residuals["iterations"] for s in [lv.state for lv in sw.levels])
             rows += [
                 (
                     f"13-level sweep 0:3000:250 N m, e_h = {e_um:g} um, warm-started ({passes} passes)",
@@ -129,7 +129,7 @@ def main() -> int:
                 ),
                 ("  of which contact geometry", geo, None, None),
                 ("  of which compliance and solver", sol, None, None),
-                ("  of which entry gaps and summaries", sw["summary_s"], None, None),
+                ("  of which entry gaps and summaries", sw.summary_s, None, None),
             ]
             res[f"sweep_{e_um:g}um"] = {
                 "s": t_sweep,
@@ -137,13 +137,13 @@ def main() -> int:
                 "passes": passes,
                 "geometry_s": geo,
                 "solver_s": sol,
-                "summary_s": sw["summary_s"],
+                "summary_s": sw.summary_s,
             }
     if not args.quick:
         cyc = build_model(build_drive(load_design(D1_CYCLOIDAL)), 3)
         solve_load(cyc, 0.0)  # its nominal pairs, as for the involute model above
         t_sweep, c_sweep, sw = cpu_best_of(lambda: torque_sweep(cyc, np.arange(0.0, 3000.1, 250.0)), 3)
-        passes = sum(s.residuals["iterations"] for s in sw["states"])
+        passes = sum(s.residuals["iterations"] for s in [lv.state for lv in sw.levels])
         rows += [
             (
                 f"13-level sweep 0:3000:250 N m, D1 cycloidal, e_h = 0 um ({passes} passes)",

@@ -273,7 +273,7 @@ def bench_engines(quick: bool) -> list[dict]:
     phis = np.deg2rad(np.linspace(30.0, 60.0, 7 if quick else 13))
     t2, c2 = best_of(lambda: tooth_clearance(sc, phis, None)["min"], 5)
     t3, res = best_of(lambda: [check_tooth(sc, float(p)) for p in phis], 1)
-    diff = max(abs(r["fcl_distance_um"] - 1e3 * c) for r, c in zip(res, c2))
+    diff = max(abs(1e3 * (r.fcl_distance - c)) for r, c in zip(res, c2))
     rows.append(
         {
             "case": f"D4 prisms, {len(phis)} teeth",
@@ -308,8 +308,8 @@ def bench_engines(quick: bool) -> list[dict]:
                 "engine": "fcl",
                 "time_s": t3,
                 "ratio": t3 / t2,
-                "difference_um": abs(r["fcl_distance_um"] - r["clearance_2d_um"]),
-                "bound_um": r["bound_um"] or 0.0,
+                "difference_um": 1e3 * abs(r.fcl_distance - r.clearance_2d),
+                "bound_um": 1e3 * (r.bound or 0.0),
                 "loft_sections": n,
             }
         )

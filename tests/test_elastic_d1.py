@@ -13,6 +13,7 @@ from wgcad.elastic import LoadedLaw, build_model, solve_load
 from wgcad.elastic.state import POSITION_TOL
 from wgcad.elastic.sweep import torque_sweep
 from wgcad.laws import Law
+from wgcad.report.load import load_document
 
 ROOT = Path(__file__).resolve().parents[1]
 D1 = ROOT / "templates" / "d1_involute.toml"
@@ -25,12 +26,17 @@ def model():
 
 @pytest.fixture(scope="module")
 def sweep(model):
-    return torque_sweep(model, [0.0, 1000.0, 3000.0])
+    return _doc(torque_sweep(model, [0.0, 1000.0, 3000.0]))
 
 
 @pytest.fixture(scope="module")
 def offset_sweep(model):
-    return torque_sweep(model, [1000.0], cam_offset_um=40.0, cam_offset_deg=0.0)
+    return _doc(torque_sweep(model, [1000.0], cam_offset_um=40.0, cam_offset_deg=0.0))
+
+
+def _doc(sw):
+    """The load audit's document of a sweep (rounded figures, units in the keys) with its load states."""
+    return {**load_document(sw), "states": [lv.state for lv in sw.levels]}
 
 
 def test_every_body_in_equilibrium_and_contacts_complementary(sweep):

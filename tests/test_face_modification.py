@@ -150,11 +150,12 @@ def test_the_3d_check_agrees_on_modified_teeth(d1_conjugate):
     """python-fcl lofts the placed tooth through the sections' poses, offsets included: it agrees with the 2D
     figures of the depth-modified pair (whose worst spot is at the inner end)."""
     from wgcad.clearance.fcl3d import verify_worst
+    from wgcad.report.check3d import check3d_document
 
     d = d1_conjugate.with_face_taper(5.498)
     res = audit(d, AuditSettings(angles=ANGLES, sections=np.array([0.0, 15.0, 30.0])))
     assert res.findings["min_clearance"].section_z == 30.0
-    out = verify_worst(d, res)
+    out = check3d_document(verify_worst(d, res))
     assert out["agree"], out["summary"]
 
 

@@ -17,6 +17,7 @@ from wgcad.design import load_design
 from wgcad.drive import build_drive
 from wgcad.placement import transform
 from wgcad.report.audit import audit_json
+from wgcad.report.check3d import check3d_document, tooth_check_document
 
 SQUARE = np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]])
 
@@ -128,7 +129,7 @@ def test_d4_fcl_equals_2d(d4):
     c = tooth_clearance(d4, phi)
     assert np.all(c["min"] > 0)
     for p in phi:
-        r = fcl3d.check_tooth(d4, float(p))
+        r = tooth_check_document(fcl3d.check_tooth(d4, float(p)))
         assert r["agree"] and not r["fcl_overlap"] and r["bound_um"] == 0.0
         # unrounded: the nearest rigid tooth straight from the solids
         rot, shift = d4.pose(np.array([p]))
@@ -138,7 +139,7 @@ def test_d4_fcl_equals_2d(d4):
             c2 = float(d4.clearance_to(rot, shift, np.array([j]))[0])
             assert not ov and abs(d - c2) <= 1e-6
     # the engine's figure is the minimum over the teeth checked
-    r = fcl3d.check_tooth(d4, float(phi[0]))
+    r = tooth_check_document(fcl3d.check_tooth(d4, float(phi[0])))
     assert r["clearance_2d_um"] == pytest.approx(1e3 * c["min"][0], abs=1e-6)
 
 
@@ -169,7 +170,7 @@ def test_d1_fcl_within_bound(d1):
         zs = np.linspace(0.0, d1.drive.design.drive.face_width, n)
         for p in phis:
             assert min(tooth_clearance(d1, np.array([p]), float(z))["min"][0] for z in zs) > 0
-            r = fcl3d.check_tooth(d1, float(p), n_sections=n)
+            r = tooth_check_document(fcl3d.check_tooth(d1, float(p), n_sections=n))
             assert r["agree"] and not r["fcl_overlap"]
             d, c2, b = r["fcl_distance_um"], r["clearance_2d_um"], r["bound_um"]
             assert c2 - b - 1e-3 <= d <= c2 + 1e-3
@@ -206,7 +207,7 @@ def test_d1_loft_error_orders(d1):
 @pytest.mark.parametrize("name", ["d4_discrete", "d1_involute", "d1_involute_nominal"])
 def test_verify_worst_agrees(name):
     drive, result = run_audit(TEMPLATES / f"{name}.toml", RunSettings(step_deg=1.0))
-    out = fcl3d.verify_worst(drive, result)
+    out = check3d_document(fcl3d.verify_worst(drive, result))
     # the pinch is checked where the audit finds one (D1 rebuilt: none - its gaps fall from the tip crossing
     # straight into flank engagement; D4 and the nominal teeth pinch as the tips pass)
     has_pinch = audit_json(result)["entry"]["pinch_um"] is not None
@@ -262,7 +263,7 @@ def test_verify_worst_places_the_imperfect_parts(name, errors, tmp_path):
     drive, result = run_audit(p, RunSettings(step_deg=1.0))
     imp = Imperfections.from_spec(drive.design.imperfections)
     w = result.findings["min_clearance"]
-    out = fcl3d.verify_worst(drive, result, imp=imp)
+    out = check3d_document(fcl3d.verify_worst(drive, result, imp=imp))
     assert out["agree"] and out["summary"].startswith("agree")
     pair = out["pairs"][0]
     assert pair["tooth"] == w.tooth and pair["generator_angle_deg"] == pytest.approx(np.rad2deg(w.generator_angle))
@@ -300,7 +301,7 @@ def test_verify_worst_places_the_imperfect_parts(name, errors, tmp_path):
     ref = transform(drive.flex.tooth_polygon(), rot, shift)[0] - rigid_translation(imp)
     gap = np.hypot(*(ref[:, None, :] - slice_[None, :, :]).transpose(2, 0, 1)).min(axis=1)
     assert gap.max() < 1e-9
-    perfect = fcl3d.verify_worst(drive, result)["pairs"][0]
+    perfect = check3d_document(fcl3d.verify_worst(drive, result))["pairs"][0]
     assert abs(perfect["clearance_2d_um"] - pair["clearance_2d_um"]) > 0.2  # the errors moved the pair
     json.dumps(out)
 

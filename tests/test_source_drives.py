@@ -15,6 +15,7 @@ from wgcad.drive import build_drive
 from wgcad.elastic import build_model
 from wgcad.elastic.sweep import torque_sweep
 from wgcad.placement import tooth_pose, transform
+from wgcad.report.load import load_document
 
 ROOT = Path(__file__).resolve().parents[1]
 D1_INV = ROOT / "templates" / "d1_involute.toml"
@@ -101,7 +102,7 @@ def test_s1_gaps_by_hand_match_the_exact_gaps():
 
 def _sweeps(path):
     model = build_model(build_drive(load_design(path)), 3)
-    return {e: torque_sweep(model, TORQUES, cam_offset_um=e) for e in (0.0, 40.0)}
+    return {e: load_document(torque_sweep(model, TORQUES, cam_offset_um=e)) for e in (0.0, 40.0)}
 
 
 @pytest.fixture(scope="module")
@@ -135,7 +136,7 @@ def test_no_load_positive_entry_gap_and_no_preload():
         assert not res.interference and res.min_clearance > 0, path
         assert res.entry_gap > 0, path
         model = build_model(drive, 3)
-        sw = torque_sweep(model, [0.0, d.load.rated_torque_nm])
+        sw = load_document(torque_sweep(model, [0.0, d.load.rated_torque_nm]))
         f0, f_rated = (lv["largest_tooth_force_n"] for lv in sw["levels"])
         assert sw["levels"][0]["entry_gap_um"] > 0
         assert f0 <= 0.05 * f_rated, (path, f0, f_rated)

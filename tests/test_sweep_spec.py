@@ -236,8 +236,8 @@ def test_loaded_figures_are_the_elastic_models():
     row = run_sample(spec.payload(), 0)
     assert row["status"] == "ok", row["reason"]
     drive = build_drive(load_design(d1))
-    lv = torque_sweep(build_model(drive, 3), [500.0], 30.0, drive.design.load.cam_offset_deg)["levels"][0]
-    assert row["entry_gap_um@500.0Nm"] == lv["entry_gap_um"] and row["teeth_in_contact@500Nm"] == lv["teeth_in_contact"]
+    lv = torque_sweep(build_model(drive, 3), [500.0], 30.0, drive.design.load.cam_offset_deg).levels[0]
+    assert row["entry_gap_um@500.0Nm"] == 1e3 * lv.entry_gap and row["teeth_in_contact@500Nm"] == lv.teeth_in_contact
     with pytest.raises(DesignError, match="named twice"):
         parse_spec(
             {

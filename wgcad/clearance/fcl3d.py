@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import time
+from dataclasses import dataclass, field
 
 import fcl
 import manifold3d
@@ -21,6 +22,9 @@ __all__ = [
     "fcl_distance",
     "check_tooth",
     "verify_worst",
+    "PairCheck",
+    "ToothCheck",
+    "Check3D",
     "imperfect_track",
 ]
 
@@ -28,6 +32,65 @@ __all__ = [
 #: double precision (~6e-9 mm at 80 mm radius, library notes); 1e-6 mm leaves
 #: room for the polygon transforms done twice (numpy here, shapely in 2D).
 FCL_TOL = 1e-6
+
+
+@dataclass
+class PairCheck:
+    """One rigid tooth against the flexspline tooth: FCL's distance and the 2D engine's over the sections (mm).
+
+    ``bound``: how far below the 2D figure the true surfaces can dip between the sections (None when the 2D figure
+    is an overlap); ``witness_z`` and ``clearance_2d_at_witness``: the section through FCL's nearest point and the
+    2D clearance there (coned and apart only)."""
+
+    rigid_tooth: int
+    fcl_distance: float
+    fcl_overlap: bool
+    clearance_2d: float
+    bound: float | None
+    agree: bool
+    witness_z: float | None = None
+    clearance_2d_at_witness: float | None = None
+
+
+@dataclass
+class ToothCheck:
+    """The 3D check of one flexspline tooth (:func:`check_tooth`), mm and rad; times in seconds.
+
+    ``fcl_distance`` / ``fcl_overlap``: the nearest rigid tooth's; ``clearance_2d``: the engine's minimum over the
+    sections; ``sections_z``: None without coning; ``bound``: 0 without coning, None for an overlap;
+    ``per_tooth``: a :class:`PairCheck` per rigid tooth; ``witness_z``, ``clearance_2d_at_witness``: the nearest
+    pair's (coned, apart); ``what``, ``generator_angle``, ``tooth``: set by :func:`verify_worst`."""
+
+    tooth_angle: float
+    rigid_teeth: list
+    fcl_distance: float
+    fcl_overlap: bool
+    clearance_2d: float
+    sections_z: list | None
+    bound: float | None
+    loft_error: float
+    agree: bool
+    per_tooth: list
+    timing: dict
+    witness_z: float | None = None
+    clearance_2d_at_witness: float | None = None
+    what: str | None = None
+    generator_angle: float | None = None
+    tooth: int | None = None
+
+
+@dataclass
+class Check3D:
+    """The 3D check of the pairs the 2D audit singles out (:func:`verify_worst`): a :class:`ToothCheck` per pair,
+    the loft's sections (``n_sections``: 2 for the prisms of a drive without coning), whether all agree."""
+
+    pairs: list
+    n_sections: int
+    coned: bool
+    agree: bool = field(init=False)
+
+    def __post_init__(self):
+        self.agree = all(p.agree for p in self.pairs)
 
 
 def _clean_ccw(local: np.ndarray) -> np.ndarray:
@@ -265,7 +328,7 @@ def _agrees(c2d: float, fcl_d: float, overlap: bool, lower: float, exact: bool) 
     return lower - FCL_TOL <= fcl_d <= c2d + FCL_TOL
 
 
-def check_tooth(scene: Scene, phi: float, n_sections: int = 9, sections=None, track=None) -> dict:
+def check_tooth(scene: Scene, phi: float, n_sections: int = 9, sections=None, track=None) -> ToothCheck:
     """FCL distance of the flexspline tooth at ``phi`` to the rigid teeth it can touch, against the 2D engine over the same sections.
 
     Rigid teeth: :meth:`Scene.neighbours` (lower, upper, third) at every
@@ -299,13 +362,7 @@ def check_tooth(scene: Scene, phi: float, n_sections: int = 9, sections=None, tr
 
     Returns
     -------
-    dict, JSON-ready (um, mm, deg, ms): ``tooth_angle_deg``,
-    ``rigid_teeth``, ``fcl_distance_um`` and ``fcl_overlap`` (nearest
-    tooth), ``clearance_2d_um`` (engine, minimum over the sections),
-    ``sections_z_mm`` (None without coning), ``bound_um``,
-    ``loft_error_um``, ``agree``, ``per_tooth`` (the same per rigid tooth,
-    with the witness section), ``fcl_witness_z_mm`` and
-    ``clearance_2d_at_witness_um`` (coning, apart), ``timing_ms``.
+    ToothCheck
 
     With ``track`` (a tooth of an imperfect drive, :func:`imperfect_track`)
     the tooth is placed by it in every section, and ``scene`` is the
@@ -330,34 +387,29 @@ def check_tooth(scene: Scene, phi: float, n_sections: int = 9, sections=None, tr
         per.append((d, _pair_row(scene, phi, zs, track, j, c[:, ti], (float(lower_t[ti]), geom), (d, ov, pts))))
     t_fcl = time.perf_counter() - t1
     d_min, best = min(per, key=lambda t: t[0])
-    ov_any = any(r["fcl_overlap"] for _, r in per)
+    ov_any = any(r.fcl_overlap for _, r in per)
     c2d = float(c_engine.min())
     c_pairs = float(c.min())
     lower = float(lower_t.min())
-    out = {
-        "tooth_angle_deg": round(float(np.rad2deg(phi)), 6),
-        "rigid_teeth": teeth,
-        "fcl_distance_um": round(1e3 * d_min, 6),
-        "fcl_overlap": ov_any,
-        "clearance_2d_um": round(1e3 * c2d, 6),
-        "sections_z_mm": [round(float(z), 6) for z in zs] if coned else None,
-        "bound_um": (round(1e3 * max(c2d - lower, 0.0), 6) if coned else 0.0) if c2d >= 0 else None,
-        "loft_error_um": round(1e3 * geom, 9),
-        "agree": bool(
+    out = ToothCheck(
+        tooth_angle=float(phi),
+        rigid_teeth=teeth,
+        fcl_distance=d_min,
+        fcl_overlap=ov_any,
+        clearance_2d=c2d,
+        sections_z=[float(z) for z in zs] if coned else None,
+        bound=(max(c2d - lower, 0.0) if coned else 0.0) if c2d >= 0 else None,
+        loft_error=geom,
+        agree=bool(
             _agrees(c2d, d_min, ov_any, lower, not coned)
-            and all(r["agree"] for _, r in per)
+            and all(r.agree for _, r in per)
             and abs(c2d - c_pairs) <= FCL_TOL
         ),
-        "per_tooth": [r for _, r in per],
-    }
-    if "fcl_witness_z_mm" in best and not ov_any:
-        out["fcl_witness_z_mm"] = best["fcl_witness_z_mm"]
-        out["clearance_2d_at_witness_um"] = best["clearance_2d_at_witness_um"]
-    out["timing_ms"] = {
-        "2d": round(1e3 * t_2d, 3),
-        "fcl_total": round(1e3 * t_fcl, 3),
-        "fcl_per_query": [round(q, 3) for q in query_ms],
-    }
+        per_tooth=[r for _, r in per],
+        timing={"2d": t_2d, "fcl_total": t_fcl, "fcl_per_query": [1e-3 * q for q in query_ms]},
+    )
+    if best.witness_z is not None and not ov_any:
+        out.witness_z, out.clearance_2d_at_witness = best.witness_z, best.clearance_2d_at_witness
     return out
 
 
@@ -399,7 +451,7 @@ def _lower_bounds(scene: Scene, phi: float, zs, track, c) -> tuple[float, np.nda
     return geom, lo_int.min(axis=0) - geom
 
 
-def _pair_row(scene: Scene, phi, zs, track, j: int, c_j, bounds, fcl) -> dict:
+def _pair_row(scene: Scene, phi, zs, track, j: int, c_j, bounds, fcl) -> PairCheck:
     """One rigid tooth's row: FCL's ``(distance, overlap, nearest points)`` against the 2D clearances ``c_j`` of its
     sections, with ``bounds`` = (lowest clearance between the sections, loft error); and their agreement."""
     lower, geom = bounds
@@ -407,23 +459,16 @@ def _pair_row(scene: Scene, phi, zs, track, j: int, c_j, bounds, fcl) -> dict:
     coned = scene.drive.coned
     c2 = float(c_j.min())
     ok = _agrees(c2, d, ov, lower, not coned)
-    row = {
-        "rigid_tooth": j,
-        "fcl_distance_um": round(1e3 * d, 6),
-        "fcl_overlap": ov,
-        "clearance_2d_um": round(1e3 * c2, 6),
-        "bound_um": round(1e3 * max(c2 - lower, 0.0), 6) if c2 >= 0 else None,
-    }
+    row = PairCheck(j, d, ov, c2, max(c2 - lower, 0.0) if c2 >= 0 else None, False)
     if coned and not ov:
         # the section through FCL's nearest point on the flexspline tooth: the loft's slice there is within `geom`
         # of the true section, so the 2D clearance of that section must match FCL to `geom`
         zw = float(np.clip(pts[0][2], zs[0], zs[-1]))
         r, s = track(zw) if track is not None else scene.pose(np.array([phi]), zw)
         cw = float(scene.clearance_to(r, s, np.array([j]))[0])
-        row["fcl_witness_z_mm"] = round(zw, 6)
-        row["clearance_2d_at_witness_um"] = round(1e3 * cw, 6)
+        row.witness_z, row.clearance_2d_at_witness = zw, cw
         ok = ok and abs(d - cw) <= geom + FCL_TOL
-    row["agree"] = bool(ok)
+    row.agree = bool(ok)
     return row
 
 
@@ -445,7 +490,7 @@ def imperfect_track(drive, imp, phi_h: float, tooth: int):
     return track
 
 
-def verify_worst(drive, result, n_sections: int = 9, imp=None) -> dict:
+def verify_worst(drive, result, n_sections: int = 9, imp=None) -> Check3D:
     """3D check (FCL) of the pairs the 2D audit singles out: the tightest tooth and the entry pinch.
 
     Parameters
@@ -467,8 +512,9 @@ def verify_worst(drive, result, n_sections: int = 9, imp=None) -> dict:
 
     Returns
     -------
-    dict, JSON-ready: ``pairs`` (see :func:`check_tooth`, plus ``what``:
-    ``"tightest"`` or ``"entry pinch"``) and a one-line ``summary``.
+    Check3D
+        A :class:`ToothCheck` per pair, its ``what`` ``"tightest"`` or ``"entry pinch"``
+        (:func:`wgcad.report.check3d.check3d_document` words it).
     """
     scene = Scene(drive)
     if imp is not None:
@@ -480,12 +526,15 @@ def verify_worst(drive, result, n_sections: int = 9, imp=None) -> dict:
     if drive.coned:
         extra = [z for z in result.settings.get("sections_z_mm", []) if z is not None]
         zs = np.unique(np.round(np.concatenate([zs, np.asarray(extra, dtype=float)]), 12))
+    n = int(len(zs)) if drive.coned else 2
     if imp is not None:
-        return _summarise(
-            drive,
-            zs,
-            [{"what": what, **_check_sample(scene, drive, imp, f, zs)} for what, f in _imperfect_targets(result)],
-        )
+        pairs = []
+        for what, f in _imperfect_targets(result):
+            track = imperfect_track(drive, imp, f.generator_angle, f.tooth)
+            chk = check_tooth(scene, float(f.tooth_angle or 0.0), sections=zs, track=track)
+            chk.what, chk.generator_angle, chk.tooth = what, float(f.generator_angle), int(f.tooth)
+            pairs.append(chk)
+        return Check3D(pairs, n, drive.coned)
     # the records' unrounded tooth angles (rad)
     f = result.findings
     targets = [("tightest", f["min_clearance"].tooth_angle)]
@@ -493,8 +542,10 @@ def verify_worst(drive, result, n_sections: int = 9, imp=None) -> dict:
         targets.append(("entry pinch", f["entry_pinch"].tooth_angle))
     pairs = []
     for what, phi in targets:
-        pairs.append({"what": what, **check_tooth(scene, float(phi), sections=zs)})
-    return _summarise(drive, zs, pairs)
+        chk = check_tooth(scene, float(phi), sections=zs)
+        chk.what = what
+        pairs.append(chk)
+    return Check3D(pairs, n, drive.coned)
 
 
 def _imperfect_targets(result):
@@ -504,31 +555,3 @@ def _imperfect_targets(result):
     if pin is not None and pin.tooth is not None and pin.generator_angle is not None and np.isfinite(pin.value):
         out.append(("entry pinch", pin))
     return out
-
-
-def _check_sample(scene, drive, imp, finding, zs) -> dict:
-    """:func:`check_tooth` of the sample a finding names (its tooth at its generator angle), with its generator angle and tooth."""
-    track = imperfect_track(drive, imp, finding.generator_angle, finding.tooth)
-    out = check_tooth(scene, float(finding.tooth_angle or 0.0), sections=zs, track=track)
-    out["generator_angle_deg"] = round(float(np.rad2deg(finding.generator_angle)), 6)
-    out["tooth"] = int(finding.tooth)
-    return out
-
-
-def _summarise(drive, zs, pairs) -> dict:
-    parts = []
-    for p in pairs:
-        f = "overlap" if p["fcl_overlap"] else f"{p['fcl_distance_um']:.4f} um"
-        b = f" (bound {p['bound_um']:.3g} um)" if drive.coned and not p["fcl_overlap"] else ""
-        who = (
-            f" (tooth {p['tooth']} at generator angle {p['generator_angle_deg']:.3f} deg, parts with their errors)"
-            if "tooth" in p
-            else ""
-        )
-        parts.append(
-            f"{p['what']} at {p['tooth_angle_deg']:.3f} deg{who}: FCL {f} vs 2D {p['clearance_2d_um']:.4f} um{b}"
-        )
-    ok = all(p["agree"] for p in pairs)
-    secs = f"{len(zs)} sections" if drive.coned else "prisms (no coning)"
-    summary = ("agree" if ok else "DISAGREE") + f", {secs}: " + "; ".join(parts)
-    return {"pairs": pairs, "n_sections": int(len(zs)) if drive.coned else 2, "agree": ok, "summary": summary}

@@ -70,91 +70,6 @@ def register_args(a) -> None:
     )
 
 
-def _summary(name: str, res: dict) -> str:
-    lines = [
-        f"{name}: under load (elastic contact model, {len(res['model']['sections_z_mm'])} sections), "
-        f"cam offset {res['cam_offset_um']:g} um at {res['cam_offset_deg']:g} deg"
-    ]
-    mnt = res["model"].get("mounted")
-    if mnt:
-        lines.append(
-            f"  on the cam at no load: W0 {mnt['w0_um']:.1f} um at the major axis (the design's), the rim within "
-            f"{mnt['largest_departure_from_law_um']:.1f} um of the law (largest at {mnt['departure_at_deg']:+.1f} deg), "
-            f"held by {mnt['balls_in_contact']} balls of {mnt['ball_preload_n']:.0f} N"
-        )
-    from ..report.text import fixed
-
-    lines.append(
-        "  torque N m | entry gap Delta um (where)           | tip crossing um | teeth in contact | max tooth force N | "
-        "max ball load N | generator N m | wind-up arcmin | secant N m/rad | tangent N m/rad"
-    )
-    for k, lv in enumerate(res["levels"]):
-        sec = res["secant_stiffness_nm_per_rad"][k]
-        tan = res["tangent_stiffness_nm_per_rad"][k - 1] if k else None
-        eg = "none" if lv["entry_gap_um"] is None else f"{lv['entry_gap_um']:9.3f}"
-        at = lv.get("entry_gap_at")
-        where = "" if not at else f"{at['tooth_angle_deg']:+6.1f} deg z {at['section_z_mm']:g} {at['edge']}"
-        cr = "none" if lv.get("crossing_gap_um") is None else f"{lv['crossing_gap_um']:.3f}"
-        lines.append(
-            f"  {lv['torque_nm']:10g} | {eg:>9} {where:<25} | {cr:>15} | {lv['teeth_in_contact']:16d} | "
-            f"{lv['largest_tooth_force_n']:17.1f} | {lv['max_ball_load_n']:15.1f} | {fixed(lv['generator_torque_nm'], 3, 13)} | "
-            f"{fixed(lv['wind_up_arcmin'], 4, 14)} | "
-            + ("-" if sec is None else f"{sec:14.4g}")
-            + " | "
-            + ("-" if tan is None else f"{tan:.4g}")
-        )
-    top = res["levels"][-1]
-    lines.append(
-        f"  at {top['torque_nm']:g} N m: smallest clearance of unloaded pairs "
-        + ("-" if top["min_clearance_um"] is None else f"{top['min_clearance_um']:.3f} um")
-        + f", largest contact approach (teeth pressed into each other, contact not interference) {top['max_contact_approach_um']:.3f} um"
-        + f", largest ball Hertz pressure {top['max_ball_pressure_mpa']:.0f} MPa"
-    )
-    for sec in top["sections"]:
-        zones = ", ".join("-" if z is None else f"{z[0]:+.1f}..{z[1]:+.1f} deg" for z in sec["zone_deg"])
-        lines.append(
-            f"    section z = {sec['section_z_mm']:g} mm: {sec['teeth_in_contact']} {'tooth' if sec['teeth_in_contact'] == 1 else 'teeth'} in contact "
-            f"({sec['working_flank_contacts']} working, {sec['non_working_flank_contacts']} non-working flanks), zones per wave {zones}"
-        )
-    worst = max(lv["residuals"]["equilibrium"] for lv in res["levels"])
-    lin = max(lv["residuals"]["linearisation_mm"] for lv in res["levels"])
-    lines.append(
-        f"  residuals: equilibrium {worst:.1e} (relative), nonlinear contact law {1e3 * lin:.3f} um; "
-        f"{res['elapsed_s']:.2f} s"
-    )
-    if res["entry_gap_closes"]:
-        lines.append("  ENTRY GAP CLOSES under load: tip interference")
-    return "\n".join(lines)
-
-
-def _sweep(path, torques, e_um, e_deg, sections, progress):
-    from ..design import load_design
-    from ..drive import build_drive
-    from ..elastic.model import build_model
-    from ..elastic.sweep import torque_sweep
-
-    drive = build_drive(load_design(path))
-    if drive.design.imperfections.any:
-        # the load audit models perfect parts: silently dropping the errors would report another drive
-        raise DesignError(
-            "imperfections",
-            "the load audit (--torque-nm) models perfect parts and this design has "
-            "[imperfections]: its KE under load is `wgcad ke --torque-nm`, its no-load clearance `wgcad audit` "
-            "without --torque-nm; for the perfect drive's load audit remove the table",
-        )
-    ld = drive.design.load
-    e_um = ld.cam_offset_um if e_um is None else e_um
-    e_deg = ld.cam_offset_deg if e_deg is None else e_deg
-    if e_um < 0:
-        raise DesignError("--cam-offset-um", f"must be >= 0 um, got {e_um:g}")
-    model = build_model(drive, sections)
-    res = torque_sweep(model, torques, e_um, e_deg, progress=progress)
-    res.pop("states")
-    res["design"] = drive.design.drive.name
-    res["source"] = drive.design.source
-    return drive, res
-
-
 def _levels(args) -> list[float]:
     """The torque levels of ``--torque-nm``: as given, or 0 to ``[load] rated_torque_nm`` in :data:`RATED_STEPS` steps."""
     if args.torque_nm != RATED:
@@ -174,20 +89,21 @@ def _levels(args) -> list[float]:
 def run_load(args) -> int:
     """The load audit: sweep, print, write JSON and PNGs atomically; exit 1 when the entry gap closes."""
     from ..atomic import atomic_batch, check_writable_dir
+    from ..report.load import load_lines, load_run
 
     torques = _levels(args)
     for path in (args.json, args.plot, args.html):
         if path:
             check_writable_dir(Path(path).parent if str(Path(path).parent) else Path("."))
     prog = Progress(args.progress or sys.stderr.isatty())
-    drive, res = _sweep(args.design, torques, args.cam_offset_um, args.cam_offset_deg, args.sections, prog)
+    drive, res = load_run(args.design, torques, args.cam_offset_um, args.cam_offset_deg, args.sections, prog)
     compare = None
     if args.compare:
         e = args.cam_offset_um if args.cam_offset_um else 40.0
         compare = []
         for path in (args.design, args.compare):
             for eu in (0.0, e):
-                d2, r2 = _sweep(path, torques, eu, args.cam_offset_deg or 0.0, args.sections, prog)
+                d2, r2 = load_run(path, torques, eu, args.cam_offset_deg or 0.0, args.sections, prog)
                 compare.append(
                     {
                         "label": f"{d2.design.drive.name}, e_h = {eu:g} um",
@@ -236,7 +152,7 @@ def run_load(args) -> int:
                     )
                 )
     if not args.quiet:
-        print(_summary(res["design"], res))
+        print(load_lines(res["design"], res))
         for c in compare or []:
             print(
                 "  compare "

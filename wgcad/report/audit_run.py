@@ -109,13 +109,14 @@ def audit_document(
         if on_stage is not None:
             on_stage("3D check (fcl)")
         from ..clearance.fcl3d import verify_worst
+        from .check3d import check3d_document
 
         imp = None
         if imperfect:
             from ..placement.imperfect import Imperfections
 
             imp = Imperfections.from_spec(drive.design.imperfections)
-        doc["fcl"] = verify_worst(drive, result, imp=imp)
+        doc["fcl"] = check3d_document(verify_worst(drive, result, imp=imp))
         doc["settings"]["engine"] = (
             "fcl (3D check of the pairs the 2D engine singles out)" if engine == "fcl" else "2d + fcl"
         )

@@ -25,7 +25,7 @@ from collections import OrderedDict
 
 import numpy as np
 
-from wgcad.units import ARCSEC_PER_RAD
+from wgcad.units import ARCMIN_PER_RAD, ARCSEC_PER_RAD, UM_PER_MM
 
 from ..errors import DesignError, ModelError, WgcadError
 from .figures import parse_figure
@@ -210,17 +210,17 @@ def _load_run(payload, data, design, drive, torques) -> dict:
     ld = design.load
     res = torque_sweep(model, sorted(torques), ld.cam_offset_um, ld.cam_offset_deg)
     out = {}
-    for lv in res["levels"]:
-        for name in (
-            "entry_gap_um",
-            "teeth_in_contact",
-            "min_clearance_um",
-            "wind_up_arcmin",
-            "largest_tooth_force_n",
-            "max_ball_load_n",
-        ):
-            v = lv[name]
-            out[f"{name}@{lv['torque_nm']:g}Nm"] = math.nan if v is None else float(v)
+    for lv in res.levels:
+        figures = {
+            "entry_gap_um": UM_PER_MM * lv.entry_gap,
+            "teeth_in_contact": float(lv.teeth_in_contact),
+            "min_clearance_um": UM_PER_MM * lv.min_clearance,
+            "wind_up_arcmin": ARCMIN_PER_RAD * lv.state.wind_up,
+            "largest_tooth_force_n": float(lv.tooth_forces.max()),
+            "max_ball_load_n": float(lv.ball_loads.max()),
+        }
+        for name, v in figures.items():
+            out[f"{name}@{lv.torque_nm:g}Nm"] = float(v)
     return out
 
 
