@@ -30,6 +30,7 @@ import wgcad.sector.scene as scene_mod  # noqa: E402
 from wgcad.design import load_design  # noqa: E402
 from wgcad.drive import build_drive, tooth_spec  # noqa: E402
 from wgcad.profiles.sector import TeethByHeight, sector_layout  # noqa: E402
+from wgcad.report.sector import sectored_audit_document  # noqa: E402
 from wgcad.sector import SectoredScene, closed_form_heights, sectored_audit, simulated_heights  # noqa: E402
 
 OUT = ROOT / "output" / "bench"
@@ -141,7 +142,7 @@ def main(argv=None) -> int:
             "s": t_full,
             **{
                 k: v
-                for k, v in a_full.to_json().items()
+                for k, v in sectored_audit_document(a_full).items()
                 if k in ("tip_to_tip", "tip_to_tip_teeth", "min_tip_clearance_um", "min_flank_clearance_um", "counts")
             },
         },
@@ -149,7 +150,7 @@ def main(argv=None) -> int:
             "s": t_built,
             **{
                 k: v
-                for k, v in a_built.to_json().items()
+                for k, v in sectored_audit_document(a_built).items()
                 if k in ("tip_to_tip", "tip_to_tip_teeth", "min_tip_clearance_um", "min_flank_clearance_um", "counts")
             },
         },

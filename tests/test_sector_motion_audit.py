@@ -109,7 +109,7 @@ def test_full_height_teeth_meet_tip_to_tip_at_the_boundaries(d4):
     design, drive, lay, teeth = d4
     a = sectored_audit(SectoredScene(drive, lay, teeth, np.full(lay.n_teeth, teeth.height)), step_deg=0.5)
     assert a.has_tip_to_tip
-    hit = {(x["sector"], x["tooth_in_sector"]) for x in a.tip_to_tip}
+    hit = {(x.sector, x.tooth_in_sector) for x in a.tip_to_tip}
     for s, kind in enumerate(lay.kinds):
         z = design.sectors.teeth[s]
         if kind == "coupling":

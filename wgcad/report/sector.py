@@ -7,11 +7,59 @@ import io
 
 import numpy as np
 
-__all__ = ["summary_json", "heights_csv", "motion_csv", "motion_phases_deg", "sector_summary_text"]
+__all__ = [
+    "summary_json",
+    "heights_csv",
+    "motion_csv",
+    "motion_phases_deg",
+    "sector_summary_text",
+    "sectored_audit_document",
+]
 
 
 def _deg(x):
     return None if x is None or not np.isfinite(x) else round(float(np.rad2deg(x)), 6)
+
+
+def _spot(s) -> dict:
+    """Where a sectored sweep found a figure (:class:`wgcad.sector.scene.SectorSpot`), um and deg; ``{}`` for none."""
+    if s is None:
+        return {}
+    return {
+        "clearance_um": round(1e3 * s.clearance, 4),
+        "generator_angle_deg": round(float(np.rad2deg(s.generator_angle)), 6),
+        "flex_tooth": s.flex_tooth,
+        "flex_tooth_angle_from_axis_deg": round(float(np.rad2deg(s.flex_tooth_angle)), 4),
+        "rigid_tooth": s.rigid_tooth,
+        "sector": s.sector,
+        "sector_kind": s.sector_kind,
+        "tooth_in_sector": s.tooth_in_sector,
+        "rigid_tooth_from_boundary_deg": round(float(np.rad2deg(s.from_boundary)), 4),
+        "rigid_tooth_height_mm": round(s.rigid_tooth_height, 6),
+    }
+
+
+def _um_or_none(x):
+    return round(1e3 * x, 4) if np.isfinite(x) else None
+
+
+def sectored_audit_document(a) -> dict:
+    """A sectored sweep's findings (:class:`wgcad.sector.scene.SectoredAudit`) as JSON: um and deg."""
+    return {
+        "tip_to_tip": a.has_tip_to_tip,
+        "tip_to_tip_teeth": len(a.tip_to_tip),
+        "tip_to_tip_at": [_spot(s) for s in a.tip_to_tip],
+        "min_tip_clearance_um": _um_or_none(a.min_tip_clearance),
+        "worst_tip": _spot(a.worst_tip),
+        "min_clearance_um": round(1e3 * a.min_clearance, 4),
+        "worst": _spot(a.worst),
+        "flank_interference": bool(a.flank_interference),
+        "min_flank_clearance_um": _um_or_none(a.min_flank_clearance),
+        "interference_tol_um": round(1e3 * a.interference_tol, 4),
+        "counts": a.counts,
+        "settings": a.settings,
+        "elapsed_s": round(a.elapsed_s, 4),
+    }
 
 
 def _phases_json(law) -> list:
@@ -76,8 +124,8 @@ def summary_json(res: dict) -> dict:
             "runs": _runs_json(law),
             "output_per_turn_deg": round(float(np.rad2deg(law.advance)), 9),
         },
-        "audit_full_height": res["audit_full"].to_json(),
-        "audit_built": res["audit_built"].to_json(),
+        "audit_full_height": sectored_audit_document(res["audit_full"]),
+        "audit_built": sectored_audit_document(res["audit_built"]),
         "timing_s": {"closed_form": round(cf.elapsed_s, 4), "simulated": round(sim.elapsed_s, 4)},
     }
 
@@ -198,8 +246,8 @@ def sector_summary_text(name: str, res: dict, summ: dict, out) -> str:
         a = res[key]
         where = ""
         if a.has_tip_to_tip:
-            kinds = sorted({x["sector_kind"] for x in a.tip_to_tip})
-            d = [x["rigid_tooth_from_boundary_deg"] for x in a.tip_to_tip]
+            kinds = sorted({x.sector_kind for x in a.tip_to_tip})
+            d = [round(float(np.rad2deg(x.from_boundary)), 4) for x in a.tip_to_tip]
             where = f" on {len(a.tip_to_tip)} teeth ({', '.join(kinds)}; {min(d):.2f} to {max(d):.2f} deg from a sector boundary)"
         tip = "TIP-TO-TIP" + where if a.has_tip_to_tip else "no tip-to-tip contact"
         lines.append(

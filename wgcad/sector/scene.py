@@ -37,6 +37,7 @@ __all__ = [
     "SectoredScene",
     "SweepPairs",
     "SectoredAudit",
+    "SectorSpot",
     "sectored_audit",
     "sweep_angles",
     "DEFAULT_STEP_DEG",
@@ -244,7 +245,8 @@ class SweepPairs:
 
 @dataclass
 class SectoredAudit:
-    """Findings of a sectored sweep (lengths mm, angles rad; :meth:`to_json` converts).
+    """Findings of a sectored sweep (lengths mm, angles rad; :func:`wgcad.report.sector.sectored_audit_document`
+    rounds and converts them).
 
     ``tip_to_tip`` lists, per rigid tooth that meets a flexspline tip
     tip-to-tip (facing tip lands, clearance within the contact tolerance),
@@ -252,10 +254,10 @@ class SectoredAudit:
     """
 
     min_clearance: float
-    worst: dict
+    worst: SectorSpot | None
     tip_to_tip: list
     min_tip_clearance: float
-    worst_tip: dict
+    worst_tip: SectorSpot | None
     flank_interference: bool
     min_flank_clearance: float
     interference_tol: float
@@ -268,44 +270,41 @@ class SectoredAudit:
     def has_tip_to_tip(self) -> bool:
         return len(self.tip_to_tip) > 0
 
-    def to_json(self) -> dict:
-        return {
-            "tip_to_tip": self.has_tip_to_tip,
-            "tip_to_tip_teeth": len(self.tip_to_tip),
-            "tip_to_tip_at": self.tip_to_tip,
-            "min_tip_clearance_um": round(1e3 * self.min_tip_clearance, 4)
-            if np.isfinite(self.min_tip_clearance)
-            else None,
-            "worst_tip": self.worst_tip,
-            "min_clearance_um": round(1e3 * self.min_clearance, 4),
-            "worst": self.worst,
-            "flank_interference": bool(self.flank_interference),
-            "min_flank_clearance_um": round(1e3 * self.min_flank_clearance, 4)
-            if np.isfinite(self.min_flank_clearance)
-            else None,
-            "interference_tol_um": round(1e3 * self.interference_tol, 4),
-            "counts": self.counts,
-            "settings": self.settings,
-            "elapsed_s": round(self.elapsed_s, 4),
-        }
+
+@dataclass
+class SectorSpot:
+    """Where a sectored sweep found a figure: the pair's clearance (mm), the generator angle (rad), the flexspline tooth
+    and its angle from the major axis (rad), the rigid tooth, its sector (index, kind, place in it), its angle from the
+    sector boundary (rad) and its built height (mm)."""
+
+    clearance: float
+    generator_angle: float
+    flex_tooth: int
+    flex_tooth_angle: float
+    rigid_tooth: int
+    sector: int
+    sector_kind: str
+    tooth_in_sector: int
+    from_boundary: float
+    rigid_tooth_height: float
 
 
-def _where(scene: SectoredScene, pairs: SweepPairs, n: int, c: float) -> dict:
+def _where(scene: SectoredScene, pairs: SweepPairs, n: int, c: float) -> SectorSpot:
     lay = scene.layout
     i = int(pairs.rigid[n])
     s = int(lay.sector[i])
-    return {
-        "clearance_um": round(1e3 * float(c), 4),
-        "generator_angle_deg": round(float(np.rad2deg(pairs.phi_h[pairs.angle[n]])), 6),
-        "flex_tooth": int(pairs.flex[n]),
-        "flex_tooth_angle_from_axis_deg": round(float(np.rad2deg(pairs.phi[n])), 4),
-        "rigid_tooth": i,
-        "sector": s,
-        "sector_kind": lay.kinds[s],
-        "tooth_in_sector": int(lay.index[i]),
-        "rigid_tooth_from_boundary_deg": round(float(np.rad2deg(lay.delta[i])), 4),
-        "rigid_tooth_height_mm": round(float(scene.heights[i]), 6),
-    }
+    return SectorSpot(
+        clearance=float(c),
+        generator_angle=float(pairs.phi_h[pairs.angle[n]]),
+        flex_tooth=int(pairs.flex[n]),
+        flex_tooth_angle=float(pairs.phi[n]),
+        rigid_tooth=i,
+        sector=s,
+        sector_kind=lay.kinds[s],
+        tooth_in_sector=int(lay.index[i]),
+        from_boundary=float(lay.delta[i]),
+        rigid_tooth_height=float(scene.heights[i]),
+    )
 
 
 def sectored_audit(
@@ -345,10 +344,10 @@ def sectored_audit(
     min_flank = float(c[nf].min()) if nf.size else float("inf")
     return SectoredAudit(
         min_clearance=float(c[k]) if k is not None else float("inf"),
-        worst=_where(scene, pairs, k, c[k]) if k is not None else {},
+        worst=_where(scene, pairs, k, c[k]) if k is not None else None,
         tip_to_tip=tip_list,
         min_tip_clearance=float(c[kt]) if kt is not None else float("inf"),
-        worst_tip=_where(scene, pairs, kt, c[kt]) if kt is not None else {},
+        worst_tip=_where(scene, pairs, kt, c[kt]) if kt is not None else None,
         flank_interference=bool(min_flank < -interference_tol),
         min_flank_clearance=min_flank,
         interference_tol=interference_tol,
