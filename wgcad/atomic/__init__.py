@@ -3,19 +3,9 @@ a target before anything is written (``targets``: only a missing or regular file
 temporary files' names and their clean-up after a killed run (``temps``). The ground floor under every writer
 (export, sweep store, the CLI)."""
 
-from .writes import (
-    TEMP_SUFFIX,
-    Batch,
-    atomic_batch,
-    atomic_write,
-    atomic_writer,
-    check_target,
-    check_writable_dir,
-    commit_all,
-    discard_all,
-    ensure_writable_dir,
-    remove_stale_temps,
-)
+from .targets import check_target, check_writable_dir, ensure_writable_dir
+from .temps import TEMP_SUFFIX, remove_stale_temps
+from .writes import Batch, atomic_batch, atomic_write, atomic_writer, commit_all, discard_all
 
 __all__ = [
     "TEMP_SUFFIX",

@@ -11,22 +11,10 @@ from pathlib import Path
 
 from wgcad.errors import OutputError
 
-from .targets import _not_a_folder, _reason, check_target, check_writable_dir, ensure_writable_dir
-from .temps import TEMP_SUFFIX, _new_temp, _remove_quietly, remove_stale_temps
+from .targets import _not_a_folder, _reason, check_target
+from .temps import _new_temp, _remove_quietly, remove_stale_temps
 
-__all__ = [
-    "TEMP_SUFFIX",
-    "check_target",
-    "check_writable_dir",
-    "ensure_writable_dir",
-    "remove_stale_temps",
-    "atomic_writer",
-    "atomic_write",
-    "commit_all",
-    "discard_all",
-    "Batch",
-    "atomic_batch",
-]
+__all__ = ["atomic_writer", "atomic_write", "commit_all", "discard_all", "Batch", "atomic_batch"]
 
 # Signals deferred while a batch renames its files into place, so that an
 # interrupt never leaves half of a batch committed.
