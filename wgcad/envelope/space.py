@@ -55,23 +55,25 @@ class ConjugateFlank:
 def _outside_all(x: np.ndarray, polys: np.ndarray, tol: float, exact) -> np.ndarray:
     """For points ``x (M, 2)``: whether no position of the tooth covers one. The chord polygons ``polys (K, N, 2)``
     decide where they cover a point by more than ``tol`` (their distance from the exact pieces); closer calls go to
-    ``exact(i, j)``, the point's exact signed distance from the tooth at position ``j`` (positive: inside)."""
+    ``exact(I, J)``, the points' ``I`` exact signed distances from the tooth at positions ``J`` (positive: inside),
+    all in one call."""
     import shapely
 
     geoms = shapely.polygons(polys)
     tree = shapely.STRtree(geoms)
     pts = shapely.points(x)
     ok = np.ones(len(x), dtype=bool)
-    hits = tree.query(pts, predicate="intersects")
-    for i, j in zip(*hits):
-        if not ok[i]:
-            continue
-        depth = shapely.distance(pts[i], geoms[j].exterior)
-        # covered, or within the chord tolerance of being covered by a sampled position: between the pass's
-        # positions (2e-3 rad apart) a tooth corner sweeps farther than the exact test at the samples sees (held
-        # to the strict test, the cycloidal flank kept points below the tip's path, crossed by 0.17 um)
-        if depth > tol or exact(i, j) > -tol:
-            ok[i] = False
+    hi, hj = tree.query(pts, predicate="intersects")
+    if not hi.size:
+        return ok
+    depth = shapely.distance(pts[hi], shapely.get_exterior_ring(geoms[hj]))
+    # covered, or within the chord tolerance of being covered by a sampled position: between the pass's
+    # positions (2e-3 rad apart) a tooth corner sweeps farther than the exact test at the samples sees (held
+    # to the strict test, the cycloidal flank kept points below the tip's path, crossed by 0.17 um)
+    ok[hi[depth > tol]] = False
+    ask = np.flatnonzero((depth <= tol) & ok[hi])
+    if ask.size:
+        ok[hi[ask[exact(hi[ask], hj[ask]) > -tol]]] = False
     return ok
 
 
@@ -130,19 +132,26 @@ def _boundary(env, idx, t, polys, tol, pieces, mot, outline):
     x = env.points[idx]
     starts = [np.linspace(p.t0, p.t1, 64) for p in outline]
 
-    def exact(i, j):
+    def exact(I, J):
         # the side of the nearest point of the flank (by distance: a projection clamped to a piece's end measures
-        # along that end's normal, which can point either way for a point off the piece)
-        rot, shift = mot.pose(np.array([t[j]]))
-        best, gap = np.inf, np.inf
-        for p, sg in zip(outline, starts):
-            c, sn = np.cos(rot[0]), np.sin(rot[0])
-            P = p.point(sg) @ np.array([[c, sn], [-sn, c]]) + shift[0]
-            s0 = sg[np.argmin(np.hypot(*(P - x[i]).T))]
-            d, g = _side_distance(p, np.array([s0]), x[i : i + 1], rot, shift, with_gap=True)
-            if g[0] < gap:
-                best, gap = d[0], g[0]
-        return best
+        # along that end's normal, which can point either way for a point off the piece); every pair at once,
+        # in chunks that keep the start grid's arrays small
+        out = np.empty(len(I))
+        for a in range(0, len(I), 4096):
+            i, j = I[a : a + 4096], J[a : a + 4096]
+            rot, shift = mot.pose(t[j])
+            c, sn = np.cos(rot)[:, None], np.sin(rot)[:, None]
+            best, gap = np.full(len(i), np.inf), np.full(len(i), np.inf)
+            for p, sg in zip(outline, starts):
+                P = p.point(sg)
+                px = P[None, :, 0] * c - P[None, :, 1] * sn + shift[:, None, 0]
+                py = P[None, :, 0] * sn + P[None, :, 1] * c + shift[:, None, 1]
+                s0 = sg[np.argmin(np.hypot(px - x[i, None, 0], py - x[i, None, 1]), axis=1)]
+                d, g = _side_distance(p, s0, x[i], rot, shift, with_gap=True)
+                closer = g < gap
+                best[closer], gap[closer] = d[closer], g[closer]
+            out[a : a + 4096] = best
+        return out
 
     keep = idx[_outside_all(x, polys, tol, exact)]
     return keep[np.argsort(np.hypot(*env.points[keep].T))]
