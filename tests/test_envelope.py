@@ -201,3 +201,23 @@ def test_every_command_runs_on_the_conjugate_template(tmp_path, capsys):
         res = audit(d, AuditSettings(angles=np.deg2rad(np.arange(720) * 0.5), sections=[z], interference_tol=1e-3))
         figs[z] = res.min_clearance
     assert figs[0.0] < -20e-3 and -1e-5 < figs[18.0] < 1e-3 and figs[30.0] > 5e-3
+
+
+def test_a_conjugate_rigid_gear_is_built_once_per_design_and_tolerance():
+    """The envelope is the costly part of building a conjugate drive: a process builds it once per design and chord
+    tolerance (drive._CONJUGATES) and a changed design or tolerance gets its own, equal to a fresh build."""
+    from wgcad import drive as drive_mod
+    from wgcad.design import with_changes
+
+    d = load_design(TEMPLATES / "d1_conjugate.toml")
+    drive_mod._CONJUGATES.clear()
+    a = build_drive(d)
+    assert build_drive(d).rigid is a.rigid  # the same design again: the kept gear
+    coarse = build_drive(d, tol=4e-3)
+    assert coarse.rigid is not a.rigid and len(coarse.rigid.period) < len(a.rigid.period)
+    backed = build_drive(with_changes(d, rigid={"conjugate_clearance_um": 5.0}))
+    assert backed.rigid is not a.rigid
+    # a kept gear is the gear a fresh build makes
+    drive_mod._CONJUGATES.clear()
+    fresh = build_drive(d)
+    assert fresh.rigid is not a.rigid and np.array_equal(fresh.rigid.period, a.rigid.period)

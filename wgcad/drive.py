@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from collections import OrderedDict
 from dataclasses import dataclass, replace
 from math import pi
 
@@ -257,8 +258,26 @@ def build_drive(
     return drive
 
 
+#: the last few conjugate rigid gears built, by (design, chord tolerance): a design's commands run in one process
+#: (the library's callers, the synthesis's neighbours, the tests) build its envelope once; the gears are frozen
+_CONJUGATES: OrderedDict = OrderedDict()
+_CONJUGATES_KEPT = 4
+
+
 def _conjugate(drive: Drive) -> Drive:
     """The drive with its rigid gear's flanks made conjugate to the flexspline's teeth (docs/models.md 13)."""
+    key = (drive.design, drive.tol)
+    if key in _CONJUGATES:
+        _CONJUGATES.move_to_end(key)
+        return replace(drive, rigid=_CONJUGATES[key])
+    drive = _build_conjugate(drive)
+    _CONJUGATES[key] = drive.rigid
+    while len(_CONJUGATES) > _CONJUGATES_KEPT:
+        _CONJUGATES.popitem(last=False)
+    return drive
+
+
+def _build_conjugate(drive: Drive) -> Drive:
     from .envelope.rigid import conjugate_rigid_gear
 
     d = drive.design
