@@ -464,3 +464,49 @@ def test_lane_minimum_prunes_only_what_cannot_be_first(name):
             # the contact named is one that takes the minimum
             hit = e == first[:, None]
             assert np.all(np.abs(np.where(hit, full, np.inf).min(axis=1) - ref) < 1e-15)
+
+
+def _table_arrays(tab):
+    return {(side, key): np.asarray(v) for side, S in tab.sides.items() for key, v in S.items()}
+
+
+def test_closing_measurements_split_between_threads_equal_one_thread(d2, monkeypatch):
+    """The closing rotation's nearest points are measured on two threads when a call has many pairs (shapely
+    releases the GIL): the contact table is the one a single thread builds, to the bit."""
+    from wgcad.clearance import closing
+
+    imp = Imperfections(flex_runout=0.01, rigid_ecc=0.005)
+    monkeypatch.setattr(closing, "_SPLIT", 10**9)
+    one = _table_arrays(K.contact_table(d2, imp, 4, sections=[None]))
+    monkeypatch.setattr(closing, "_SPLIT", 2)
+    two = _table_arrays(K.contact_table(d2, imp, 4, sections=[None]))
+    assert one.keys() == two.keys() and one
+    for key in one:
+        np.testing.assert_array_equal(one[key], two[key], err_msg=str(key))
+
+
+def test_a_forked_process_measures_with_threads_of_its_own(d2, monkeypatch):
+    """A sweep's worker forked after the parent measured has none of the parent's pool threads: it starts its own
+    (a pool inherited across a fork would take the work and never run it)."""
+    import multiprocessing
+
+    from wgcad.clearance import closing
+
+    monkeypatch.setattr(closing, "_SPLIT", 2)
+    K.contact_table(d2, Imperfections(), 2, sections=[None])  # the parent's pool exists now
+    assert closing._POOL is not None
+    ctx = multiprocessing.get_context("fork")
+    q = ctx.Queue()
+    p = ctx.Process(target=_child_table, args=(d2, q))
+    p.start()
+    p.join(30)  # the child builds its table in about a second
+    alive = p.is_alive()
+    if alive:
+        p.kill()
+    assert not alive, "the forked child hung on the inherited pool"
+    assert q.get(timeout=5) > 0
+
+
+def _child_table(d2, q):
+    tab = K.contact_table(d2, Imperfections(), 2, sections=[None])
+    q.put(int(sum(len(S["g"]) for S in tab.sides.values())))

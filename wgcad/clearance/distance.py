@@ -7,7 +7,7 @@ import shapely
 
 from ..placement import transform
 
-__all__ = ["Template", "signed_clearance"]
+__all__ = ["Template", "overlap_depth", "signed_clearance"]
 
 
 class Template:
@@ -71,6 +71,16 @@ def _relative(rot_a, shift_a, rot_b, shift_b):
     return rel, np.stack([c * d[:, 0] - s * d[:, 1], s * d[:, 0] + c * d[:, 1]], axis=-1)
 
 
+def overlap_depth(a: Template, rot_a, shift_a, b: Template, rot_b, shift_b) -> np.ndarray:
+    """Penetration depth ``(K,)`` of pairs known to touch or overlap (their distance is 0): the deepest vertex of
+    either polygon inside the other, measured to the other's boundary (:func:`signed_clearance`)."""
+    r, t = _relative(rot_a, shift_a, rot_b, shift_b)
+    depth_ab = b.depth_of(transform(a.local, r, t))  # vertices of A inside B
+    r, t = _relative(rot_b, shift_b, rot_a, shift_a)
+    depth_ba = a.depth_of(transform(b.local, r, t))  # vertices of B inside A
+    return np.maximum(depth_ab, depth_ba)
+
+
 def signed_clearance(
     a: Template, rot_a, shift_a, b: Template, rot_b, shift_b, b_geoms=None, area: bool = False, a_geoms=None
 ):
@@ -115,11 +125,7 @@ def signed_clearance(
     over = np.nonzero(d == 0.0)[0]
     out = d.copy()
     if over.size:
-        r, t = _relative(rot_a[over], shift_a[over], rot_b[over], shift_b[over])
-        depth_ab = b.depth_of(transform(a.local, r, t))  # vertices of A inside B
-        r, t = _relative(rot_b[over], shift_b[over], rot_a[over], shift_a[over])
-        depth_ba = a.depth_of(transform(b.local, r, t))  # vertices of B inside A
-        out[over] = -np.maximum(depth_ab, depth_ba)
+        out[over] = -overlap_depth(a, rot_a[over], shift_a[over], b, rot_b[over], shift_b[over])
     if not area:
         return out
     ov_area = np.zeros(len(d))
