@@ -17,7 +17,9 @@ of ``python -c "import a, b, ..."`` with one more module each row, so the
 difference between rows is what that module adds (cold, in the order audit
 imports them). Times are best-of-N wall clock; the machine's load average is
 printed with them because other jobs on a 2-core machine change them.
-Writes output/bench/startup.md and startup.csv.
+Then the whole-process figures issue 22 sets goals for (exact and polygon audit, generate, the KE of
+d2_imperfect, the part set with STEP and its peak memory) against a bare ``import numpy, shapely`` of the same
+run. Writes output/bench/startup.md and startup.csv.
 """
 
 from __future__ import annotations
@@ -53,13 +55,14 @@ def env() -> dict:
     return {**os.environ, "PYTHONPATH": str(ROOT)}
 
 
-def wall(cmd: list[str], n: int) -> tuple[float, float]:
+def wall(cmd: list[str], n: int, peak: list | None = None) -> tuple[float, float]:
     """Best-of-n wall time of a whole process, spawn to exit, and its CPU time (user + system) in that run.
 
     The CPU time is the steadier figure when other jobs share the machine:
-    waiting for a core does not count in it.
+    waiting for a core does not count in it. ``peak``: a list the largest
+    resident size of the runs (MiB) is appended to.
     """
-    best, cpu = float("inf"), float("nan")
+    best, cpu, rss = float("inf"), float("nan"), 0.0
     for _ in range(n):
         t = time.perf_counter()
         p = subprocess.Popen(cmd, env=env(), stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
@@ -68,8 +71,11 @@ def wall(cmd: list[str], n: int) -> tuple[float, float]:
         p.returncode = os.waitstatus_to_exitcode(status)
         if p.returncode not in (0, 1):
             raise SystemExit(f"{' '.join(cmd)} failed ({p.returncode})")
+        rss = max(rss, usage.ru_maxrss / 1024.0)
         if dt < best:
             best, cpu = dt, usage.ru_utime + usage.ru_stime
+    if peak is not None:
+        peak.append(rss)
     return best, cpu
 
 
@@ -84,6 +90,76 @@ def in_process(template: Path, n: int) -> float:
         main(["audit", str(template), "--quiet"])
         best = min(best, time.perf_counter() - t)
     return best
+
+
+def _goals(py: str, n: int) -> list[dict]:
+    """The whole-process figures issue 22 sets goals for, each with the bare import's time of the same run."""
+    import tempfile
+
+    bare, bare_cpu = wall([py, "-c", "import numpy, shapely"], n)
+    d1, d2i = str(ROOT / "templates" / "d1_involute.toml"), str(ROOT / "templates" / "d2_imperfect.toml")
+    out = [
+        {
+            "command": "python -c 'import numpy, shapely'",
+            "wall_s": bare,
+            "cpu_s": bare_cpu,
+            "ratio": 1.0,
+            "peak_mib": None,
+            "goal": "the yardstick",
+            "met": True,
+        }
+    ]
+    with tempfile.TemporaryDirectory() as tmp:
+        cases = [
+            (
+                "wgcad audit d1_involute --quiet (exact)",
+                [py, "-m", "wgcad", "audit", d1, "--quiet"],
+                n,
+                "<= 2.5x",
+                lambda w, r, p: r <= 2.5,
+            ),
+            (
+                "wgcad audit d1_involute --quiet --no-refine",
+                [py, "-m", "wgcad", "audit", d1, "--quiet", "--no-refine"],
+                n,
+                "(polygons)",
+                None,
+            ),
+            (
+                "wgcad generate d1_involute",
+                [py, "-m", "wgcad", "generate", d1, "--out", f"{tmp}/g", "--quiet"],
+                n,
+                "<= 3x",
+                lambda w, r, p: r <= 3.0,
+            ),
+            ("wgcad ke d2_imperfect", [py, "-m", "wgcad", "ke", d2i], n, "< 2 s", lambda w, r, p: w < 2.0),
+            (
+                "wgcad parts d1_involute --format dxf,svg,stl,3mf,step",
+                [py, "-m", "wgcad", "parts", d1, "--format", "dxf,svg,stl,3mf,step", "--out", f"{tmp}/p", "--quiet"],
+                min(n, 3),
+                "< 8 s, < 300 MiB",
+                lambda w, r, p: w < 8.0 and p < 300.0,
+            ),
+        ]
+        for label, cmd, reps, goal, ok in cases:
+            peak = []
+            w, c = wall(cmd, reps, peak)
+            out.append(
+                {
+                    "command": label,
+                    "wall_s": w,
+                    "cpu_s": c,
+                    "ratio": w / bare,
+                    "peak_mib": peak[0],
+                    "goal": goal,
+                    "met": True if ok is None else bool(ok(w, w / bare, peak[0])),
+                }
+            )
+            print(
+                f"{label:60s} {w:6.3f} s (cpu {c:6.3f} s) {w / bare:5.2f}x bare, peak {peak[0]:5.0f} MiB  goal {goal}",
+                flush=True,
+            )
+    return out
 
 
 def main(argv=None) -> int:
@@ -126,6 +202,7 @@ def main(argv=None) -> int:
             f"{row['step']:60s} {row['whole_process_s']:6.3f} s (cpu {row['whole_process_cpu_s']:6.3f} s){adds}",
             flush=True,
         )
+    goals = _goals(py, n)
     load1 = os.getloadavg()
 
     OUT.mkdir(parents=True, exist_ok=True)
@@ -159,6 +236,20 @@ def main(argv=None) -> int:
     for r in chain:
         adds = "" if r["adds_s"] is None else f"{r['adds_s']:.3f}"
         md.append(f"| {r['step']} | {r['whole_process_s']:.3f} | {r['whole_process_cpu_s']:.3f} | {adds} |")
+    md += [
+        "",
+        'Whole-process goals (issue 22): each command against a bare `python -c "import numpy, shapely"` in the same '
+        "run (best of N wall; the parts run best of 3, its peak the largest resident size of those runs)",
+        "",
+        "| command | whole process, s | CPU, s | x bare import | peak, MiB | goal | met |",
+        "|---|---|---|---|---|---|---|",
+    ]
+    for g in goals:
+        peak = "" if g["peak_mib"] is None else f"{g['peak_mib']:.0f}"
+        met = "yes" if g["met"] else "NO"
+        md.append(
+            f"| {g['command']} | {g['wall_s']:.3f} | {g['cpu_s']:.3f} | {g['ratio']:.2f} | {peak} | {g['goal']} | {met} |"
+        )
     (OUT / "startup.md").write_text("\n".join(md) + "\n")
     print(f"wrote {OUT / 'startup.md'} and startup.csv")
     return 0

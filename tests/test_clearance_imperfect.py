@@ -277,7 +277,8 @@ def test_full_cycle_is_every_turn_of_the_flexspline_errors(tmp_path):
     # polygon figures (no refinement): the same polygons at the same poses either way
     _, full = run_audit(design(), RunSettings(step_deg=2.0, turns=None, refine=False))
     assert (
-        full.settings["generator_turns"] == 43 and full.settings["shortcuts_that_hold"]["one_generator_turn"] is False
+        round(full.settings.imperfect.generator_turns, 6) == 43
+        and full.settings.imperfect.shortcuts_that_hold["one_generator_turn"] is False
     )
     u = gear_ratios(86, 88)["u_hg"]
     per_turn = [
@@ -306,7 +307,7 @@ def test_one_turn_holds_every_state_without_flexspline_errors(tmp_path):
     p.write_text(text)
     _, one = run_audit(p, RunSettings(step_deg=2.0, refine=False))
     _, three = run_audit(p, RunSettings(step_deg=2.0, refine=False, turns=3))
-    assert one.settings["shortcuts_that_hold"]["one_generator_turn"] is True
+    assert one.settings.imperfect.shortcuts_that_hold["one_generator_turn"] is True
     assert three.min_clearance == pytest.approx(one.min_clearance, abs=1e-9)
 
 
@@ -405,11 +406,11 @@ def test_entry_gap_of_every_passage_against_a_dense_reference(d1):
     # other passages (a sample of each section's): none below the reported gap
     from wgcad.clearance.entry import entry_crossings
 
-    p_star = [g[1] for g in entry_crossings(sc, list(got.settings["sections_z_mm"]), exact=False)]
+    p_star = [g[1] for g in entry_crossings(sc, list(got.settings.sections), exact=False)]
     t = np.linspace(sc.tip_arc.t0, sc.tip_arc.t1, 401)
     rng = np.random.default_rng(3)
     checked = 0
-    for z, p0 in zip(got.settings["sections_z_mm"], p_star):
+    for z, p0 in zip(got.settings.sections, p_star):
         ph0, ks = passages(sc, p0, 0.0, 2 * np.pi)
         for i in rng.choice(len(ph0), 6, replace=False):
             # the crossing nearest the perfect one on a 0.05 deg grid, then bisection

@@ -221,7 +221,7 @@ def test_verify_worst_agrees(name):
     # exact curves: they differ by at most the polygon-curve difference (2 x the chord tolerance)
     assert (
         w["clearance_2d_um"]
-        <= audit_json(result)["worst"]["clearance_um"] + 2.0 * result.settings["chord_tol_um"] + 1e-2
+        <= audit_json(result)["worst"]["clearance_um"] + 2.0 * 1e3 * result.settings.chord_tol + 1e-2
     )
     if result.min_clearance < 0:
         assert w["fcl_overlap"]

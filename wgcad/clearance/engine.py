@@ -37,7 +37,6 @@ from math import pi
 
 import numpy as np
 
-from .. import constants
 from ..placement import tooth_pose
 from .backlash import backlash
 from .cascade import FINE, refine_candidates
@@ -52,7 +51,7 @@ from .entry import (
     section_poses,
     smallest,
 )
-from .findings import Finding
+from .findings import AuditRun, Finding
 from .scene import Scene, _classify, clearance_at_poses, refine_min, tooth_clearance, tooth_clearance_sections
 from .search import AuditSettings, _evaluate, _fold, _sample_phi, _SectionSearch
 
@@ -86,7 +85,7 @@ class AuditResult:
     most, read off the records.
     """
 
-    settings: dict
+    settings: AuditRun
     findings: dict
     interference: bool
     interference_tol: float
@@ -108,7 +107,7 @@ class AuditResult:
 
     @property
     def entry_side(self) -> str:
-        return self.settings.get("entry_side", "entry (+phi)")
+        return "entry (+phi)" if self.settings.entry_sign > 0 else "entry (-phi)"
 
     @property
     def raw(self) -> dict:
@@ -257,9 +256,8 @@ def audit(drive, settings: AuditSettings, progress=None) -> AuditResult:
         "refined": int(n_refined),
         "fine_polygon": int(n_fine),
     }
-    rs = settings_doc(drive, scene, settings, angles, sections)
     res = AuditResult(
-        settings=rs,
+        settings=audit_run(drive, scene, settings, angles, sections),
         findings={
             "min_clearance": worst,
             "entry_gap": entry,
@@ -344,32 +342,24 @@ def _refine(drive, scene: Scene, phi_sorted, sections, cands, settings: AuditSet
     return best, where, n_refined, n_fine
 
 
-def settings_doc(drive, scene: Scene, settings: AuditSettings, angles: np.ndarray, sections: list) -> dict:
-    """The settings a perfect drive's audit ran with, as its JSON document states them."""
-    bw = drive.design.drive.face_width
-    ends = (not drive.coned) or (min(sections) <= 1e-9 and max(sections) >= bw - 1e-9)
-    rs = {
-        "engine": "2d",
-        "angles": int(len(angles)),
-        "angle_step_deg": round(float(np.rad2deg(np.median(np.diff(angles)))), 6) if len(angles) > 1 else None,
-        "sections_z_mm": [None if z is None else round(z, 6) for z in sections],
-        "sections_note": (
-            "identical sections (no coning): one computed"
-            if not drive.coned
-            else "coned: every section computed" + ("" if ends else "; the face ends were NOT checked")
-        ),
-        "face_ends_checked": bool(ends),
-        "mesh_period": bool(settings.use_period),
-        "identical_waves": bool(settings.use_waves),
-        "mirror_symmetry": bool(settings.use_mirror),
-        "culling": bool(settings.cull),
-        "branch_and_bound": bool(settings.bound),
-        **accuracy_settings(drive, settings.refine),
-        "working_flank": scene.working,
-        "entry_side": "entry (+phi)" if scene.entry_sign > 0 else "entry (-phi)",
-        "rigid_pitch_radius_mm": drive.rigid.r,
-    }
-    return rs
+def audit_run(drive, scene: Scene, settings: AuditSettings, angles: np.ndarray, sections: list) -> AuditRun:
+    """What a perfect drive's audit ran with."""
+    return AuditRun(
+        angles=np.asarray(angles, dtype=float),
+        sections=tuple(sections),
+        coned=bool(drive.coned),
+        face_width=float(drive.design.drive.face_width),
+        mesh_period=bool(settings.use_period),
+        identical_waves=bool(settings.use_waves),
+        mirror_symmetry=bool(settings.use_mirror),
+        culling=bool(settings.cull),
+        branch_and_bound=bool(settings.bound),
+        refined=bool(settings.refine),
+        chord_tol=float(drive.tol),
+        working_flank=scene.working,
+        entry_sign=1 if scene.entry_sign > 0 else -1,
+        rigid_pitch_radius=float(drive.rigid.r),
+    )
 
 
 def entry_findings(scene: Scene, sections: list, refine: bool, interference_tol: float):
@@ -441,21 +431,6 @@ def entry_findings(scene: Scene, sections: list, refine: bool, interference_tol:
     else:
         pinch = Finding("entry_pinch", nan, method, details={"tip_to_tip_risk": False})
     return gap, crossing, pinch
-
-
-def accuracy_settings(drive, refine: bool) -> dict:
-    """The settings entries that say how exact an audit's figures are (shared by the perfect and imperfect audits)."""
-    return {
-        "chord_tol_um": round(1e3 * drive.tol, 6),
-        "refined": bool(refine),
-        "refine_tol_um": round(1e3 * constants.REFINE_TOL, 6) if refine else None,
-        "error_side": (
-            "figures on the exact curves, within refine_tol_um either side"
-            if refine
-            else "polygon figures: chords lie inside convex and outside concave curve parts, "
-            "so each figure is within 2 x chord_tol_um of the exact one, either side"
-        ),
-    }
 
 
 def _worst_finding(

@@ -524,7 +524,7 @@ def verify_worst(drive, result, n_sections: int = 9, imp=None) -> Check3D:
     bw = float(drive.design.drive.face_width)
     zs = np.linspace(0.0, bw, max(int(n_sections), 2))
     if drive.coned:
-        extra = [z for z in result.settings.get("sections_z_mm", []) if z is not None]
+        extra = [z for z in result.settings.sections if z is not None]
         zs = np.unique(np.round(np.concatenate([zs, np.asarray(extra, dtype=float)]), 12))
     n = int(len(zs)) if drive.coned else 2
     if imp is not None:

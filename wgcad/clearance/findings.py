@@ -10,7 +10,9 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
-__all__ = ["Finding", "FIGURES", "METHODS"]
+import numpy as np
+
+__all__ = ["Finding", "FIGURES", "METHODS", "AuditRun", "ImperfectRun"]
 
 #: the figures an audit reports
 FIGURES = ("min_clearance", "entry_gap", "entry_crossing", "entry_pinch", "backlash")
@@ -74,3 +76,49 @@ class Finding:
             raise ValueError(f"unknown figure {self.figure!r}")
         if self.method not in METHODS:
             raise ValueError(f"unknown method {self.method!r}")
+
+
+@dataclass(frozen=True)
+class ImperfectRun:
+    """How an imperfect drive's audit swept (:func:`wgcad.clearance.imperfect.audit_imperfect`): the generator turns
+    swept and the whole error cycle's, which work-skipping facts still hold (and why), the generator angles per
+    chunk."""
+
+    generator_turns: float
+    full_cycle_turns: int
+    shortcuts_that_hold: dict
+    why: str
+    chunk: int
+
+
+@dataclass(frozen=True)
+class AuditRun:
+    """What an audit ran with, in mm and rad (the report states it in the units of its keys, with its notes).
+
+    ``angles``: the generator angles; ``sections``: the cross-sections, mm (``(None,)`` without coning);
+    the shortcuts used; ``refined`` (figures on the exact curves) and ``chord_tol`` (the outlines' chord
+    tolerance, mm); the working flank, the entry side (+1: entry at +phi), the rigid gear's pitch radius (mm);
+    ``imperfect`` for an imperfect drive's audit."""
+
+    angles: np.ndarray
+    sections: tuple
+    coned: bool
+    face_width: float
+    mesh_period: bool
+    identical_waves: bool
+    mirror_symmetry: bool
+    culling: bool
+    branch_and_bound: bool
+    refined: bool
+    chord_tol: float
+    working_flank: str
+    entry_sign: int
+    rigid_pitch_radius: float
+    imperfect: ImperfectRun | None = None
+
+    @property
+    def face_ends_checked(self) -> bool:
+        """Both ends of the face were among the sections (always, without coning)."""
+        if not self.coned:
+            return True
+        return min(self.sections) <= 1e-9 and max(self.sections) >= self.face_width - 1e-9

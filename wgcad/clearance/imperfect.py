@@ -24,7 +24,7 @@ What still saves work (docs/models.md 7, last paragraph):
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from math import pi
 
 import numpy as np
@@ -33,7 +33,7 @@ import shapely
 from ..placement import transform
 from ..placement.imperfect import Imperfections, flex_poses_batch, full_cycle_turns, rigid_translation, shortcuts
 from .cascade import FINE, refine_candidates
-from .findings import Finding
+from .findings import AuditRun, Finding, ImperfectRun
 from .imperfect_bounds import ErrorBound, PerfectBound, PerfectBounds, chunk_bounds
 from .imperfect_scene import ImperfectScene
 from .scene import Scene, clearance_at_poses, refine_min
@@ -180,7 +180,7 @@ def audit_imperfect(drive, settings, imp: Imperfections, progress=None, chunk_sa
         "backlash": Finding("backlash", float(bl), "brent", generator_angle=float(run.angles[0]), section_z=z_mid),
     }
     res = AuditResult(
-        settings=_settings_doc(run),
+        settings=_audit_run(run),
         findings=findings,
         interference=best < -settings.interference_tol,
         interference_tol=settings.interference_tol,
@@ -415,49 +415,26 @@ def _entry(run: _Run):
     return gaps, imperfect_entry(run.drive, run.imp, run.isc, scene, gaps, p_pinch, span, sections, run.settings.refine)
 
 
-def _settings_doc(run: _Run) -> dict:
-    """The settings the audit ran with, as its JSON document states them."""
-    from .engine import accuracy_settings
+def _audit_run(run: _Run) -> AuditRun:
+    """What the audit ran with: no shortcut of the perfect drive, and how much of the error cycle it swept."""
+    from .engine import audit_run
 
-    drive, settings, angles, sections, scene = run.drive, run.settings, run.angles, run.sections, run.scene
-    A, B = len(angles), run.B
+    angles = run.angles
+    A = len(angles)
     sc = shortcuts(run.imp)
-    bw = drive.design.drive.face_width
-    ends = (not drive.coned) or (min(sections) <= 1e-9 and max(sections) >= bw - 1e-9)
-    rs = {
-        "engine": "2d",
-        "angles": int(A),
-        "angle_step_deg": round(float(np.rad2deg(np.median(np.diff(angles)))), 6) if A > 1 else None,
-        "sections_z_mm": [None if z is None else round(z, 6) for z in sections],
-        "sections_note": (
-            "identical sections (no coning): one computed"
-            if not drive.coned
-            else "coned: every section computed" + ("" if ends else "; the face ends were NOT checked")
+    base = audit_run(run.drive, run.scene, run.settings, angles, run.sections)
+    imp = ImperfectRun(
+        generator_turns=float(
+            (angles[-1] - angles[0]) / (2 * pi) + (np.median(np.diff(angles)) / (2 * pi) if A > 1 else 0.0)
         ),
-        "face_ends_checked": bool(ends),
-        "mesh_period": False,
-        "identical_waves": False,
-        "mirror_symmetry": False,
-        "culling": bool(settings.cull),
-        "branch_and_bound": bool(settings.bound),
-        "imperfections": True,
-        "generator_turns": round(
-            float((angles[-1] - angles[0]) / (2 * pi) + (np.median(np.diff(angles)) / (2 * pi) if A > 1 else 0.0)), 6
-        ),
-        "full_cycle_turns": int(full_cycle_turns(drive.design.drive.z_flex, drive.design.drive.z_rigid)),
-        "shortcuts_that_hold": {
-            k2: sc[k2] for k2 in ("mesh_period", "identical_waves", "mirror_symmetry", "one_generator_turn")
+        full_cycle_turns=int(full_cycle_turns(run.drive.design.drive.z_flex, run.drive.design.drive.z_rigid)),
+        shortcuts_that_hold={
+            k: sc[k] for k in ("mesh_period", "identical_waves", "mirror_symmetry", "one_generator_turn")
         },
-        "shortcuts_note": (
-            "imperfect parts: every (generator angle, tooth, section) sample posed with its errors, "
-            f"in chunks of {B} generator angles; bounds only along a tooth's track ({sc['why']})"
-        ),
-        **accuracy_settings(drive, settings.refine),
-        "working_flank": scene.working,
-        "rigid_pitch_radius_mm": drive.rigid.r,
-    }
-    rs["entry_side"] = "entry (+phi)" if scene.entry_sign > 0 else "entry (-phi)"
-    return rs
+        why=sc["why"],
+        chunk=int(run.B),
+    )
+    return replace(base, mesh_period=False, identical_waves=False, mirror_symmetry=False, imperfect=imp)
 
 
 def _entry_findings(run: _Run, gaps, ent: dict):

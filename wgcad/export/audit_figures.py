@@ -30,8 +30,8 @@ def audit_plot_data(drive, result) -> dict:
     from ..report.audit import audit_json
 
     scene = Scene(drive)
-    imperfect = bool(result.settings.get("imperfections"))
-    secs = [None] if not drive.coned else [s for s in result.settings["sections_z_mm"]]
+    imperfect = result.settings.imperfect is not None
+    secs = [None] if not drive.coned else list(result.settings.sections)
     prof = clearance_profile(scene, secs)
     doc = audit_json(result)
     name = drive.design.drive.name
@@ -113,7 +113,7 @@ def _vs_angle(drive, result, scene, prof, secs, imperfect: bool) -> tuple:
                 [1e3 * g for g in ent["perfect_gaps"]],
                 1e3 * result.interference_tol,
                 f"{name}: entry gap of every passage of a tooth through the entry, imperfect parts "
-                f"({result.settings.get('generator_turns', 1):g} generator turn(s); the audit's smallest is refined on the exact curves)",
+                f"({round(result.settings.imperfect.generator_turns, 6) if imperfect else 1:g} generator turn(s); the audit's smallest is refined on the exact curves)",
             ),
         )
     perfect_note = " (perfect drive)" if imperfect else ""

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["audit_json", "audit_summary", "worst_json", "entry_json", "backlash_at_json"]
+__all__ = ["audit_json", "audit_summary", "worst_json", "entry_json", "backlash_at_json", "settings_json"]
 
 
 def _deg(x, nd=6):
@@ -114,11 +114,76 @@ def backlash_at_json(f) -> dict:
     return {"generator_angle_deg": _deg(f.generator_angle), "section_z_mm": _z(f.section_z)}
 
 
+def _accuracy(run) -> dict:
+    """The settings entries that say how exact an audit's figures are."""
+    from wgcad import constants
+
+    return {
+        "chord_tol_um": round(1e3 * run.chord_tol, 6),
+        "refined": run.refined,
+        "refine_tol_um": round(1e3 * constants.REFINE_TOL, 6) if run.refined else None,
+        "error_side": (
+            "figures on the exact curves, within refine_tol_um either side"
+            if run.refined
+            else "polygon figures: chords lie inside convex and outside concave curve parts, "
+            "so each figure is within 2 x chord_tol_um of the exact one, either side"
+        ),
+    }
+
+
+def settings_json(run) -> dict:
+    """What an audit ran with (:class:`~wgcad.clearance.findings.AuditRun`) as its JSON document states it."""
+    A = len(run.angles)
+    ends = run.face_ends_checked
+    out = {
+        "engine": "2d",
+        "angles": int(A),
+        "angle_step_deg": round(float(np.rad2deg(np.median(np.diff(run.angles)))), 6) if A > 1 else None,
+        "sections_z_mm": [None if z is None else round(z, 6) for z in run.sections],
+        "sections_note": (
+            "identical sections (no coning): one computed"
+            if not run.coned
+            else "coned: every section computed" + ("" if ends else "; the face ends were NOT checked")
+        ),
+        "face_ends_checked": bool(ends),
+        "mesh_period": run.mesh_period,
+        "identical_waves": run.identical_waves,
+        "mirror_symmetry": run.mirror_symmetry,
+        "culling": run.culling,
+        "branch_and_bound": run.branch_and_bound,
+    }
+    side = "entry (+phi)" if run.entry_sign > 0 else "entry (-phi)"
+    imp = run.imperfect
+    if imp is None:
+        out.update(_accuracy(run))
+        out.update(
+            {"working_flank": run.working_flank, "entry_side": side, "rigid_pitch_radius_mm": run.rigid_pitch_radius}
+        )
+        return out
+    out.update(
+        {
+            "imperfections": True,
+            "generator_turns": round(imp.generator_turns, 6),
+            "full_cycle_turns": imp.full_cycle_turns,
+            "shortcuts_that_hold": dict(imp.shortcuts_that_hold),
+            "shortcuts_note": (
+                "imperfect parts: every (generator angle, tooth, section) sample posed with its errors, "
+                f"in chunks of {imp.chunk} generator angles; bounds only along a tooth's track ({imp.why})"
+            ),
+        }
+    )
+    out.update(_accuracy(run))
+    out.update(
+        {"working_flank": run.working_flank, "rigid_pitch_radius_mm": run.rigid_pitch_radius, "entry_side": side}
+    )
+    return out
+
+
 def audit_json(result) -> dict:
     """The JSON document of an :class:`~wgcad.clearance.engine.AuditResult` (units in the key names)."""
     r = result
     f = r.findings
-    r_b = r.settings["rigid_pitch_radius_mm"]
+    r_b = r.settings.rigid_pitch_radius
     finite_bl = np.isfinite(r.backlash)
     return {
         "min_clearance_um": round(1e3 * r.min_clearance, 4),
@@ -131,7 +196,7 @@ def audit_json(result) -> dict:
         "interference_tol_um": round(1e3 * r.interference_tol, 4),
         "worst": worst_json(f["min_clearance"]),
         "entry": entry_json(f["entry_gap"], f.get("entry_crossing", f["entry_gap"]), f["entry_pinch"], r.entry_side),
-        "settings": r.settings,
+        "settings": settings_json(r.settings),
         "counts": r.counts,
         "elapsed_s": round(r.elapsed_s, 4),
     }
