@@ -86,7 +86,7 @@ def backlash(scene: Scene, phi_h: float, z=None, exact: bool = False) -> float:
         if d.min() < 0:
             return float("nan")  # teeth interfere here: there is no dead travel (no need to look further)
         sides.append((idx, direction, d))
-    total = 0.0
+    bests, angles = [], []
     for idx, direction, d in sides:
         order = np.argsort(d)
         best = np.inf
@@ -103,42 +103,55 @@ def backlash(scene: Scene, phi_h: float, z=None, exact: bool = False) -> float:
                 else contact_angle(int(i), int(idx[i]), direction)
             )
             best = min(best, angle[int(i)])
-        if exact and np.isfinite(best):
-            best = _exact_side(scene, turned, idx, direction, d, angle, best, gap)
-        total += best
-    return float(total)
+        bests.append(best)
+        angles.append(angle)
+    if exact:
+        bests = _exact_sides(scene, turned, sides, angles, bests, gap)
+    return float(sum(bests))
 
 
-def _exact_side(scene, turned, idx, direction, d, angle, best, gap) -> float:
-    """The smallest contact rotation of one side on the exact curves, from the polygon's.
+def _exact_sides(scene, turned, sides, angles, bests, gap) -> list:
+    """The smallest contact rotation of each side on the exact curves, from the polygon's.
 
     A tooth's polygon root ``a_i`` and its exact root differ by about
     ``gap / s_i``, with ``s_i ~ d_i / a_i`` the clearance's mean slope from
     no rotation to contact; every tooth whose root can then be the smallest
     is solved by Newton on the exact clearance (``Scene.exact_to``; the
-    derivative by a 1e-9 rad difference), all in one batch per step.
+    derivative by a 1e-9 rad difference), both sides in one batch per step
+    (a refinement's cost is per call more than per pair).
     """
-    rows = np.array([i for i, a in angle.items() if np.isfinite(a)], dtype=int)
-    a = np.array([angle[i] for i in rows])
-    with np.errstate(divide="ignore", invalid="ignore"):
-        slope = np.where(a > 0, np.maximum(d[rows] / a, 1e-12), np.inf)
-    j = int(np.argmin(a))
-    keep = a - 2.0 * gap / slope <= a[j] + 2.0 * gap / slope[j]
-    rows, x = rows[keep], a[keep].copy()
+    rows, dirs, rigid, x, side_of = [], [], [], [], []
+    for k, ((idx, direction, d), angle, best) in enumerate(zip(sides, angles, bests)):
+        if not np.isfinite(best):
+            continue
+        r = np.array([i for i, a in angle.items() if np.isfinite(a)], dtype=int)
+        a = np.array([angle[i] for i in r])
+        with np.errstate(divide="ignore", invalid="ignore"):
+            slope = np.where(a > 0, np.maximum(d[r] / a, 1e-12), np.inf)
+        j = int(np.argmin(a))
+        keep = a - 2.0 * gap / slope <= a[j] + 2.0 * gap / slope[j]
+        rows.append(r[keep])
+        dirs.append(np.full(int(keep.sum()), direction))
+        rigid.append(idx[r[keep]])
+        x.append(a[keep].copy())
+        side_of.append(np.full(int(keep.sum()), k))
+    if not rows:
+        return list(bests)
+    rows, dirs, rigid, x, side_of = (np.concatenate(v) for v in (rows, dirs, rigid, x, side_of))
 
-    def f(rows_, x_):
-        r, sh = turned(rows_, direction * x_)
-        return scene.exact_to(r, sh, idx[rows_])[0]
+    def f(sel, x_):
+        r, sh = turned(rows[sel], dirs[sel] * x_)
+        return scene.exact_to(r, sh, rigid[sel])[0]
 
     h = 1e-9
     live = np.arange(len(rows))
     for _ in range(8):
         if live.size == 0:
             break
-        both = f(np.concatenate([rows[live], rows[live]]), np.concatenate([x[live], x[live] + h]))
+        both = f(np.concatenate([live, live]), np.concatenate([x[live], x[live] + h]))
         f0, f1 = both[: live.size], both[live.size :]
         step = f0 / np.where(f1 != f0, (f1 - f0) / h, np.inf)
         x[live] -= step
         # 1e-10 mm from contact is ~1e-11 rad of turn on these levers (> 10 mm): far below 1e-3 arcsec
         live = live[(np.abs(f0) > 1e-10) & (np.abs(step) > 1e-13)]
-    return float(x.min())
+    return [float(x[side_of == k].min()) if np.any(side_of == k) else bests[k] for k in range(len(bests))]
