@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import time
 from dataclasses import dataclass, field, replace
+from typing import NamedTuple
 
 import numpy as np
 
@@ -308,7 +309,9 @@ def solve_load(
             break
         if state.settled_after(change, tol):
             break
-        state.advance(it, change, tol, loads_new, sol.a, F[:Z], F_t_new, keys, F[Z:] > 0)
+        active = np.zeros(n_keys, dtype=bool)
+        active[keys] = F[Z:] > 0
+        state.advance(it, change, tol, _Plain(loads_new, sol.a, F[:Z], F_t_new, active))
     else:
         raise ContactSolveError(
             f"the elastic model did not converge at {torque_nm:g} N m: tooth positions still moving by "
@@ -358,10 +361,10 @@ class _Iterate:
         self.relaxed = self.settled >= 3
         return self.relaxed
 
-    def advance(self, it, change, tol, loads_new, rigid_new, F_ball_new, F_teeth_new, keys, loaded) -> None:
-        """The next iterate: Anderson-accelerated, or under-relaxed once the plain iteration stops contracting (the
-        exact gaps are piecewise smooth in the poses, polygon vertices, which can leave a 2-cycle of sub-micrometre
-        amplitude)."""
+    def advance(self, it: int, change: float, tol: float, plain: _Plain) -> None:
+        """The next iterate from the linearisation's solution ``plain``: Anderson-accelerated, or under-relaxed once
+        the plain iteration stops contracting (the exact gaps are piecewise smooth in the poses, polygon vertices,
+        which can leave a 2-cycle of sub-micrometre amplitude)."""
         cycling = it >= 5 and change > 0.95 * self.last_change  # a cycle, not a slow contraction
         # once relaxing: a step not yet settled while the change does not halve per pass relaxes further
         # (a 2-cycle's change stays near its amplitude; halving only on the passes where it grows took twice the passes)
@@ -372,16 +375,25 @@ class _Iterate:
         self.last_change = change
         w = self.omega
         if w < 1.0:
-            self.loads = (1 - w) * self.loads + w * loads_new
-            self.rigid = (1 - w) * self.rigid + w * rigid_new
-            self.F_ball = (1 - w) * self.F_ball + w * F_ball_new
-            self.F_teeth = (1 - w) * self.F_teeth + w * F_teeth_new
+            self.loads = (1 - w) * self.loads + w * plain.loads
+            self.rigid = (1 - w) * self.rigid + w * plain.rigid
+            self.F_ball = (1 - w) * self.F_ball + w * plain.F_ball
+            self.F_teeth = (1 - w) * self.F_teeth + w * plain.F_teeth
         else:
-            self.loads, self.rigid = self.acc.step(self.loads, self.rigid, loads_new, rigid_new, change)
-            self.F_ball = F_ball_new.copy()
-            self.F_teeth = F_teeth_new
-        self.active = np.zeros(len(self.active), dtype=bool)
-        self.active[keys] = loaded
+            self.loads, self.rigid = self.acc.step(self.loads, self.rigid, plain.loads, plain.rigid, change)
+            self.F_ball = plain.F_ball.copy()
+            self.F_teeth = plain.F_teeth
+        self.active = plain.active
+
+
+class _Plain(NamedTuple):
+    """The linearisation's solution as the next iterate of the plain fixed-point iteration."""
+
+    loads: np.ndarray
+    rigid: np.ndarray
+    F_ball: np.ndarray
+    F_teeth: np.ndarray
+    active: np.ndarray
 
 
 def _start(model: ElasticModel, e: np.ndarray, warm: LoadState | None):
