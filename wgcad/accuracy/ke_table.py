@@ -220,51 +220,63 @@ def _first_contacts(lat: _Lattice, engaged, side: int):
     con = closing_rotation(lat.flex, rot[idx], shift[idx], lat.rigid, rb, np.zeros((len(idx), 2)), side, lat.reach)
     good = con.ok & (np.hypot(con.nt[:, 0], con.nt[:, 1]) * drive.rigid.r <= NT_MAX)
     k = np.nonzero(good)[0]
-    rows = _rows(con, k, idx, rot, shift, drot, dshift, lat.m_all, j, cz, side, np.zeros(len(k)))
-    return rows, (rows, k, idx, rot, shift, drot, dshift, j, cz, rb)
+    poses = _Poses(idx, rot, shift, drot, dshift, lat.m_all, j, cz)
+    rows = _rows(con, k, poses, side, np.zeros(len(k)))
+    return rows, _Solved(rows, k, poses, rb)
 
 
 def _more_features(lat: _Lattice, tab: ContactTable, imp: Imperfections, side: int, pending: list, exhaustive: bool):
     """The second features of the pairs of one side that can be first (:func:`_second_features`), as table rows."""
     out = []
     keep = (
-        np.ones(sum(len(x[1]) for x in pending), dtype=bool)
+        np.ones(sum(len(x.k) for x in pending), dtype=bool)
         if exhaustive
         else _can_be_first(tab, side, imp, pending, lat.flex, lat.rigid)
     )
     at = 0
-    for rows, k, idx, rot, shift, drot, dshift, j, cz, rb in pending:
-        sub = np.nonzero(keep[at : at + len(k)])[0]
-        at += len(k)
-        rho = cz * (imp.cam_flex + imp.cam_fixed) + imp.flex_ecc + imp.rigid_ecc
+    for sv in pending:
+        sub = np.nonzero(keep[at : at + len(sv.k)])[0]
+        at += len(sv.k)
+        rho = sv.poses.cz * (imp.cam_flex + imp.cam_fixed) + imp.flex_ecc + imp.rigid_ecc
         if rho > 0.0 and sub.size:
-            out.extend(
-                _second_features(
-                    lat.flex,
-                    lat.rigid,
-                    {key: v[sub] for key, v in rows.items()},
-                    k[sub],
-                    idx,
-                    rot,
-                    shift,
-                    drot,
-                    dshift,
-                    lat.m_all,
-                    j,
-                    cz,
-                    side,
-                    rb,
-                    rho,
-                    lat.reach,
-                    lat.drive.rigid.r,
-                    warm=not exhaustive,
-                )
-            )
+            out.extend(_second_features(lat, sv, sub, side, rho, warm=not exhaustive))
     return out
 
 
-def _rows(con, k, idx, rot, shift, drot, dshift, m_all, j, cz, side, extra):
-    """Table rows of contacts ``k`` of a closing-rotation solve (poses ``rot``, ``shift`` indexed by ``idx[k]``)."""
+@dataclass
+class _Poses:
+    """Tooth pairs of the lattice: ``idx`` the lattice points (into ``rot``, ``shift``: the lattice's poses), and per
+    pair the pose's derivatives along the rim (``drot``, ``dshift``), the rigid tooth ``j``; the lattice indices
+    ``m_all`` and the section's coning factor ``cz``."""
+
+    idx: np.ndarray
+    rot: np.ndarray
+    shift: np.ndarray
+    drot: np.ndarray
+    dshift: np.ndarray
+    m_all: np.ndarray
+    j: np.ndarray
+    cz: float
+
+    def take(self, k) -> _Poses:
+        """The pairs ``k``."""
+        return _Poses(self.idx[k], self.rot, self.shift, self.drot[k], self.dshift[k], self.m_all, self.j[k], self.cz)
+
+
+@dataclass
+class _Solved:
+    """One section's and side's first contacts: their table rows, which engaged pairs they are (``k``, into
+    ``poses``), and the rigid teeth's angles ``rb`` of the engaged pairs."""
+
+    rows: dict
+    k: np.ndarray
+    poses: _Poses
+    rb: np.ndarray
+
+
+def _rows(con, k, poses: _Poses, side: int, extra):
+    """Table rows of contacts ``k`` of a closing-rotation solve of the pairs ``poses``."""
+    idx, rot, shift, drot, dshift, j = poses.idx, poses.rot, poses.shift, poses.drot, poses.dshift, poses.j
     t = side * con.delta[k]
     ct, st = np.cos(t), np.sin(t)
     sh = np.stack([ct * shift[idx[k], 0] - st * shift[idx[k], 1], st * shift[idx[k], 0] + ct * shift[idx[k], 1]], -1)
@@ -273,14 +285,14 @@ def _rows(con, k, idx, rot, shift, drot, dshift, m_all, j, cz, side, extra):
     dP = drot[k, None] * np.stack([-(p[:, 1] - sh[:, 1]), p[:, 0] - sh[:, 0]], -1) + ds
     rr = rot[idx[k]] + t
     return {
-        "m": m_all[idx[k]],
+        "m": poses.m_all[idx[k]],
         "g": con.delta[k],
         "nt": nt,
         "a_phi": np.einsum("ij,ij->i", dP, nt),
         "a_rho": np.cos(rr) * nt[:, 0] + np.sin(rr) * nt[:, 1],
         "a_beta": -q[:, 1] * nt[:, 0] + q[:, 0] * nt[:, 1],
         "j": j[k],
-        "c": np.full(len(k), cz),
+        "c": np.full(len(k), poses.cz),
         "dP": dP,
         "rr": rr,
         "q": q,
@@ -318,15 +330,13 @@ def _can_be_first(tab: ContactTable, side: int, imp: Imperfections, pending, fle
     """
     if not pending:
         return np.zeros(0, dtype=bool)
-    g = np.concatenate([r["g"] for r, *_ in pending])
-    m = np.concatenate([r["m"] for r, *_ in pending])
-    c = np.concatenate([r["c"] for r, *_ in pending])
-    ntn = np.concatenate([np.hypot(*r["nt"].T) for r, *_ in pending])
+    g = np.concatenate([sv.rows["g"] for sv in pending])
+    m = np.concatenate([sv.rows["m"] for sv in pending])
+    c = np.concatenate([sv.rows["c"] for sv in pending])
+    ntn = np.concatenate([np.hypot(*sv.rows["nt"].T) for sv in pending])
     # a second feature's contact point is on the tooth moved radially by up to the reach
     arm = float(np.hypot(*flex.local.T).max()) + imp.flex_ecc + imp.rigid_ecc + imp.cam_flex + imp.cam_fixed
-    speed = np.concatenate(
-        [np.hypot(*dshift[k].T) + np.abs(drot[k]) * arm for _, k, _, _, _, drot, dshift, *_ in pending]
-    )
+    speed = np.concatenate([np.hypot(*sv.poses.dshift[sv.k].T) + np.abs(sv.poses.drot[sv.k]) * arm for sv in pending])
     q_max = float(np.hypot(*rigid.local.T).max())
     A_b = 0.5 * imp.rigid_runout / tab.r_b
     A_a = (0.5 * imp.flex_runout + imp.flex_ecc) / tab.r_g
@@ -347,10 +357,9 @@ _RADIAL_STEPS = (-0.25, 0.25, -0.5, 0.5, -1.0, 1.0)
 _LINE_TOL = 0.01 / ARCSEC_PER_RAD
 
 
-def _second_features(
-    flex, rigid, rows, k, idx, rot, shift, drot, dshift, m_all, j, cz, side, rb, rho, reach, r_b, warm=True
-):
-    """Contacts on the features a pair touches once the errors move its flexspline tooth radially by up to ``rho``.
+def _second_features(lat: _Lattice, sv: _Solved, sub, side: int, rho: float, warm: bool = True):
+    """Contacts on the features pairs ``sub`` of ``sv`` touch once the errors move their flexspline teeth radially by
+    up to ``rho``.
 
     Where the tooth space is locally convex (a tip running from the other's
     flank into its root fillet), the closing rotation is the smaller of the
@@ -362,30 +371,23 @@ def _second_features(
     where a corner turns the other way the smaller rotation would be wrong).
     """
     out = []
+    rows = {key: v[sub] for key, v in sv.rows.items()}
+    k, P = sv.k[sub], sv.poses
+    r_b = lat.drive.rigid.r
 
     def solve(f, kk):
-        ii = idx[k[kk]]
-        sh = shift[ii] + f * rho * np.stack([np.cos(rot[ii]), np.sin(rot[ii])], -1)
+        pk = P.take(k[kk])
+        ii = pk.idx
+        sh = P.shift[ii] + f * rho * np.stack([np.cos(P.rot[ii]), np.sin(P.rot[ii])], -1)
         # started 1 um of gap before where the pair's own line puts the moved contact (as _refine): a Newton
         # step or two when the feature stays, a bracket and a few steps when it changes
         start = rows["g"][kk] - f * rho * rows["a_rho"][kk] - _FD_START * np.hypot(*rows["nt"][kk].T) if warm else None
         with np.errstate(invalid="ignore"):
-            c2 = closing_rotation(flex, rot[ii], sh, rigid, rb[k[kk]], np.zeros((len(kk), 2)), side, reach, start=start)
-            c2.delta = np.where(c2.ok, c2.delta, 0.0)
-            r2 = _rows(
-                c2,
-                np.arange(len(kk)),
-                ii,
-                rot,
-                shift,
-                drot[k[kk]],
-                dshift[k[kk]],
-                m_all,
-                j[k[kk]],
-                cz,
-                side,
-                np.ones(len(kk)),
+            c2 = closing_rotation(
+                lat.flex, P.rot[ii], sh, lat.rigid, sv.rb[k[kk]], np.zeros((len(kk), 2)), side, lat.reach, start=start
             )
+            c2.delta = np.where(c2.ok, c2.delta, 0.0)
+            r2 = _rows(c2, np.arange(len(kk)), pk, side, np.ones(len(kk)))
         return c2, r2
 
     # the full reach first, every pair: those whose closing rotation there is off the perfect contact's
