@@ -221,3 +221,21 @@ def test_a_conjugate_rigid_gear_is_built_once_per_design_and_tolerance():
     drive_mod._CONJUGATES.clear()
     fresh = build_drive(d)
     assert fresh.rigid is not a.rigid and np.array_equal(fresh.rigid.period, a.rigid.period)
+
+
+def test_a_conjugate_drive_sampled_finer_keeps_its_exact_curves():
+    """The audit's finer polygons (a flat minimum sorted out at a chord tolerance 8 times smaller) sample the same
+    conjugate flank as the drive's own: its exact pieces are kept (not enveloped again at the finer tolerance) and
+    every point of them lies within the finer tolerance of the finer polygon."""
+    import shapely
+
+    d = build_drive(load_design(TEMPLATES / "d1_conjugate.toml"))
+    fine = d.sampled_at(d.tol / 8)
+    assert fine.rigid.pieces is d.rigid.pieces and fine.rigid.tol == d.tol / 8
+    assert len(fine.rigid.period) > len(d.rigid.period)
+    pts = np.vstack([p.point(np.linspace(p.t0, p.t1, 400)) for p in d.rigid.pieces])
+    gap = shapely.distance(shapely.LineString(fine.rigid.period), shapely.points(pts))
+    # the pieces span a mirrored pitch; the period polygon runs -pi/z .. pi/z: the points on it are within tol / 8
+    on = np.abs(np.arctan2(pts[:, 1], pts[:, 0])) <= np.pi / d.rigid.spec.z
+    assert on.sum() > 1000 and gap[on].max() <= fine.rigid.tol * (1 + 1e-9)
+    assert gap[on].max() > d.tol / 100  # the polygon is a sampling, not the curve: the test sees its chords

@@ -140,6 +140,11 @@ class Drive:
             return 1e-3 * float(fs.face_taper_um_per_mm)
         return 0.0
 
+    def sampled_at(self, tol: float) -> Drive:
+        """This drive with its outlines sampled at chord tolerance ``tol``: the same exact curves (a conjugate rigid
+        gear's pieces sampled anew, its flank not enveloped again at that tolerance)."""
+        return build_drive(self.design, tol=tol, rigid_gear=self.rigid.sampled_at(tol))
+
     def with_face_taper(self, taper_um_per_mm: float) -> Drive:
         """This drive with its flexspline's teeth offset linearly along the face (``face_modification = 'linear'``).
 
@@ -195,8 +200,12 @@ def build_drive(
     *,
     max_memory_mb: float | None = DEFAULT_MAX_MEMORY_MB,
     run: dict | None = None,
+    rigid_gear: Gear | None = None,
 ) -> Drive:
     """Build both gears and the deformation law, checking the derived geometry.
+
+    ``rigid_gear``: a conjugate design's rigid gear, already enveloped (:meth:`Drive.sampled_at`: the same curves at
+    another tolerance); without it the envelope is built (once per design and tolerance in a process).
 
     Before any outline is sampled the run is estimated
     (:func:`wgcad.design.budget.estimate_run`, with ``run`` its audit and
@@ -254,7 +263,7 @@ def build_drive(
     if drive.face_taper:  # the centre section's law carries its teeth's offset like every other section's
         drive = replace(drive, law=replace(law, tooth_offset=drive.tooth_offset(None)))
     if design.rigid.flanks == "conjugate":
-        drive = _conjugate(drive)
+        drive = replace(drive, rigid=rigid_gear) if rigid_gear is not None else _conjugate(drive)
     return drive
 
 

@@ -317,9 +317,8 @@ def _refine(drive, scene: Scene, phi_sorted, sections, cands, settings: AuditSet
 
         def fine(idx):
             # many samples within the polygon-curve margin (a flat minimum): polygons FINE times finer
-            from ..drive import build_drive
 
-            ref_scene = Scene(build_drive(drive.design, tol=drive.tol / FINE))
+            ref_scene = Scene(drive.sampled_at(drive.tol / FINE))
             vals = _chunked(
                 lambda sl: tooth_clearance_sections(ref_scene, phi_sorted[cand_i[idx[sl]]], cand_s[idx[sl]], sections),
                 len(idx),

@@ -345,9 +345,8 @@ def _refine(run: _Run, found: _Found) -> tuple[float, int, int, int]:
         return found.best, int(np.argsort(found.v, kind="stable")[0]), 0, 0
 
     def fine(idx):
-        from ..drive import build_drive
 
-        ref = ImperfectScene.from_scene(Scene(build_drive(run.drive.design, tol=run.drive.tol / FINE)), run.imp)
+        ref = ImperfectScene.from_scene(Scene(run.drive.sampled_at(run.drive.tol / FINE)), run.imp)
         rot, shift = run.poses(found.a[idx], found.k[idx], found.s[idx])
         # in batches: a candidate on the finer polygons holds ~18 kB while measured, and their number
         # grows with the sampling density (2900 at 0.05 deg on D1 [S4])

@@ -149,43 +149,48 @@ def conjugate_rigid_gear(drive, z: float | None = None, clearance: float = 0.0) 
         raise ValueError("the conjugate flank reaches past the middle of the space: the rigid teeth would be pointed")
     hp.append(pc.arc((0.0, 0.0), r_f, float(a_up[-1]), half))
     pieces = tuple(pc.merge_arcs(pc.mirror_path(hp) + hp))
-    # the polylines of the outline, within the drive's tolerance like every other gear's: arcs by their sagitta,
-    # the flank's exact points thinned (Douglas-Peucker to half the tolerance); the pieces keep every point
-    import shapely
-
-    tol = drive.tol
-
-    def arc_pts(r, a0, a1):
-        n = max(2, int(np.ceil(abs(a1 - a0) * r / np.sqrt(8.0 * r * tol))) + 1)
-        a = np.linspace(a0, a1, n)
-        return r * np.stack([np.cos(a), np.sin(a)], -1)
-
+    spec = replace(rg.spec, form="conjugate", tip_radius=r_a)
     flank = np.vstack([tip_pt, up]) if np.hypot(*(up[0] - tip_pt)) > 1e-12 else up
-    flank = np.asarray(shapely.LineString(flank).simplify(0.5 * tol).coords)
-    root = arc_pts(r_f, a_up[-1], half)  # from the radial wall's foot (it starts at root_pt, not at the flank)
-    half_period = np.concatenate([arc_pts(r_a, 0.0, a_up[0])[:-1], flank, root])
-    keep = np.concatenate([[True], np.hypot(*np.diff(half_period, axis=0).T) > 1e-9])
-    half_period = half_period[keep]
-    mirror = half_period[::-1] * np.array([1.0, -1.0])
-    period = np.concatenate([mirror, half_period[1:]])
-    gamma = 2.0 * pi / zr
-    k = np.arange(zr)[:, None]
-    ang = np.arctan2(period[:-1, 1], period[:-1, 0])[None, :] + k * gamma + rg.spec.phase
-    rad = np.hypot(period[:-1, 0], period[:-1, 1])[None, :]
-    outline = np.stack([rad * np.cos(ang), rad * np.sin(ang)], -1).reshape(-1, 2)
-    for arr in (half_period, period, outline):
-        arr.setflags(write=False)
-    gear = Gear(
-        replace(rg.spec, form="conjugate", tip_radius=r_a),
-        rg.r,
-        r_a,
-        r_f,
-        None,
-        float(2.0 * r_a * a_up[0]),
-        half_period,
-        period,
-        outline,
-        tol,
-        pieces,
-    )
+
+    def sampled(tol: float) -> Gear:
+        # the polylines of the outline, within ``tol`` like every other gear's: arcs by their sagitta, the flank's
+        # exact points thinned (Douglas-Peucker to half the tolerance); the pieces keep every point. A finer copy
+        # (the audit's fine polygons) samples these same pieces: its flank is not enveloped again
+        import shapely
+
+        def arc_pts(r, a0, a1):
+            n = max(2, int(np.ceil(abs(a1 - a0) * r / np.sqrt(8.0 * r * tol))) + 1)
+            a = np.linspace(a0, a1, n)
+            return r * np.stack([np.cos(a), np.sin(a)], -1)
+
+        thin = np.asarray(shapely.LineString(flank).simplify(0.5 * tol).coords)
+        root = arc_pts(r_f, a_up[-1], half)  # from the radial wall's foot (it starts at root_pt, not at the flank)
+        half_period = np.concatenate([arc_pts(r_a, 0.0, a_up[0])[:-1], thin, root])
+        keep = np.concatenate([[True], np.hypot(*np.diff(half_period, axis=0).T) > 1e-9])
+        half_period = half_period[keep]
+        mirror = half_period[::-1] * np.array([1.0, -1.0])
+        period = np.concatenate([mirror, half_period[1:]])
+        gamma = 2.0 * pi / zr
+        k = np.arange(zr)[:, None]
+        ang = np.arctan2(period[:-1, 1], period[:-1, 0])[None, :] + k * gamma + rg.spec.phase
+        rad = np.hypot(period[:-1, 0], period[:-1, 1])[None, :]
+        outline = np.stack([rad * np.cos(ang), rad * np.sin(ang)], -1).reshape(-1, 2)
+        for arr in (half_period, period, outline):
+            arr.setflags(write=False)
+        return Gear(
+            spec,
+            rg.r,
+            r_a,
+            r_f,
+            None,
+            float(2.0 * r_a * a_up[0]),
+            half_period,
+            period,
+            outline,
+            tol,
+            pieces,
+            resample=sampled,
+        )
+
+    gear = sampled(drive.tol)
     return gear, cf

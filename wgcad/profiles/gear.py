@@ -97,6 +97,14 @@ class Gear:
     pieces: tuple = field(default=(), repr=False)
     #: radii (lo, hi) between which the outline is flank, where the form has no closed form for them (double arc)
     flank_radii: tuple | None = None
+    #: ``resample(tol)``: this gear's exact pieces sampled at another chord tolerance, where the pieces are not the
+    #: spec's alone (a conjugate gear's flank comes from an envelope: :meth:`sampled_at`)
+    resample: object = field(default=None, repr=False, compare=False)
+
+    def sampled_at(self, tol: float) -> Gear | None:
+        """The same exact curves sampled at chord tolerance ``tol``; None where the spec rebuilds them
+        (:func:`make_gear` at ``tol``)."""
+        return None if self.resample is None else self.resample(tol)
 
     def outline_pieces(self) -> list:
         """The exact pieces of the whole :attr:`outline` (``z`` pitches turned by ``k 2 pi/z + phase``), in its order."""
