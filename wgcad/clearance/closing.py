@@ -108,7 +108,10 @@ class _Pairs:
         self.shift = np.asarray(shift, dtype=float).reshape(K, 2)
         self.rot_b = np.broadcast_to(np.asarray(rot_b, dtype=float), (K,))
         self.shift_b = np.asarray(shift_b, dtype=float).reshape(K, 2)
-        self.rigid_g = shapely.polygons(transform(rigid.local, self.rot_b, self.shift_b))
+        # the rigid teeth: a few hundred distinct poses among thousands of pairs, each built once (the geometries are
+        # immutable and shared by the pairs that face the same tooth)
+        poses, inv = np.unique(np.column_stack([self.rot_b, self.shift_b]), axis=0, return_inverse=True)
+        self.rigid_g = shapely.polygons(transform(rigid.local, poses[:, 0], poses[:, 1:]))[inv.ravel()]
         #: the largest distance of a flexspline outline point from the axis, mm
         self.lever = (
             float(np.hypot(self.shift[:, 0], self.shift[:, 1]).max() + np.hypot(*flex.local.T).max()) if K else 1.0
