@@ -248,7 +248,7 @@ def main(argv=None) -> int:
     md += [
         "",
         'Whole-process goals (issue 22): each command against a bare `python -c "import numpy, shapely"` in the same '
-        "run (best of N wall; the parts run best of 3, its peak the largest resident size of those runs)",
+        "run (best of N wall, the parts run best of 3; peak: one more run under GNU time)",
         "",
         "| command | whole process, s | CPU, s | x bare import | peak, MiB | goal | met |",
         "|---|---|---|---|---|---|---|",
