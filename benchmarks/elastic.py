@@ -129,7 +129,7 @@ def main() -> int:
                 ),
                 ("  of which contact geometry", geo, None, None),
                 ("  of which compliance and solver", sol, None, None),
-                ("  of which entry gaps and summaries", sw.summary_s, None, None),
+                ("  of which entry gaps and the mounted state", sw.summary_s, None, None),
             ]
             res[f"sweep_{e_um:g}um"] = {
                 "s": t_sweep,
