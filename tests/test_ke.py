@@ -358,7 +358,7 @@ def test_pruned_table_gives_the_exhaustive_ke(name, scale, pruned):
 
 @pytest.mark.parametrize("name", ["d2_imperfect", "d4_discrete"])
 def test_lanes_drop_only_contacts_that_are_never_first(name, monkeypatch):
-    # _lanes keeps per lattice class the candidates that can be first, from a bound that compares each contact
+    # candidate_lanes keeps per lattice class the candidates that can be first, from a bound that compares each contact
     # with its group's best through both contacts' sensitivities (second features included). The KE with
     # every contact of the class as a candidate must be the same, sample by sample.
     drive = build_drive(load_design(TEMPLATES / f"{name}.toml"))
@@ -388,9 +388,9 @@ def test_lanes_drop_only_contacts_that_are_never_first(name, monkeypatch):
             out[r, : len(x)] = x
         return out
 
-    pruned = (K._lanes(tab, tab.side_w, imp) >= 0).sum()
+    pruned = (K.candidate_lanes(tab, tab.side_w, imp) >= 0).sum()
     assert pruned < 0.5 * (every(tab, tab.side_w, imp) >= 0).sum()  # the lanes do drop most contacts
-    monkeypatch.setattr(K, "_lanes", every)
+    monkeypatch.setattr(K, "candidate_lanes", every)
     b = K.kinematic_error(drive, imp, table=tab, samples=I)
     np.testing.assert_array_equal(a.delta_w, b.delta_w)
     np.testing.assert_array_equal(a.delta_n, b.delta_n)
@@ -420,23 +420,23 @@ ALL_ERRORS = dict(
 def test_harmonic_form_is_the_linear_error_terms(name):
     # Every error is a first harmonic over the teeth or the generator angle, so each contact's linear terms are
     # Re(A_e . w(i)) with three waves shared by all contacts (docs/models.md 6.2); the KE evaluates them so.
-    # Held to the term-by-term formulas (_terms: tooth indices, rigid pitches and normals per sample) at
+    # Held to the term-by-term formulas (error_terms: tooth indices, rigid pitches and normals per sample) at
     # random samples, every error kind and installation angle at once, to float rounding (1e-15 rad against
     # terms of ~1e-3 rad).
-    from wgcad.accuracy.ke_table import _harmonics, _terms, harmonic_terms
+    from wgcad.accuracy.ke_lanes import error_terms, harmonic_terms, harmonics
 
     drive = build_drive(load_design(TEMPLATES / f"{name}.toml"))
     imp = Imperfections(**ALL_ERRORS)
     tab = K.contact_table(drive, imp)
     i = np.sort(np.random.default_rng(5).choice(K._record(tab), 3000, replace=False))
     for side in tab.sides:
-        lanes = K._lanes(tab, side, imp)
+        lanes = K.candidate_lanes(tab, side, imp)
         e = lanes[i % tab.N]
         pad = e < 0
         e = np.where(pad, 0, e)
         for grp in ("cam", "rigid", "flex"):
-            ref = _terms(tab, side, imp, i[:, None], e, grp)
-            got = harmonic_terms(tab, lanes, _harmonics(tab, side, imp, (grp,)), i)
+            ref = error_terms(tab, side, imp, i[:, None], e, grp)
+            got = harmonic_terms(tab, lanes, harmonics(tab, side, imp, (grp,)), i)
             assert np.abs(ref[~pad]).max() > 1e-5  # the group does act
             assert np.abs(got - ref)[~pad].max() < 1e-15
 
@@ -445,15 +445,15 @@ def test_harmonic_form_is_the_linear_error_terms(name):
 def test_lane_minimum_prunes_only_what_cannot_be_first(name):
     # lane_minimum evaluates in each block of samples only the lanes whose chord, widened by the waves' bend,
     # can come below the block's best; the minimum over every lane at every sample must be the same.
-    from wgcad.accuracy.ke_table import _harmonics, harmonic_terms, lane_minimum
+    from wgcad.accuracy.ke_lanes import harmonic_terms, harmonics, lane_minimum
 
     drive = build_drive(load_design(TEMPLATES / f"{name}.toml"))
     imp = Imperfections(**ALL_ERRORS)
     tab = K.contact_table(drive, imp)
     i = np.arange(0, 20000)
     for side in tab.sides:
-        lanes = K._lanes(tab, side, imp)
-        A = _harmonics(tab, side, imp)
+        lanes = K.candidate_lanes(tab, side, imp)
+        A = harmonics(tab, side, imp)
         g = tab.sides[side]["g"]
         e = lanes[i % tab.N]
         full = np.where(e >= 0, g[np.maximum(e, 0)] + harmonic_terms(tab, lanes, A, i), np.inf)

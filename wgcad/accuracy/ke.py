@@ -36,7 +36,7 @@ What is exploited (tested against the direct computation in tests/test_ke.py):
   with three waves shared by every contact; the first contact of a block
   of samples is sought only among the lanes whose chord over the block,
   widened by the waves' bend, can come lowest (exact:
-  :func:`wgcad.accuracy.ke_table.lane_minimum`);
+  :func:`wgcad.accuracy.ke_lanes.lane_minimum`);
 * **installation angles**: the coefficients depend on an installation
   angle ``gamma`` as ``A + X cos(gamma) + Y sin(gamma)``; ``X`` and ``Y``
   are computed once.
@@ -55,7 +55,8 @@ from ..clearance.closing import closing_direct
 from ..errors import DesignError, ModelError
 from ..kinematics import gear_ratios
 from ..placement.imperfect import Imperfections
-from .ke_table import DEFAULT_N, ContactTable, LanePlan, _harmonics, _lanes, contact_table, lane_minimum
+from .ke_lanes import LanePlan, candidate_lanes, harmonics, lane_minimum
+from .ke_table import DEFAULT_N, ContactTable, contact_table
 
 #: generator angles per pass (a few MB of temporaries per lattice class)
 _SPAN = 1 << 16
@@ -76,17 +77,17 @@ __all__ = [
 
 
 def _side_coeffs(tab, side, imp, lever):
-    """The harmonic coefficients (:func:`wgcad.accuracy.ke_table._harmonics`) of one side: of every error group but
+    """The harmonic coefficients (:func:`wgcad.accuracy.ke_lanes.harmonics`) of one side: of every error group but
     the lever's, and, with a lever, of its group at installation angles 0 and 90 deg (``X``, ``Y``)."""
     groups = tuple(g for g in ("cam", "rigid", "flex") if g != lever)
-    A = _harmonics(tab, side, imp, groups)
+    A = harmonics(tab, side, imp, groups)
     if lever is None:
         return A, None, None
     key = "rigid_install" if lever == "rigid" else "flex_install"
     return (
         A,
-        _harmonics(tab, side, imp.replace(**{key: 0.0}), (lever,)),
-        _harmonics(tab, side, imp.replace(**{key: 0.5 * pi}), (lever,)),
+        harmonics(tab, side, imp.replace(**{key: 0.0}), (lever,)),
+        harmonics(tab, side, imp.replace(**{key: 0.5 * pi}), (lever,)),
     )
 
 
@@ -155,10 +156,10 @@ def kinematic_error(
         raise DesignError("imperfections.cam_offset_cam_um", "the contact table was built for another cam-borne offset")
     I = _record(tab) if samples is None else int(samples)
     _require_contacts(tab)
-    lw, ln = _lanes(tab, tab.side_w, imp), _lanes(tab, -tab.side_w, imp)
+    lw, ln = candidate_lanes(tab, tab.side_w, imp), candidate_lanes(tab, -tab.side_w, imp)
     dw, dn = np.empty(I), np.empty(I)
     deep = np.zeros(I, dtype=bool)
-    co = {s: _harmonics(tab, s, imp) for s in (tab.side_w, -tab.side_w)}
+    co = {s: harmonics(tab, s, imp) for s in (tab.side_w, -tab.side_w)}
     for a in range(0, I, _SPAN):
         i = np.arange(a, min(I, a + _SPAN))
         for side, lanes, out in ((tab.side_w, lw, dw), (-tab.side_w, ln, dn)):
@@ -207,7 +208,10 @@ def install_angle_scan(tab: ContactTable, imp: Imperfections, angles, lever: str
     ca, sa = np.cos(ang), np.sin(ang)
     I = _record(tab)
     _require_contacts(tab)
-    lw, ln = _lanes(tab, tab.side_w, imp), _lanes(tab, -tab.side_w, imp)  # the bounds hold for every angle
+    lw, ln = (
+        candidate_lanes(tab, tab.side_w, imp),
+        candidate_lanes(tab, -tab.side_w, imp),
+    )  # the bounds hold for every angle
     hi = np.full(len(ang), -np.inf)
     lo = np.full(len(ang), np.inf)
     cw, cn = _side_coeffs(tab, tab.side_w, imp, lever), _side_coeffs(tab, -tab.side_w, imp, lever)
