@@ -174,10 +174,10 @@ def test_entry_gap_wind_up_closes_it_and_the_loaded_rim_opens_it(sweep):
 
     from wgcad.elastic.cam import mounted
     from wgcad.elastic.mesh import entry_gaps
-    from wgcad.elastic.state import _merge_loads
+    from wgcad.elastic.rim import merge_loads
 
     m = sweep["states"][0].model
-    psi0, loads0 = _merge_loads(m.tables.angles, mounted(m).loads)
+    psi0, loads0 = merge_loads(m.tables.angles, mounted(m).loads)
 
     def gaps(mod):
         return np.array(

@@ -80,11 +80,12 @@ def test_report_gaps_against_a_full_measurement(torque_nm):
     # clearance and leaves the others linearised; measuring every pair at the solved state must give the same
     # figures for the former, and for the latter exact gaps above the smallest open one (at 3000 N m no open
     # pair is measured at the solved poses before the report: it looks for the nearest first)
-    from wgcad.elastic.state import _geometry, _loads_on_table
+    from wgcad.elastic.rim import loads_on_table
+    from wgcad.elastic.state import _geometry
 
     m = _model("d1_involute")
     st = solve_load(m, torque_nm)
-    keys, gaps, _ = _geometry(m, _loads_on_table(m.tables, st.laws[0].psi, st.laws[0].loads), st.rigid)
+    keys, gaps, _ = _geometry(m, loads_on_table(m.tables, st.laws[0].psi, st.laws[0].loads), st.rigid)
     full = dict(zip(keys.tolist(), gaps))
     c = st.contacts
     tooth = np.nonzero(c["kind"] == 1)[0]
@@ -100,15 +101,15 @@ def test_report_gaps_against_a_full_measurement(torque_nm):
 
 
 def test_teeth_near_engagement_as_from_placed_tips():
-    # _poses finds the teeth whose tips reach within RADIAL_MARGIN of the rigid tip circle from |R p + s|^2
+    # tooth_poses finds the teeth whose tips reach within RADIAL_MARGIN of the rigid tip circle from |R p + s|^2
     # expanded (no placed copies): the same teeth as placing the tip vertices, and radii equal to round-off
-    from wgcad.elastic.state import RADIAL_MARGIN, _loads_on_table, _poses
+    from wgcad.elastic.rim import RADIAL_MARGIN, loads_on_table, tooth_poses
     from wgcad.placement import transform
 
     for name in ("d1_involute", "d1_cycloidal"):
         m = _model(name)
         st = solve_load(m, 3000.0)
-        rot, shift, _, _, cand = _poses(m, _loads_on_table(m.tables, st.laws[0].psi, st.laws[0].loads), st.rigid)
+        rot, shift, _, _, cand = tooth_poses(m, loads_on_table(m.tables, st.laws[0].psi, st.laws[0].loads), st.rigid)
         tips = transform(m.scene.flex_tip_local, rot, shift)
         R = np.hypot(tips[..., 0], tips[..., 1]).max(axis=1)
         assert np.array_equal(cand, np.nonzero(R >= m.scene.r_tip_b - RADIAL_MARGIN)[0])

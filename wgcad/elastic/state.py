@@ -9,13 +9,20 @@ from typing import NamedTuple
 import numpy as np
 
 from wgcad.errors import DesignError
-from wgcad.placement import pose_from_displacements
 
 from .anderson import Anderson
 from .cam import ball_rows, cam_excess, generator_torque, mounted
 from .loaded import LoadedLaw
 from .model import ElasticModel
 from .pairs import GAP_MARGIN, MeasuredPairs
+from .rim import (
+    RADIAL_MARGIN,
+    dense_loads,
+    loads_on_table,
+    merge_loads,
+    tooth_origins,
+    tooth_poses,
+)
 from .solve import ContactSolveError, solve_supported
 from .tables import Compliance
 
@@ -26,9 +33,6 @@ __all__ = ["LoadState", "solve_load", "POSITION_TOL", "RADIAL_MARGIN", "GAP_MARG
 #: The gaps are exact for the polygons, whose contact points move from edge to
 #: edge: below ~0.1 um the iteration sees that discreteness, not the drive).
 POSITION_TOL = 2e-4
-#: Teeth whose tips stay this far inside the rigid tip circle are left out, mm:
-#: the rim moves by tens of um under rated load; 0.2 mm is four times more.
-RADIAL_MARGIN = 0.2
 #: Contact forces below this are floored when the Hertz secants are taken, N
 #: (the approach error it leaves is below 1e-5 mm for the balls and teeth of D1).
 FORCE_FLOOR = 1e-2
@@ -111,62 +115,9 @@ def _cam_offset(e_um: float, e_deg: float) -> np.ndarray:
     return np.array([e * np.cos(a), e * np.sin(a)])
 
 
-def _rim(model: ElasticModel, loads: np.ndarray, rigid) -> tuple:
-    """``w, v, theta`` ``(S, z_g)`` of every section at the tooth angles, and the elastic field ``(3, z_g)`` (centre scale).
-
-    The formula of :class:`LoadedLaw` (nominal law + scaled ring field +
-    rigid-body motion) on the model's tables: the same numbers, without the
-    kernel evaluations.
-    """
-    tab = model.tables
-    el = tab.tooth_field(loads)
-    phi = tab.angles[: tab.z_g]
-    c, sn = np.cos(phi), np.sin(phi)
-    dx, dy, rot = (float(x) for x in rigid)
-    nom = tab.nominal
-    f = model.scales[:, None]
-    # the rim is round when unloaded: the cam's balls bend it (their forces are among the loads), so the
-    # elastic field is the whole displacement; the rotation turns the deformed rim, which is the nominal
-    # law to within the bearing's clearance (its coupling terms are second order: rot times w, v)
-    w = f * el[0] + (dx * c + dy * sn) - rot * nom[:, 1]
-    v = f * el[1] + (-dx * sn + dy * c) + rot * (model.drive.r_m + nom[:, 0])
-    th = f * el[2] + rot
-    return w, v, th, el
-
-
-def _poses(model: ElasticModel, loads: np.ndarray, rigid, tooth_errors=None):
-    """Poses of every tooth of every section (flattened ``section * z_g + tooth``), their neutral-line origins and
-    the elastic field, plus the indices of the teeth whose tips reach within RADIAL_MARGIN of the rigid tips.
-
-    ``tooth_errors``: ``(turn (S z_g,), move (S z_g, 2))``, each tooth's pose turned about the axis by ``turn``
-    then moved by ``move`` (relative to the rigid teeth: an imperfect drive's errors, :func:`solve_load`)."""
-    d = model.drive
-    z_g = model.tables.z_g
-    S = len(model.zs)
-    w, v, th, el = _rim(model, loads, rigid)
-    phi = np.broadcast_to(model.tables.angles[:z_g], (S, z_g))
-    off = np.array([model.section_law(i).tooth_offset for i in range(S)])[:, None]
-    rot, shift = pose_from_displacements(phi, w, v, th, d.r_m, 0.0, off)
-    rot, shift = rot.ravel(), shift.reshape(-1, 2)
-    c, sn = np.cos(phi).ravel(), np.sin(phi).ravel()
-    w, v = w.ravel(), v.ravel()
-    origin = np.stack([(d.r_m + w) * c - v * sn, (d.r_m + w) * sn + v * c], axis=-1)
-    if tooth_errors is not None:
-        rot = rot + tooth_errors[0]
-        shift = _displaced(shift, tooth_errors)
-        origin = _displaced(origin, tooth_errors)
-    # outermost tip radius of each placed tooth: |R p + s|^2 = |p|^2 + |s|^2 + 2 p . R^T s, one small product
-    tip = model.scene.flex_tip_local
-    cr, sr = np.cos(rot), np.sin(rot)
-    u = np.stack([cr * shift[:, 0] + sr * shift[:, 1], -sr * shift[:, 0] + cr * shift[:, 1]], axis=-1)
-    R = np.sqrt(((tip * tip).sum(axis=1) + 2.0 * (u @ tip.T)).max(axis=1) + (shift * shift).sum(axis=1))
-    cand = np.nonzero(R >= model.scene.r_tip_b - RADIAL_MARGIN)[0]
-    return rot, shift, origin, el, cand
-
-
 def _geometry(model: ElasticModel, loads: np.ndarray, rigid):
     """Every tooth pair within GAP_MARGIN measured on the exact geometry at the state ``(loads, rigid)``: keys, gaps, pairs."""
-    rot, shift, origin, el, cand = _poses(model, loads, rigid)
+    rot, shift, origin, el, cand = tooth_poses(model, loads, rigid)
     pairs = MeasuredPairs(model)
     keys = pairs.update(rot, shift, origin, el, cand, rigid, full=True) if cand.size else np.zeros(0, dtype=int)
     return keys, pairs.gap[keys], pairs
@@ -210,22 +161,6 @@ def _first_guess(model: ElasticModel, keys, q, Z: int, torque_nm: float):
         working = 1 if model.scene.working == "upper" else 0
         act[Z:] &= (keys % 2) == working
     return act
-
-
-def _merge_loads(phi, loads):
-    """Generalized loads summed per distinct angle, zero ones dropped (same field, far fewer kernel evaluations)."""
-    nz = np.any(loads != 0.0, axis=1)
-    u, inv = np.unique(np.round(phi[nz], 15), return_inverse=True)
-    out = np.zeros((len(u), 3))
-    np.add.at(out, inv, loads[nz])
-    return u, out
-
-
-def _dense_loads(n: int, idx, F, f, b) -> np.ndarray:
-    """Generalized loads ``(n, 3)`` on the ring at the table's angles from contact forces ``F`` (N)."""
-    out = np.zeros((n, 3))
-    np.add.at(out, idx, -(F * f)[:, None] * b)
-    return out
 
 
 def solve_load(
@@ -294,12 +229,12 @@ def solve_load(
         times["geometry"] += lin.t_geo
         times["solver"] += lin.t_sol
         last = (keys, F, sol, lin.idx, lin.b, lin.f, pairs.point[keys], pairs.normal[keys], lin.cam_shift)
-        loads_new = _dense_loads(len(model.tables.angles), lin.idx, F, lin.f, lin.b)
+        loads_new = dense_loads(len(model.tables.angles), lin.idx, F, lin.f, lin.b)
         F_t_new = np.zeros(n_keys)
         F_t_new[keys] = F[Z:]
         # convergence: the largest move of an engaging tooth from the linearisation's poses to the solution's
         # (the fixed-point residual itself, from the tables: no engine call)
-        o_new = _origins(model, loads_new, sol.a, tooth_errors)
+        o_new = tooth_origins(model, loads_new, sol.a, tooth_errors)
         k2 = keys // 2
         d = np.hypot(*(o_new[k2] - lin.origin[k2]).T)
         change = max(float(d.max()) if d.size else 0.0, abs(float(sol.a[2] - state.rigid[2])) * model.drive.r_m)
@@ -400,7 +335,7 @@ def _start(model: ElasticModel, e: np.ndarray, warm: LoadState | None):
     """The state the iteration starts from: ring loads per table angle, rim freedoms, ball forces, measured pairs."""
     tab = model.tables
     if warm is not None:
-        loads, rigid = _loads_on_table(tab, warm.laws[0].psi, warm.laws[0].loads), np.array(warm.rigid)
+        loads, rigid = loads_on_table(tab, warm.laws[0].psi, warm.laws[0].loads), np.array(warm.rigid)
         F_ball = warm.contacts["force"][warm.contacts["kind"] == 0].copy()
     else:
         # a cold start begins on the cam: the rim pressed onto it by the balls alone (no teeth, no torque)
@@ -413,7 +348,7 @@ def _start(model: ElasticModel, e: np.ndarray, warm: LoadState | None):
     key = ("mounted_pairs", float(e[0]), float(e[1]))
     if key not in model.cache:
         nominal = MeasuredPairs(model)
-        rot0, shift0, origin0, el0, cand0 = _poses(model, loads, rigid)
+        rot0, shift0, origin0, el0, cand0 = tooth_poses(model, loads, rigid)
         nominal.update(rot0, shift0, origin0, el0, cand0, rigid, full=True)
         model.cache[key] = nominal
     return loads, rigid, F_ball, model.cache[key].copy()
@@ -442,7 +377,7 @@ def _linearise(model, torque_nm, e, f_ext, pairs, loads, rigid, F_ball, F_teeth_
     forces it finds before the teeth move."""
     Z = len(model.bearing.psi)
     t0 = time.perf_counter()
-    rot, shift, origin, el, cand = _poses(model, loads, rigid, tooth_errors)
+    rot, shift, origin, el, cand = tooth_poses(model, loads, rigid, tooth_errors)
     if cand.size == 0 and torque_nm > 0:
         raise DesignError(
             "generator.w0_coef",
@@ -498,15 +433,15 @@ def _report(model, torque_nm, e, pairs, last, progress, times, tooth_errors) -> 
     # the reported state is the last contact solution itself (not a relaxed mixture): its forces, points and
     # normals are in equilibrium to round-off; the exact gaps are then measured on the final poses
     keys, F, sol, idx, b, f, point, normal, cam_shift = last
-    loads = _dense_loads(n_ang, idx, F, f, b)
+    loads = dense_loads(n_ang, idx, F, f, b)
     rigid = sol.a.copy()
     F_ball, Ft = F[:Z], F[Z:]
     model.bearing.check(F_ball)
     t0 = time.perf_counter()
     pairs2 = pairs.copy()
-    keys2, gaps2, exact2 = pairs2.report(*_poses(model, loads, rigid, tooth_errors), rigid)
+    keys2, gaps2, exact2 = pairs2.report(*tooth_poses(model, loads, rigid, tooth_errors), rigid)
     times["geometry"] += time.perf_counter() - t0
-    psi, law_loads = _merge_loads(tab.angles, loads)
+    psi, law_loads = merge_loads(tab.angles, loads)
     laws = [
         LoadedLaw(centre, model.section_law(i), model.ring, psi, law_loads, model.scales[i], tuple(rigid))
         for i in range(len(model.zs))
@@ -574,31 +509,3 @@ def _report(model, torque_nm, e, pairs, last, progress, times, tooth_errors) -> 
         generator_torque(rows, F_ball),
         cam_shift,
     )
-
-
-def _displaced(points: np.ndarray, tooth_errors) -> np.ndarray:
-    """Points ``(S z_g, 2)`` of each tooth turned about the axis by ``turn`` and moved by ``move`` (``tooth_errors``)."""
-    turn, move = tooth_errors
-    ct, st = np.cos(turn), np.sin(turn)
-    return np.stack([ct * points[:, 0] - st * points[:, 1], st * points[:, 0] + ct * points[:, 1]], axis=-1) + move
-
-
-def _origins(model: ElasticModel, loads: np.ndarray, rigid, tooth_errors=None) -> np.ndarray:
-    """Neutral-line origins ``(S z_g, 2)`` of every tooth of every section (flattened as in :func:`_poses`)."""
-    w, v, _, _ = _rim(model, loads, rigid)
-    phi = model.tables.angles[: model.tables.z_g]
-    c, sn = np.cos(phi), np.sin(phi)
-    r = model.drive.r_m + w
-    out = np.stack([r * c - v * sn, r * sn + v * c], axis=-1).reshape(-1, 2)
-    return out if tooth_errors is None else _displaced(out, tooth_errors)
-
-
-def _loads_on_table(tab, psi, loads) -> np.ndarray:
-    """Generalized loads at angles ``psi`` put on the table's angles (a warm start from a solved state)."""
-    out = np.zeros((len(tab.angles), 3))
-    where = {}
-    for i, a in enumerate(np.round(tab.angles, 15).tolist()):
-        where.setdefault(a, i)
-    for a, l in zip(np.round(psi, 15).tolist(), loads):
-        out[where[a]] += l
-    return out
