@@ -7,6 +7,7 @@ from math import pi
 import numpy as np
 
 from ..placement import tooth_pose, transform
+from ..plane import rotate
 from ..roots import brentq
 from .scene import Scene
 from .search import _fold
@@ -41,9 +42,7 @@ def backlash(scene: Scene, phi_h: float, z=None, exact: bool = False) -> float:
     def turned(i, d):
         # the tooth (or teeth, with arrays) turned by d about the gear axis
         if np.ndim(i):
-            c, s = np.cos(d), np.sin(d)
-            sh = shift0[i]
-            return rot0[i] + d, np.stack([c * sh[:, 0] - s * sh[:, 1], s * sh[:, 0] + c * sh[:, 1]], axis=-1)
+            return rot0[i] + d, rotate(shift0[i], d)
         c, s = np.cos(d), np.sin(d)
         sh = shift0[i]
         return rot0[i] + d, np.array([[c * sh[0] - s * sh[1], s * sh[0] + c * sh[1]]])

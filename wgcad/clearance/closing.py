@@ -29,6 +29,7 @@ import shapely
 from ..errors import DesignError
 from ..placement import transform
 from ..placement.imperfect import Imperfections, flex_poses, rigid_poses
+from ..plane import rotate
 from .distance import Template, overlap_depth
 
 __all__ = ["Contact", "closing_rotation", "closing_direct"]
@@ -67,8 +68,7 @@ class Contact:
 
 
 def _turn(rot, shift, t):
-    c, s = np.cos(t), np.sin(t)
-    return rot + t, np.stack([c * shift[:, 0] - s * shift[:, 1], s * shift[:, 0] + c * shift[:, 1]], axis=-1)
+    return rot + t, rotate(shift, t)
 
 
 #: pairs measured per call above which the measurement is split between two threads (shapely releases the GIL in

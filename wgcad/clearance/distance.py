@@ -6,6 +6,7 @@ import numpy as np
 import shapely
 
 from ..placement import transform
+from ..plane import relative_pose
 
 __all__ = ["Template", "overlap_depth", "signed_clearance"]
 
@@ -63,20 +64,12 @@ class Template:
         return out
 
 
-def _relative(rot_a, shift_a, rot_b, shift_b):
-    """Pose of copies of A in the frame of the copies of B: rotation and shift."""
-    rel = rot_a - rot_b
-    d = shift_a - shift_b
-    c, s = np.cos(-rot_b), np.sin(-rot_b)
-    return rel, np.stack([c * d[:, 0] - s * d[:, 1], s * d[:, 0] + c * d[:, 1]], axis=-1)
-
-
 def overlap_depth(a: Template, rot_a, shift_a, b: Template, rot_b, shift_b) -> np.ndarray:
     """Penetration depth ``(K,)`` of pairs known to touch or overlap (their distance is 0): the deepest vertex of
     either polygon inside the other, measured to the other's boundary (:func:`signed_clearance`)."""
-    r, t = _relative(rot_a, shift_a, rot_b, shift_b)
+    r, t = relative_pose(rot_a, shift_a, rot_b, shift_b)
     depth_ab = b.depth_of(transform(a.local, r, t))  # vertices of A inside B
-    r, t = _relative(rot_b, shift_b, rot_a, shift_a)
+    r, t = relative_pose(rot_b, shift_b, rot_a, shift_a)
     depth_ba = a.depth_of(transform(b.local, r, t))  # vertices of B inside A
     return np.maximum(depth_ab, depth_ba)
 

@@ -36,6 +36,7 @@ from __future__ import annotations
 import numpy as np
 import shapely
 
+from ..plane import relative_pose, rotate
 from .exact import ExactTooth, curv_h, point_signed_distance
 
 __all__ = ["ExactTooth", "refine_pairs", "point_signed_distance"]
@@ -54,19 +55,6 @@ _DONE = 1e-9
 #: below this distance (mm) the curves are taken to cross: the second derivative of the signed value
 #: is computed by dividing by it, so it is not trusted there
 _CROSS = 1e-10
-
-
-def _rel(rot_a, shift_a, rot_b, shift_b):
-    """Pose of A in B's frame."""
-    rel = rot_a - rot_b
-    d = shift_a - shift_b
-    c, s = np.cos(-rot_b), np.sin(-rot_b)
-    return rel, np.stack([c * d[:, 0] - s * d[:, 1], s * d[:, 0] + c * d[:, 1]], axis=-1)
-
-
-def _rotate(v, rot):
-    c, s = np.cos(rot), np.sin(rot)
-    return np.stack([c * v[:, 0] - s * v[:, 1], s * v[:, 0] + c * v[:, 1]], axis=-1)
 
 
 def _vertex_sd(A: ExactTooth, polyA: np.ndarray, ringB, rot, shift) -> np.ndarray:
@@ -101,7 +89,7 @@ class _Sides:
         A, B, project = self.A, self.B, self.project
         """A's point at (ia, s); its projection on B's piece ib, or the neighbouring piece when it runs off an end."""
         Pa, a1, a2 = A.eval(ia, s)
-        Pa, a1, a2 = _rotate(Pa, r_k) + sh_k, _rotate(a1, r_k), _rotate(a2, r_k)
+        Pa, a1, a2 = rotate(Pa, r_k) + sh_k, rotate(a1, r_k), rotate(a2, r_k)
         t, dist = project(ib, t, Pa)
         for step in (1, -1):  # off the end (start) in travel direction: try the next (previous) piece
             end = np.where(B.sense[ib] * step > 0, B.hi[ib], B.lo[ib])
@@ -187,7 +175,7 @@ def _seeds(A: ExactTooth, B: ExactTooth, sd: np.ndarray, rot, shift, margin):
     ia = np.concatenate(rows_ia)
     s = np.concatenate(rows_sa)
     # the B pieces that can hold the nearest point to the seed (as in point_signed_distance)
-    P0 = _rotate(A.eval(ia, s, order=0)[0], rot[kk]) + shift[kk]
+    P0 = rotate(A.eval(ia, s, order=0)[0], rot[kk]) + shift[kk]
     d2 = B.grid_d2(P0)  # (m, nB, G)
     gmin = np.sqrt(d2.min(axis=2))
     cand = gmin <= gmin.min(axis=1, keepdims=True) + B.grid_step[None, :]
@@ -292,7 +280,7 @@ def _one_side(A: ExactTooth, B: ExactTooth, sd: np.ndarray, rot, shift, margin):
     r_k, sh_k = rot[kk], shift[kk]
     ia, s, stuck = _newton(_Sides(A, B), ia, s, ib, t, r_k, sh_k, kk)
     # each candidate measured exactly against the whole of B: a true signed distance of a true curve point
-    Pa = _rotate(A.eval(ia, s, order=0)[0], r_k) + sh_k
+    Pa = rotate(A.eval(ia, s, order=0)[0], r_k) + sh_k
     val = point_signed_distance(B, Pa)
     out = np.full(K, np.inf)
     order = np.lexsort((val, kk))
@@ -341,8 +329,8 @@ def refine_pairs(
     rot_b = np.broadcast_to(np.asarray(rot_b, dtype=float), (K,))
     shift_a = np.atleast_2d(np.asarray(shift_a, dtype=float))
     shift_b = np.broadcast_to(np.asarray(shift_b, dtype=float), (K, 2))
-    r1, t1 = _rel(rot_a, shift_a, rot_b, shift_b)
-    r2, t2 = _rel(rot_b, shift_b, rot_a, shift_a)
+    r1, t1 = relative_pose(rot_a, shift_a, rot_b, shift_b)
+    r2, t2 = relative_pose(rot_b, shift_b, rot_a, shift_a)
     sd1 = _vertex_sd(A, polyA, geomB, r1, t1)
     sd2 = _vertex_sd(B, polyB, geomA, r2, t2)
     v1, _, _, p1, sure = _one_side(A, B, sd1, r1, t1, margin)

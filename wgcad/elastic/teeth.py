@@ -9,6 +9,7 @@ import shapely
 
 from wgcad.clearance.engine import Scene
 from wgcad.placement import transform
+from wgcad.plane import rotate
 
 __all__ = ["ContactGeometry", "flank_contacts", "pair_contacts", "ToothCompliance"]
 
@@ -142,7 +143,7 @@ def _smooth_normals(local: np.ndarray, rot: np.ndarray, shift: np.ndarray, p: np
     te = te[:, None]
     n = (1.0 - te) * vn[e] + te * vn[(e + 1) % N]
     n /= np.hypot(n[:, 0], n[:, 1])[:, None]
-    return np.stack([c * n[:, 0] - s * n[:, 1], s * n[:, 0] + c * n[:, 1]], axis=-1), kink_edge[e]
+    return rotate(n, rot), kink_edge[e]
 
 
 def flank_contacts(scene: Scene, rot: np.ndarray, shift: np.ndarray) -> dict[str, ContactGeometry]:

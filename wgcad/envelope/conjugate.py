@@ -23,6 +23,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from wgcad.plane import rotate
+
 __all__ = ["EnvelopePoints", "envelope", "flank_pieces"]
 
 #: Newton stops when the step along the flank is below this, mm
@@ -149,9 +151,8 @@ def envelope(pieces, motion, t, samples: int = 256) -> EnvelopePoints:
         same = np.concatenate([[False], ti[1:] == ti[:-1]])
         for j in np.flatnonzero(same):
             branch[j] = branch[j - 1] + 1
-        c, s = np.cos(rot[ti]), np.sin(rot[ti])
-        X = np.stack([c * p[:, 0] - s * p[:, 1], s * p[:, 0] + c * p[:, 1]], axis=-1) + shift[ti]
-        n = np.stack([c * dp[:, 1] + s * dp[:, 0], s * dp[:, 1] - c * dp[:, 0]], axis=-1)  # R (dp_y, -dp_x)
+        X = rotate(p, rot[ti]) + shift[ti]
+        n = rotate(np.stack([dp[:, 1], -dp[:, 0]], axis=-1), rot[ti])  # R (dp_y, -dp_x)
         n /= np.linalg.norm(n, axis=-1)[:, None]
         for name, val in (
             ("t", t[ti]),

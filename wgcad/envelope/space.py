@@ -19,6 +19,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from wgcad.plane import rotate
+
 from .conjugate import envelope, flank_pieces
 from .motion import LawMotion
 
@@ -85,10 +87,9 @@ def _side_distance(piece, s0, x, rot, shift, with_gap: bool = False):
     may run either way (an involute's roll parameter falls toward the root, an arc's angle may rise), so the
     side is taken from the direction of travel, ``t0 -> t1``, not from ``p'`` alone (a double-arc flank, whose
     angles rise, read every point on the wrong side)."""
-    c, sn = np.cos(rot), np.sin(rot)
 
     def place(v):
-        return np.stack([c * v[:, 0] - sn * v[:, 1], sn * v[:, 0] + c * v[:, 1]], axis=-1)
+        return rotate(v, rot)
 
     s = np.array(s0, dtype=float)
     lo, hi = min(piece.t0, piece.t1), max(piece.t0, piece.t1)

@@ -18,6 +18,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from wgcad.plane import rotate
+
 __all__ = [
     "ArcPath",
     "fit_pieces",
@@ -388,9 +390,7 @@ def segment_tangents(path: ArcPath) -> tuple[np.ndarray, np.ndarray]:
     chord = _unit(e - v)
     half = 2.0 * np.arctan(path.bulges)  # theta / 2
 
-    def turn(u, a):
-        c, s = np.cos(a), np.sin(a)
-        return np.stack([c * u[:, 0] - s * u[:, 1], s * u[:, 0] + c * u[:, 1]], axis=-1)
+    turn = rotate
 
     return turn(chord, -half), turn(chord, half)
 
