@@ -239,3 +239,14 @@ def test_a_conjugate_drive_sampled_finer_keeps_its_exact_curves():
     on = np.abs(np.arctan2(pts[:, 1], pts[:, 0])) <= np.pi / d.rigid.spec.z
     assert on.sum() > 1000 and gap[on].max() <= fine.rigid.tol * (1 + 1e-9)
     assert gap[on].max() > d.tol / 100  # the polygon is a sampling, not the curve: the test sees its chords
+
+
+def test_a_conjugate_drive_pickles_with_its_sampler():
+    """A drive goes to worker processes by pickle: its conjugate rigid gear carries its sampler as a record (a local
+    function would not pickle), and the copy samples the same curves."""
+    import pickle
+
+    d = build_drive(load_design(TEMPLATES / "d1_conjugate.toml"))
+    back = pickle.loads(pickle.dumps(d))
+    assert np.array_equal(back.rigid.outline, d.rigid.outline)
+    assert np.array_equal(back.sampled_at(d.tol / 8).rigid.period, d.sampled_at(d.tol / 8).rigid.period)

@@ -16,7 +16,7 @@ the design's tooth count, module and radii; only its flanks change.
 
 from __future__ import annotations
 
-from dataclasses import replace
+from dataclasses import dataclass, replace
 from math import pi
 
 import numpy as np
@@ -152,10 +152,34 @@ def conjugate_rigid_gear(drive, z: float | None = None, clearance: float = 0.0) 
     spec = replace(rg.spec, form="conjugate", tip_radius=r_a)
     flank = np.vstack([tip_pt, up]) if np.hypot(*(up[0] - tip_pt)) > 1e-12 else up
 
-    def sampled(tol: float) -> Gear:
-        # the polylines of the outline, within ``tol`` like every other gear's: arcs by their sagitta, the flank's
-        # exact points thinned (Douglas-Peucker to half the tolerance); the pieces keep every point. A finer copy
-        # (the audit's fine polygons) samples these same pieces: its flank is not enveloped again
+    sampler = _ConjugateSampler(
+        spec, rg.r, r_a, r_f, float(2.0 * r_a * a_up[0]), pieces, flank, a_up[0], a_up[-1], half, zr, rg.spec.phase
+    )
+    gear = sampler(drive.tol)
+    return gear, cf
+
+
+@dataclass(frozen=True)
+class _ConjugateSampler:
+    """A conjugate rigid gear's outline sampled at a chord tolerance from its exact pieces and flank points (a record,
+    so a drive holding the gear pickles): arcs by their sagitta, the flank's exact points thinned (Douglas-Peucker
+    to half the tolerance); the pieces keep every point. A finer copy (the audit's finer polygons) samples these
+    same pieces: its flank is not enveloped again."""
+
+    spec: object
+    r: float
+    r_a: float
+    r_f: float
+    tip_thickness: float
+    pieces: tuple
+    flank: np.ndarray
+    a_first: float
+    a_last: float
+    half: float
+    z: int
+    phase: float
+
+    def __call__(self, tol: float) -> Gear:
         import shapely
 
         def arc_pts(r, a0, a1):
@@ -163,34 +187,31 @@ def conjugate_rigid_gear(drive, z: float | None = None, clearance: float = 0.0) 
             a = np.linspace(a0, a1, n)
             return r * np.stack([np.cos(a), np.sin(a)], -1)
 
-        thin = np.asarray(shapely.LineString(flank).simplify(0.5 * tol).coords)
-        root = arc_pts(r_f, a_up[-1], half)  # from the radial wall's foot (it starts at root_pt, not at the flank)
-        half_period = np.concatenate([arc_pts(r_a, 0.0, a_up[0])[:-1], thin, root])
+        thin = np.asarray(shapely.LineString(self.flank).simplify(0.5 * tol).coords)
+        root = arc_pts(self.r_f, self.a_last, self.half)  # from the radial wall's foot (not from the flank)
+        half_period = np.concatenate([arc_pts(self.r_a, 0.0, self.a_first)[:-1], thin, root])
         keep = np.concatenate([[True], np.hypot(*np.diff(half_period, axis=0).T) > 1e-9])
         half_period = half_period[keep]
         mirror = half_period[::-1] * np.array([1.0, -1.0])
         period = np.concatenate([mirror, half_period[1:]])
-        gamma = 2.0 * pi / zr
-        k = np.arange(zr)[:, None]
-        ang = np.arctan2(period[:-1, 1], period[:-1, 0])[None, :] + k * gamma + rg.spec.phase
+        gamma = 2.0 * pi / self.z
+        k = np.arange(self.z)[:, None]
+        ang = np.arctan2(period[:-1, 1], period[:-1, 0])[None, :] + k * gamma + self.phase
         rad = np.hypot(period[:-1, 0], period[:-1, 1])[None, :]
         outline = np.stack([rad * np.cos(ang), rad * np.sin(ang)], -1).reshape(-1, 2)
         for arr in (half_period, period, outline):
             arr.setflags(write=False)
         return Gear(
-            spec,
-            rg.r,
-            r_a,
-            r_f,
+            self.spec,
+            self.r,
+            self.r_a,
+            self.r_f,
             None,
-            float(2.0 * r_a * a_up[0]),
+            self.tip_thickness,
             half_period,
             period,
             outline,
             tol,
-            pieces,
-            resample=sampled,
+            self.pieces,
+            resample=self,
         )
-
-    gear = sampled(drive.tol)
-    return gear, cf
