@@ -145,3 +145,22 @@ def test_d1_entry_crossing_gap_of_the_non_working_edge_is_exact():
         b = transform(dense.rigid.tooth_polygon(), scene.rigid_rot[j], scene.rigid_shift[j])
         ref = np.array([dense_pair(a[k], b[k]) for k in range(len(rot))])
         assert np.abs(gaps[:, col] - ref).max() <= REFINE_TOL + DENSE_TOL, (1e3 * (gaps[:, col] - ref)).round(5)
+
+
+@pytest.mark.parametrize("name", ["d1_involute", "d1_cycloidal", "d2_imperfect"])
+def test_the_finer_polygons_prune_pairs_without_changing_the_minimum(name, monkeypatch):
+    """A flat minimum's candidates are sorted out on finer polygons, and their exact refinement then takes only the
+    pairs within the finer margin of each sample's smallest. Against every candidate refined with every pair within
+    the coarse margin (no finer pass: FINE_ABOVE beyond the candidates' count), the audit's minimum is the same to
+    the bit and at the same sample."""
+    from wgcad.audit import RunSettings, run_audit
+    from wgcad.clearance import cascade
+
+    path = TEMPLATES / f"{name}.toml"
+    _, pruned = run_audit(path, RunSettings(step_deg=1.0))
+    assert pruned.counts["fine_polygon"] > 0  # the finer pass ran
+    monkeypatch.setattr(cascade, "FINE_ABOVE", 10**9)
+    _, every = run_audit(path, RunSettings(step_deg=1.0))
+    assert every.counts["fine_polygon"] == 0 and every.counts["refined"] > pruned.counts["refined"]
+    a, b = pruned.findings["min_clearance"], every.findings["min_clearance"]
+    assert a.value == b.value and a.tooth_angle == b.tooth_angle and a.section_z == b.section_z

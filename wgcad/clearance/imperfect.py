@@ -344,23 +344,32 @@ def _refine(run: _Run, found: _Found) -> tuple[float, int, int, int]:
     if not (run.settings.refine and len(found.v)):
         return found.best, int(np.argsort(found.v, kind="stable")[0]), 0, 0
 
-    def fine(idx):
+    # the finer polygons' figure of every pair of every candidate: the exact refinement then takes only the pairs
+    # within the finer margin of their sample's smallest (as the perfect drive's audit, engine._refine)
+    finer = {}
+    keys = ("lower", "upper", "third", "min", "lo", "up", "th")
 
+    def fine(idx):
         ref = ImperfectScene.from_scene(Scene(run.drive.sampled_at(run.drive.tol / FINE)), run.imp)
         rot, shift = run.poses(found.a[idx], found.k[idx], found.s[idx])
+        n = len(found.v)
+        finer.update(
+            {key: (np.zeros(n, dtype=int) if key in ("lo", "up", "th") else np.full(n, np.inf)) for key in keys}
+        )
         # in batches: a candidate on the finer polygons holds ~18 kB while measured, and their number
         # grows with the sampling density (2900 at 0.05 deg on D1 [S4])
-        vals = np.concatenate(
-            [
-                clearance_at_poses(ref, rot[a : a + _FINE_BATCH], shift[a : a + _FINE_BATCH])["min"]
-                for a in range(0, len(rot), _FINE_BATCH)
-            ]
-        )
-        return vals, ref.chord_gap
+        for a in range(0, len(rot), _FINE_BATCH):
+            det = clearance_at_poses(ref, rot[a : a + _FINE_BATCH], shift[a : a + _FINE_BATCH])
+            for key in keys:
+                finer[key][idx[a : a + _FINE_BATCH]] = det[key]
+        finer["gap"] = ref.chord_gap
+        return finer["min"][idx], ref.chord_gap
 
     def exact(idx):
         rot, shift = run.poses(found.a[idx], found.k[idx], found.s[idx])
-        return refine_min(run.isc, rot, shift, clearance_at_poses(run.isc, rot, shift))["min"]
+        if not finer:
+            return refine_min(run.isc, rot, shift, clearance_at_poses(run.isc, rot, shift))["min"]
+        return refine_min(run.isc, rot, shift, {key: finer[key][idx] for key in keys}, gap=finer["gap"])["min"]
 
     return refine_candidates(found.v, run.isc.chord_gap, exact, fine=fine, one_call=_ONE_CALL)
 

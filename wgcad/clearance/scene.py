@@ -237,18 +237,19 @@ def tooth_clearance_sections(
     return refine_min(scene, rot, shift, out)["min"] if exact else out["min"]
 
 
-def refine_min(scene: Scene, rot: np.ndarray, shift: np.ndarray, det: dict) -> dict:
+def refine_min(scene: Scene, rot: np.ndarray, shift: np.ndarray, det: dict, gap: float | None = None) -> dict:
     """Refine on the exact curves every pair of :func:`clearance_at_poses` that can hold a tooth's minimum.
 
     A pair's exact figure is within ``scene.chord_gap`` of its polygon one,
     so only pairs whose polygon figure is within twice that of the tooth's
     smallest are refined; the others keep their polygon figures (they
-    cannot be the minimum). Adds ``refined_lower``/``_upper``/``_third``
+    cannot be the minimum; ``gap``: the polygons' own where ``det`` comes from finer
+    polygons than the scene's). Adds ``refined_lower``/``_upper``/``_third``
     (bool) and ``point_lower``... (the extremal point, rigid-tooth frame
     for side 0) to ``det`` and updates the figures and ``min``.
     """
     out = dict(det)
-    gap = scene.chord_gap
+    gap = scene.chord_gap if gap is None else gap
     best = det["min"]
     idx = {"lower": det["lo"], "upper": det["up"]}
     if "th" in det:
