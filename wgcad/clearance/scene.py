@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from functools import cached_property
 from math import pi
 
 import numpy as np
@@ -49,11 +50,9 @@ class Scene:
         # through the flank that faces against that motion: the working flank.
         rel = rot / self.ratios["u_hg"]
         self.working = "upper" if rel < 0 else "lower"
-        # exact pieces of both teeth, and how far a polygon figure can be from the curves' one:
-        # every vertex is on its curve and every chord within tol of it, so a distance, and a
-        # depth measured from vertices, moves by at most tol per tooth (docs/models.md 5)
-        self.flex_exact = ExactTooth(drive.flex, self.flex.local)
-        self.rigid_exact = ExactTooth(drive.rigid, self.rigid.local)
+        # how far a polygon figure can be from the curves' one: every vertex is on its curve and every chord
+        # within tol of it, so a distance, and a depth measured from vertices, moves by at most tol per tooth
+        # (docs/models.md 5)
         self.chord_gap = 2.0 * drive.tol
         tip = [
             p
@@ -65,6 +64,16 @@ class Scene:
         self.tip_arc = tip[0] if tip else None
         self.entry_sign = rot  # teeth enter engagement on the side the generator turns toward
         self._laws = {}
+
+    @cached_property
+    def flex_exact(self) -> ExactTooth:
+        """The flexspline tooth's exact pieces, built on first use (a scene of finer polygons measures none)."""
+        return ExactTooth(self.drive.flex, self.flex.local)
+
+    @cached_property
+    def rigid_exact(self) -> ExactTooth:
+        """The rigid tooth's exact pieces, built on first use."""
+        return ExactTooth(self.drive.rigid, self.rigid.local)
 
     def law(self, z):
         if z is None:
