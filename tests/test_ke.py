@@ -473,12 +473,12 @@ def _table_arrays(tab):
 def test_closing_measurements_split_between_threads_equal_one_thread(d2, monkeypatch):
     """The closing rotation's nearest points are measured on two threads when a call has many pairs (shapely
     releases the GIL): the contact table is the one a single thread builds, to the bit."""
-    from wgcad.clearance import closing
+    from wgcad.clearance import halves
 
     imp = Imperfections(flex_runout=0.01, rigid_ecc=0.005)
-    monkeypatch.setattr(closing, "_SPLIT", 10**9)
+    monkeypatch.setattr(halves, "SPLIT", 10**9)
     one = _table_arrays(K.contact_table(d2, imp, 4, sections=[None]))
-    monkeypatch.setattr(closing, "_SPLIT", 2)
+    monkeypatch.setattr(halves, "SPLIT", 2)
     two = _table_arrays(K.contact_table(d2, imp, 4, sections=[None]))
     assert one.keys() == two.keys() and one
     for key in one:
@@ -490,11 +490,11 @@ def test_a_forked_process_measures_with_threads_of_its_own(d2, monkeypatch):
     (a pool inherited across a fork would take the work and never run it)."""
     import multiprocessing
 
-    from wgcad.clearance import closing
+    from wgcad.clearance import halves
 
-    monkeypatch.setattr(closing, "_SPLIT", 2)
+    monkeypatch.setattr(halves, "SPLIT", 2)
     K.contact_table(d2, Imperfections(), 2, sections=[None])  # the parent's pool exists now
-    assert closing._POOL is not None
+    assert halves._POOL is not None
     ctx = multiprocessing.get_context("fork")
     q = ctx.Queue()
     p = ctx.Process(target=_child_table, args=(d2, q))
