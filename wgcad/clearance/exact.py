@@ -49,9 +49,12 @@ class ExactTooth:
         self.grid_p = np.stack([p.point(g) for p, g in zip(pcs, grid)])  # (n, G, 2)
         # longest step between grid points of each piece: bounds how far the nearest grid point can be
         self.grid_step = np.hypot(*np.diff(self.grid_p, axis=1).transpose(2, 0, 1)).max(axis=1)
-        # every vertex of the period part of the polygon: its piece and parameter
+        # every vertex of the period part of the polygon: its piece and parameter. The polygon of an internal
+        # gear's tooth runs the two body points first, then the period backwards (Gear.tooth_polygon)
         n_per = len(gear.period)
-        verts = polygon[:n_per]
+        first = len(polygon) - n_per if internal else 0
+        self.vert_index = np.arange(first, first + n_per)
+        verts = polygon[self.vert_index]
         self.vert_piece, self.vert_t = self._locate(verts)
         self.n_vert = n_per
         # farther than the chord tolerance from the curves, the polygon tells inside from outside

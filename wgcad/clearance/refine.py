@@ -61,7 +61,7 @@ def _vertex_sd(A: ExactTooth, polyA: np.ndarray, ringB, rot, shift) -> np.ndarra
     """Polygon signed distance ``(K, nv)`` of A's period vertices (A placed in B's frame) to B's polygon."""
     K = len(rot)
     nv = A.n_vert
-    va = np.einsum("kij,nj->kni", _rotmat(rot), polyA[:nv]) + shift[:, None, :]  # (K, nv, 2)
+    va = np.einsum("kij,nj->kni", _rotmat(rot), polyA[A.vert_index]) + shift[:, None, :]  # (K, nv, 2)
     flat = va.reshape(-1, 2)
     pts = shapely.points(flat)
     d = shapely.distance(ringB.exterior, pts)
