@@ -8,7 +8,7 @@ import shapely
 from ..placement import transform
 from ..plane import relative_pose
 
-__all__ = ["Template", "overlap_depth", "signed_clearance"]
+__all__ = ["Template", "outline_distance", "overlap_depth", "signed_clearance"]
 
 
 class Template:
@@ -39,29 +39,48 @@ class Template:
         return out.reshape(K, N).max(axis=1)
 
     def boundary_distance(self, pts: np.ndarray) -> np.ndarray:
-        """Distance ``(M,)`` of points ``(M, 2)`` to the outline, point against every edge in numpy.
+        """Distance ``(M,)`` of points ``(M, 2)`` to the outline (:func:`outline_distance`)."""
+        return outline_distance(self.local, pts)[0]
 
-        The outlines have tens of edges: one vectorised pass beats a GEOS
-        call per point (and its point objects) by an order of magnitude.
-        Points are taken in chunks so memory stays bounded.
-        """
-        if not hasattr(self, "_seg_a"):
-            a = self.local
-            self._seg_a = a
-            self._seg_d = np.roll(a, -1, axis=0) - a
-            self._seg_l2 = np.maximum((self._seg_d**2).sum(-1), 1e-300)
-        a, d, l2 = self._seg_a, self._seg_d, self._seg_l2
-        out = np.empty(len(pts))
-        step = max(1, 400_000 // len(a))
-        for i in range(0, len(pts), step):
-            p = pts[i : i + step]
-            rx = p[:, None, 0] - a[None, :, 0]
-            ry = p[:, None, 1] - a[None, :, 1]
-            u = np.clip((rx * d[None, :, 0] + ry * d[None, :, 1]) / l2[None, :], 0.0, 1.0)
-            ex = rx - u * d[None, :, 0]
-            ey = ry - u * d[None, :, 1]
-            out[i : i + step] = np.sqrt((ex * ex + ey * ey).min(axis=1))
-        return out
+
+def outline_distance(outline: np.ndarray, pts: np.ndarray):
+    """Distance ``(M,)`` of points ``(M, 2)`` to a closed outline ``(N, 2)``, point against every edge in numpy;
+    with the nearest edge ``(M,)`` (edge i runs from vertex i to i + 1) and the position along it ``(M,)`` in [0, 1].
+
+    The tooth outlines have tens of edges: one vectorised pass beats a GEOS
+    call per point (and its point objects) by an order of magnitude.
+    Points are taken in chunks so memory stays bounded.
+    """
+    a = np.asarray(outline, dtype=float)
+    d = np.roll(a, -1, axis=0) - a
+    l2 = np.maximum((d**2).sum(-1), 1e-300)
+    ax, ay, dx, dy = a[:, 0], a[:, 1], d[:, 0], d[:, 1]
+    M = len(pts)
+    out = np.empty(M)
+    edge = np.empty(M, dtype=int)
+    along = np.empty(M)
+    # ~40,000 point-edge pairs a chunk: the temporaries stay in the cache (twice as fast as 400,000)
+    step = max(1, 40_000 // len(a))
+    rows = np.arange(min(step, M))
+    for i in range(0, M, step):
+        p = pts[i : i + step]
+        rx = p[:, 0, None] - ax
+        ry = p[:, 1, None] - ay
+        u = rx * dx
+        u += ry * dy
+        u /= l2
+        np.clip(u, 0.0, 1.0, out=u)
+        rx -= u * dx  # the offset from the nearest point of each edge
+        ry -= u * dy
+        rx *= rx
+        ry *= ry
+        rx += ry
+        j = rx.argmin(axis=1)
+        r = rows[: len(p)]
+        out[i : i + step] = np.sqrt(rx[r, j])
+        edge[i : i + step] = j
+        along[i : i + step] = u[r, j]
+    return out, edge, along
 
 
 def overlap_depth(a: Template, rot_a, shift_a, b: Template, rot_b, shift_b) -> np.ndarray:

@@ -12,6 +12,11 @@ the second side is measured only where the polygons say the teeth can
 touch or overlap, or where a row of the first side stopped short of a
 stationary point or a corner (its figure is then only an upper bound).
 
+Pairs the polygons say are apart are measured first by one batch for all
+of them (:mod:`wgcad.clearance.apart`: the distance between the curves by a
+joint Newton iteration from the same seeds); the pairs it leaves unsolved,
+and those that can touch or overlap, by the iteration below.
+
 How: every polygon vertex lies on a piece with a known parameter. The
 vertices whose polygon signed distance is within a margin of the polygon
 minimum seed a Newton iteration on ``f(s) = sd_B(P_A(s))`` for the vertex's
@@ -37,9 +42,11 @@ import numpy as np
 import shapely
 
 from ..plane import relative_pose, rotate
+from .apart import apart_distance, vertex_seeds
+from .distance import outline_distance
 from .exact import ExactTooth, curv_h, point_signed_distance
 
-__all__ = ["ExactTooth", "refine_pairs", "point_signed_distance"]
+__all__ = ["ExactTooth", "refine_pairs", "apart_pairs", "point_signed_distance"]
 
 _NEWTON_STEPS = 40
 #: neighbours of a local minimum of the vertex distances also seeded (a coarse polygon's extremum can lie a
@@ -57,16 +64,16 @@ _DONE = 1e-9
 _CROSS = 1e-10
 
 
-def _vertex_sd(A: ExactTooth, polyA: np.ndarray, ringB, rot, shift) -> np.ndarray:
-    """Polygon signed distance ``(K, nv)`` of A's period vertices (A placed in B's frame) to B's polygon."""
+def _vertex_sd(A: ExactTooth, polyA: np.ndarray, polyB: np.ndarray, geomB, rot, shift):
+    """Polygon signed distance ``(K, nv)`` of A's period vertices (A placed in B's frame) to B's polygon, with the
+    nearest edge of B's polygon and the position on it (:func:`wgcad.clearance.distance.outline_distance`)."""
     K = len(rot)
     nv = A.n_vert
     va = np.einsum("kij,nj->kni", _rotmat(rot), polyA[A.vert_index]) + shift[:, None, :]  # (K, nv, 2)
     flat = va.reshape(-1, 2)
-    pts = shapely.points(flat)
-    d = shapely.distance(ringB.exterior, pts)
-    inside = shapely.contains_xy(ringB, flat[:, 0], flat[:, 1])
-    return np.where(inside, -d, d).reshape(K, nv)
+    d, edge, along = outline_distance(polyB, flat)
+    inside = shapely.contains_xy(geomB, flat[:, 0], flat[:, 1])
+    return np.where(inside, -d, d).reshape(K, nv), edge.reshape(K, nv), along.reshape(K, nv)
 
 
 class _Sides:
@@ -149,18 +156,11 @@ class _Sides:
 def _seeds(A: ExactTooth, B: ExactTooth, sd: np.ndarray, rot, shift, margin):
     """Newton's starting rows: ``(pair, A piece, A parameter, B piece, B parameter)`` from the polygon vertices
     whose distance is a local minimum within ``margin`` of the pair's smallest (module docstring)."""
-    lo = sd.min(axis=1)
-    # seeds: local minima of the vertex sequence within the margin of the pair's minimum (the
-    # curve's extrema lie between a vertex and its neighbours; one seed per basin is enough)
-    pad = np.pad(sd, ((0, 0), (1, 1)), constant_values=np.inf)
-    local = (sd <= pad[:, :-2]) & (sd <= pad[:, 2:])
-    # and the two vertices either side: where vertices are sparse (coarse chords, a cycloid's
-    # pitch-point cusp) the curve's extremum can lie a chord or two away from the polygon's
-    near = local.copy()
-    for sh in _NEAR:
-        near[:, sh:] |= local[:, :-sh]
-        near[:, :-sh] |= local[:, sh:]
-    seed_k, seed_v = np.nonzero(near & (sd <= lo[:, None] + margin))
+    # seeds: local minima of the vertex sequence within the margin of the pair's minimum (the curve's extrema
+    # lie between a vertex and its neighbours; one seed per basin is enough), and the vertices either side:
+    # where vertices are sparse (coarse chords, a cycloid's pitch-point cusp) the curve's extremum can lie a
+    # chord or two away from the polygon's
+    seed_k, seed_v = vertex_seeds(sd, margin, _NEAR)
     # each seed: its vertex's piece (and the neighbouring piece at a junction) against every B piece
     ia = A.vert_piece[seed_v]
     sa = A.vert_t[seed_v]
@@ -324,27 +324,61 @@ def refine_pairs(
     point : (K, 2) float
         That point, in B's frame for side 0 and A's frame for side 1.
     """
+    (r1, t1), (r2, t2) = _relative(rot_a, shift_a, rot_b, shift_b)
+    K = len(r1)
+    sd1, edge1, along1 = _vertex_sd(A, polyA, polyB, geomB, r1, t1)
+    sd2 = _vertex_sd(B, polyB, polyA, geomA, r2, t2)[0]
+    # the polygons' distance is the smaller vertex distance of the two sides (a polygon's closest point to
+    # another is a vertex of one of them); the curves are within margin / 2 of it, so above margin / 2
+    # the teeth are apart: their figure is the distance between the curves (wgcad.clearance.apart), and
+    # the pairs it leaves unsolved are refined as those that can touch or overlap
+    value = np.full(K, np.inf)
+    side = np.zeros(K, dtype=int)
+    point = np.full((K, 2), np.nan)
+    apart = np.nonzero(np.minimum(sd1.min(axis=1), sd2.min(axis=1)) > 0.5 * margin)[0]
+    if apart.size:
+        seeds = vertex_seeds(sd1[apart], margin, _NEAR)
+        dist, solved, pts, _ = apart_distance(A, B, r1[apart], t1[apart], seeds, edge1[apart], along1[apart])
+        ok = apart[solved]
+        value[ok], point[ok] = dist[solved], pts[solved]
+    rest = np.nonzero(~np.isfinite(value))[0]
+    if rest.size:
+        value[rest], side[rest], point[rest] = _general(
+            A, B, sd1[rest], sd2[rest], r1[rest], t1[rest], r2[rest], t2[rest], margin
+        )
+    return value, side, point
+
+
+def apart_pairs(A: ExactTooth, polyA, rot_a, shift_a, B: ExactTooth, polyB, geomB, rot_b, shift_b, margin: float):
+    """Distance between the curves of pairs of placed teeth known to be apart (:mod:`wgcad.clearance.apart`), seeded
+    from A's polygon vertices as :func:`refine_pairs` is: ``(distance (K,), solved (K,), A's point, B's point)``, the
+    points in B's frame."""
+    (r1, t1), _ = _relative(rot_a, shift_a, rot_b, shift_b)
+    sd1, edge1, along1 = _vertex_sd(A, polyA, polyB, geomB, r1, t1)
+    return apart_distance(A, B, r1, t1, vertex_seeds(sd1, margin, _NEAR), edge1, along1)
+
+
+def _relative(rot_a, shift_a, rot_b, shift_b):
+    """A's poses in B's frames and B's in A's, ``((rot, shift), (rot, shift))``, B's poses broadcast to A's count."""
     rot_a = np.atleast_1d(np.asarray(rot_a, dtype=float))
     K = len(rot_a)
     rot_b = np.broadcast_to(np.asarray(rot_b, dtype=float), (K,))
     shift_a = np.atleast_2d(np.asarray(shift_a, dtype=float))
     shift_b = np.broadcast_to(np.asarray(shift_b, dtype=float), (K, 2))
-    r1, t1 = relative_pose(rot_a, shift_a, rot_b, shift_b)
-    r2, t2 = relative_pose(rot_b, shift_b, rot_a, shift_a)
-    sd1 = _vertex_sd(A, polyA, geomB, r1, t1)
-    sd2 = _vertex_sd(B, polyB, geomA, r2, t2)
+    return relative_pose(rot_a, shift_a, rot_b, shift_b), relative_pose(rot_b, shift_b, rot_a, shift_a)
+
+
+def _general(A: ExactTooth, B: ExactTooth, sd1, sd2, r1, t1, r2, t2, margin):
+    """Both sides' refinement of pairs that can touch or overlap (or whose distance the batch left unsolved)."""
+    K = len(r1)
     v1, _, _, p1, sure = _one_side(A, B, sd1, r1, t1, margin)
-    # the polygons' distance is the smaller vertex distance of the two sides (a polygon's closest point to
-    # another is a vertex of one of them); the curves are within margin / 2 of it, so above margin / 2
-    # the teeth are apart, and for teeth apart both sides' minima are the one distance between their
-    # boundaries: the second side is measured only for pairs that can touch or overlap, and for pairs
-    # whose first side has a row that stopped short of a stationary point (its figure only bounds)
+    # for teeth apart both sides' minima are the one distance between their boundaries: the second side is
+    # measured only for pairs that can touch or overlap, and for pairs whose first side has a row that stopped
+    # short of a stationary point (its figure only bounds)
     v2 = np.full(K, np.inf)
     p2 = np.full((K, 2), np.nan)
     two = np.nonzero((np.minimum(sd1.min(axis=1), sd2.min(axis=1)) <= 0.5 * margin) | ~sure)[0]
     if two.size:
         v2[two], _, _, p2[two], _ = _one_side(B, A, sd2[two], r2[two], t2[two], margin)
     side = (v2 < v1).astype(int)
-    value = np.minimum(v1, v2)
-    point = np.where(side[:, None] == 0, p1, p2)
-    return value, side, point
+    return np.minimum(v1, v2), side, np.where(side[:, None] == 0, p1, p2)

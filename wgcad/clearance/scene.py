@@ -11,7 +11,7 @@ import shapely
 from ..kinematics import gear_ratios
 from ..placement import pose_from_displacements, tooth_frames, tooth_pose, transform
 from .distance import Template, signed_clearance
-from .refine import ExactTooth, refine_pairs
+from .refine import ExactTooth, apart_pairs, refine_pairs
 
 __all__ = ["Scene", "tooth_clearance", "tooth_clearance_sections", "clearance_at_poses", "refine_min", "classify"]
 
@@ -199,25 +199,27 @@ class Scene:
             a_geoms=flex_geoms,
         )
 
+    def apart_to(self, rot, shift, j):
+        """Distance between the curves of flexspline teeth at poses ``(rot, shift)`` and rigid teeth ``j``, known to
+        be apart: ``(distance (K,), solved (K,), flexspline point (K, 2), rigid point (K, 2))``, the points in the
+        rigid tooth's frame (:func:`wgcad.clearance.refine.apart_pairs`)."""
+        j = np.atleast_1d(j)
+        f, r = self.flex, self.rigid
+        return apart_pairs(self.flex_exact, f.local, rot, shift, self.rigid_exact, r.local, r.polygon, *self._rigid(j))
+
     def exact_to(self, rot, shift, j):
         """Signed clearance of flexspline teeth at poses ``(rot, shift)`` to rigid teeth ``j`` on the exact curves.
 
         Returns ``(value (K,), side (K,), point (K, 2))`` of :func:`wgcad.clearance.refine.refine_pairs`.
         """
         j = np.atleast_1d(j)
-        return refine_pairs(
-            self.flex_exact,
-            self.flex.local,
-            self.flex.polygon,
-            rot,
-            shift,
-            self.rigid_exact,
-            self.rigid.local,
-            self.rigid.polygon,
-            self.rigid_rot[j],
-            self.rigid_shift[j],
-            margin=2.0 * self.chord_gap,
-        )
+        f, r = self.flex, self.rigid
+        flex = (self.flex_exact, f.local, f.polygon, rot, shift)
+        return refine_pairs(*flex, self.rigid_exact, r.local, r.polygon, *self._rigid(j))
+
+    def _rigid(self, j):
+        """Poses of rigid teeth ``j`` and the refinement's seed margin (twice the polygon-curve gap of a pair)."""
+        return self.rigid_rot[j], self.rigid_shift[j], 2.0 * self.chord_gap
 
 
 def tooth_clearance(scene: Scene, phi, z=None, third: bool = True, area: bool = False, exact: bool = False) -> dict:
