@@ -295,8 +295,9 @@ def _polygon_search(scene: Scene, phi_sorted: np.ndarray, sections: list, settin
 
 
 def _candidates(scene: Scene, results: list, best_poly: float, settings: AuditSettings):
-    """Every evaluated sample within the polygon-curve margin of the polygon minimum: (section, sample, figure)."""
-    cand_s, cand_i, cand_v = [], [], []
+    """Every evaluated sample within the polygon-curve margin of the polygon minimum: (section, sample, figure, and
+    its pairs' figures (n, 3))."""
+    cand_s, cand_i, cand_v, cand_p = [], [], [], []
     for si, r in enumerate(results):
         ev = np.nonzero(r.evaluated)[0]
         lim = best_poly + (2.0 * scene.chord_gap if settings.refine else 0.0)
@@ -304,13 +305,13 @@ def _candidates(scene: Scene, results: list, best_poly: float, settings: AuditSe
         cand_s.append(np.full(keep.size, si))
         cand_i.append(keep)
         cand_v.append(r.value[keep])
-    cand_s, cand_i, cand_v = np.concatenate(cand_s), np.concatenate(cand_i), np.concatenate(cand_v)
-    return cand_s, cand_i, cand_v
+        cand_p.append(r.pairs[keep])
+    return np.concatenate(cand_s), np.concatenate(cand_i), np.concatenate(cand_v), np.concatenate(cand_p)
 
 
 def _refine(drive, scene: Scene, phi_sorted, sections, cands, settings: AuditSettings, best_poly: float, stg):
     """The minimum on the exact curves (wgcad.clearance.cascade) and the (section, sample) holding it."""
-    cand_s, cand_i, cand_v = cands
+    cand_s, cand_i, cand_v, cand_pairs = cands
     best = best_poly
     n_refined = n_fine = 0
     if settings.refine:
@@ -329,7 +330,11 @@ def _refine(drive, scene: Scene, phi_sorted, sections, cands, settings: AuditSet
             def part(sl):
                 k = idx[sl]
                 rot, shift = ref_scene.pose_sections(phi_sorted[cand_i[k]], cand_s[k], sections)
-                det = clearance_at_poses(ref_scene, rot, shift)
+                # only the pairs whose polygon figure can hold their sample's minimum (within twice the
+                # polygon-curve gap of it: as scene.refine_min): about half of them
+                coarse = cand_pairs[k]
+                need = coarse <= np.nanmin(coarse, axis=1, keepdims=True) + 2.0 * scene.chord_gap
+                det = clearance_at_poses(ref_scene, rot, shift, need=need)
                 for key, arr in finer.items():
                     arr[k] = det[key]
                 return det["min"]

@@ -206,14 +206,17 @@ class ExactTooth:
     def _project(self, pts, idx, t, steps: int = 40):
         """Newton on ``(P(t) - x) . P'(t) = 0`` within each piece's range."""
         lo, hi = self.lo[idx], self.hi[idx]
+        t = np.array(t, dtype=float)
+        live = np.arange(len(t))  # a row stops once its step is below 1e-15 relative; the others go on
         for _ in range(steps):
-            P, d1, d2 = self.eval(idx, t)
-            r = P - pts
+            P, d1, d2 = self.eval(idx[live], t[live])
+            r = P - pts[live]
             g = (r * d1).sum(-1)
-            t_new = np.clip(t - g / curv_h(d1, r, d2), lo, hi)
-            done = np.abs(t_new - t) <= 1e-15 * np.maximum(1.0, np.abs(t))
-            t = t_new
-            if done.all():
+            t_new = np.clip(t[live] - g / curv_h(d1, r, d2), lo[live], hi[live])
+            done = np.abs(t_new - t[live]) <= 1e-15 * np.maximum(1.0, np.abs(t[live]))
+            t[live] = t_new
+            live = live[~done]
+            if live.size == 0:
                 break
         return t
 

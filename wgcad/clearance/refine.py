@@ -305,7 +305,7 @@ def _rotmat(rot):
 
 
 def refine_pairs(
-    A: ExactTooth, polyA, geomA, rot_a, shift_a, B: ExactTooth, polyB, geomB, rot_b, shift_b, margin: float
+    A: ExactTooth, polyA, geomA, rot_a, shift_a, B: ExactTooth, polyB, geomB, rot_b, shift_b, margin: float, apart=None
 ):
     """Exact signed clearance ``(K,)`` of pairs of placed teeth (A_k at ``rot_a, shift_a``, B_k at ``rot_b, shift_b``).
 
@@ -313,7 +313,8 @@ def refine_pairs(
     ``geomB`` prepared shapely polygons of them. ``margin`` (mm): vertices
     whose polygon signed distance is within it of the polygon minimum seed
     the refinement (module docstring); at least twice the polygons' distance
-    from the curves.
+    from the curves. ``apart (K,)`` bool, optional: pairs known to be apart
+    (their polygon figure above its polygon-curve gap), else found here.
 
     Returns
     -------
@@ -327,15 +328,18 @@ def refine_pairs(
     (r1, t1), (r2, t2) = _relative(rot_a, shift_a, rot_b, shift_b)
     K = len(r1)
     sd1, edge1, along1 = _vertex_sd(A, polyA, polyB, geomB, r1, t1)
-    sd2 = _vertex_sd(B, polyB, polyA, geomA, r2, t2)[0]
     # the polygons' distance is the smaller vertex distance of the two sides (a polygon's closest point to
     # another is a vertex of one of them); the curves are within margin / 2 of it, so above margin / 2
     # the teeth are apart: their figure is the distance between the curves (wgcad.clearance.apart), and
     # the pairs it leaves unsolved are refined as those that can touch or overlap
+    sd2 = None
+    if apart is None:
+        sd2 = _vertex_sd(B, polyB, polyA, geomA, r2, t2)[0]
+        apart = np.minimum(sd1.min(axis=1), sd2.min(axis=1)) > 0.5 * margin
     value = np.full(K, np.inf)
     side = np.zeros(K, dtype=int)
     point = np.full((K, 2), np.nan)
-    apart = np.nonzero(np.minimum(sd1.min(axis=1), sd2.min(axis=1)) > 0.5 * margin)[0]
+    apart = np.nonzero(apart)[0]
     if apart.size:
         seeds = vertex_seeds(sd1[apart], margin, _NEAR)
         dist, solved, pts, _ = apart_distance(A, B, r1[apart], t1[apart], seeds, edge1[apart], along1[apart])
@@ -343,8 +347,9 @@ def refine_pairs(
         value[ok], point[ok] = dist[solved], pts[solved]
     rest = np.nonzero(~np.isfinite(value))[0]
     if rest.size:
+        sd2r = sd2[rest] if sd2 is not None else _vertex_sd(B, polyB, polyA, geomA, r2[rest], t2[rest])[0]
         value[rest], side[rest], point[rest] = _general(
-            A, B, sd1[rest], sd2[rest], r1[rest], t1[rest], r2[rest], t2[rest], margin
+            A, B, sd1[rest], sd2r, r1[rest], t1[rest], r2[rest], t2[rest], margin
         )
     return value, side, point
 

@@ -207,15 +207,16 @@ class Scene:
         f, r = self.flex, self.rigid
         return apart_pairs(self.flex_exact, f.local, rot, shift, self.rigid_exact, r.local, r.polygon, *self._rigid(j))
 
-    def exact_to(self, rot, shift, j):
-        """Signed clearance of flexspline teeth at poses ``(rot, shift)`` to rigid teeth ``j`` on the exact curves.
+    def exact_to(self, rot, shift, j, apart=None):
+        """Signed clearance of flexspline teeth at poses ``(rot, shift)`` to rigid teeth ``j`` on the exact curves
+        (``apart``: the pairs known to be apart, optional).
 
         Returns ``(value (K,), side (K,), point (K, 2))`` of :func:`wgcad.clearance.refine.refine_pairs`.
         """
         j = np.atleast_1d(j)
         f, r = self.flex, self.rigid
         flex = (self.flex_exact, f.local, f.polygon, rot, shift)
-        return refine_pairs(*flex, self.rigid_exact, r.local, r.polygon, *self._rigid(j))
+        return refine_pairs(*flex, self.rigid_exact, r.local, r.polygon, *self._rigid(j), apart=apart)
 
     def _rigid(self, j):
         """Poses of rigid teeth ``j`` and the refinement's seed margin (twice the polygon-curve gap of a pair)."""
@@ -240,12 +241,17 @@ def tooth_clearance(scene: Scene, phi, z=None, third: bool = True, area: bool = 
 
 
 def tooth_clearance_sections(
-    scene: Scene, phi: np.ndarray, zi: np.ndarray, zs: list, exact: bool = False
-) -> np.ndarray:
-    """Smallest clearance of teeth at angles ``phi[k]`` in sections ``zs[zi[k]]``, in one batch, ``(K,)``."""
+    scene: Scene, phi: np.ndarray, zi: np.ndarray, zs: list, exact: bool = False, pairs: bool = False
+):
+    """Smallest clearance of teeth at angles ``phi[k]`` in sections ``zs[zi[k]]``, in one batch, ``(K,)``; with
+    ``pairs`` also each pair's ``(K, 3)`` (lower, upper, third)."""
     rot, shift = scene.pose_sections(phi, zi, zs)
     out = clearance_at_poses(scene, rot, shift)
-    return refine_min(scene, rot, shift, out)["min"] if exact else out["min"]
+    if exact:
+        out = refine_min(scene, rot, shift, out)
+    if pairs:
+        return out["min"], np.stack([out["lower"], out["upper"], out["third"]], axis=1)
+    return out["min"]
 
 
 def refine_min(scene: Scene, rot: np.ndarray, shift: np.ndarray, det: dict, gap: float | None = None) -> dict:
@@ -272,7 +278,9 @@ def refine_min(scene: Scene, rot: np.ndarray, shift: np.ndarray, det: dict, gap:
     # every pair of every kind in one call: the refinement's cost is per call more than per pair
     allk = np.concatenate([needs[k] for k in idx])
     allj = np.concatenate([idx[k][needs[k]] for k in idx])
-    ex = scene.exact_to(rot[allk], shift[allk], allj)[0] if allk.size else np.zeros(0)
+    # a pair whose polygon figure exceeds the polygons' gap is apart on the curves too
+    apart = np.concatenate([np.asarray(det[k], dtype=float)[needs[k]] > gap for k in idx])
+    ex = scene.exact_to(rot[allk], shift[allk], allj, apart=apart)[0] if allk.size else np.zeros(0)
     at = 0
     for key in idx:
         val = np.asarray(det[key], dtype=float).copy()
@@ -288,14 +296,23 @@ def refine_min(scene: Scene, rot: np.ndarray, shift: np.ndarray, det: dict, gap:
 
 
 def clearance_at_poses(
-    scene: Scene, rot: np.ndarray, shift: np.ndarray, third: bool = True, area: bool = False
+    scene: Scene, rot: np.ndarray, shift: np.ndarray, third: bool = True, area: bool = False, need=None
 ) -> dict:
-    """:func:`tooth_clearance` for teeth given by their poses (rigid frame)."""
+    """:func:`tooth_clearance` for teeth given by their poses (rigid frame).
+
+    ``need (K, 3)`` bool, optional: which of the lower, upper and third
+    pairs to measure (the others read inf; not with ``area``).
+    """
     lo, up, th = scene.neighbours(shift, rot)
     pts = transform(scene.flex_local, rot, shift)
     geoms = shapely.polygons(pts)  # built once, measured against every neighbour
     out = {}
-    for key, idx in (("lower", lo), ("upper", up)):
+    for col, (key, idx) in enumerate((("lower", lo), ("upper", up))):
+        if need is not None:
+            k = np.nonzero(need[:, col])[0]
+            out[key] = np.full(len(rot), np.inf)
+            out[key][k] = scene.clearance_to(rot[k], shift[k], idx[k], flex_geoms=geoms[k])
+            continue
         res = scene.clearance_to(rot, shift, idx, area=area, flex_geoms=geoms)
         if area:
             out[key], out[f"{key}_area"] = res
@@ -313,9 +330,12 @@ def clearance_at_poses(
         r_lo = np.minimum(R.min(axis=1), scene.rigid_r_min)
         lb = 2.0 * r_lo * np.sin(np.clip(gap, 0.0, None) / 2.0)
         # polygons lie within the chord tolerance of the curves: the bound is widened by that
-        need = np.nonzero(lb < best + scene.chord_gap)[0]
-        if need.size:
-            out["third"][need] = scene.clearance_to(rot[need], shift[need], th[need], flex_geoms=geoms[need])
+        near = lb < best + scene.chord_gap
+        if need is not None:
+            near &= need[:, 2]
+        k = np.nonzero(near)[0]
+        if k.size:
+            out["third"][k] = scene.clearance_to(rot[k], shift[k], th[k], flex_geoms=geoms[k])
     out["min"] = np.minimum(best, out["third"])
     out["lo"], out["up"], out["th"] = lo, up, th
     return out

@@ -61,6 +61,7 @@ class _SectionSearch:
         self.scene, self.phi, self.z, self.settings = scene, phi_u, z, settings
         n = len(phi_u)
         self.value = np.full(n, np.nan)
+        self.pairs = np.full((n, 3), np.nan)  # each evaluated sample's lower, upper and third pair
         self.evaluated = np.zeros(n, dtype=bool)
         self.radial = scene.radial_bound(scene.place(phi_u, z, local=scene.flex_tip_local))
         self.lower = self.radial.copy()
@@ -127,15 +128,17 @@ def _evaluate(scene: Scene, searches: list, picks: list, zs: list, done=None) ->
     if phis.size:
         zi = np.concatenate([np.full(len(ix), i) for i, ix in enumerate(picks)])
         vals = np.empty(len(phis))
+        pairs = np.empty((len(phis), 3))
         for a in range(0, len(phis), _CHUNK):
             b = min(a + _CHUNK, len(phis))
-            vals[a:b] = tooth_clearance_sections(scene, phis[a:b], zi[a:b], zs)
+            vals[a:b], pairs[a:b] = tooth_clearance_sections(scene, phis[a:b], zi[a:b], zs, pairs=True)
             if done is not None:
                 done(b / len(phis))
         at = 0
         for r, ix in zip(searches, picks):
             n = len(ix)
             r.value[ix] = vals[at : at + n]
+            r.pairs[ix] = pairs[at : at + n]
             r.lower[ix] = vals[at : at + n]
             r.evaluated[ix] = True
             at += n
