@@ -65,16 +65,42 @@ def refine_candidates(
     order = np.argsort(values, kind="stable")
     v = np.asarray(values, dtype=float)[order]
     n_fine = 0
-    if fine is not None and len(v) > FINE_ABOVE:
-        v, gap = fine(order)
-        n_fine = len(v)
-        o = np.argsort(v, kind="stable")
-        order, v = order[o], v[o]
-        keep = v <= v[0] + 2.0 * gap
-        order, v = order[keep], v[keep]
     best, where = np.inf, int(order[0])
     n_refined = 0
-    at = 0
+    if fine is not None and len(v) > FINE_ABOVE:
+        # the lowest few on the exact curves first: their best is a bar no candidate whose polygon figure less
+        # the gap is above can beat, which leaves fewer for the finer polygons
+        first = np.asarray(exact(order[:FIRST]), dtype=float)
+        n_refined = len(first)
+        j = int(np.argmin(first))
+        best, where = float(first[j]), int(order[j])
+        rest = np.nonzero(v[FIRST:] - gap < best)[0] + FIRST
+        if progress is not None:
+            progress(0.1)
+        if rest.size == 0:
+            return best, where, n_refined, n_fine
+        order, v = order[rest], v[rest]
+        if len(v) > FINE_ABOVE:
+            v, gap = fine(order)
+            n_fine = len(v)
+            o = np.argsort(v, kind="stable")
+            order, v = order[o], v[o]
+            keep = v <= v[0] + 2.0 * gap
+            order, v = order[keep], v[keep]
+    at = 0 if not n_refined else -1
+    if at < 0:  # the bar is set: every candidate that can still beat it, in one call
+        at = 0
+        if not len(v) or v[0] - gap >= best:
+            return best, where, n_refined, n_fine
+        live = np.nonzero(v - gap < best)[0]
+        vals = np.asarray(exact(order[live]), dtype=float)
+        n_refined += len(vals)
+        j = int(np.argmin(vals))
+        if vals[j] < best:
+            best, where = float(vals[j]), int(order[live[j]])
+        if progress is not None:
+            progress(1.0)
+        return best, where, n_refined, n_fine
     while at < len(v):
         # candidates are in increasing order: once one cannot beat the best exact figure, none after it can
         if v[at] - gap >= best:
