@@ -68,7 +68,9 @@ def backlash(scene: Scene, phi_h: float, z=None, exact: bool = False) -> float:
             fb = f(b)
         if np.sign(fb) == np.sign(f0):
             return float("inf")
-        return brentq(f, min(a, b), max(a, b), xtol=1e-13)
+        # to 1e-13 rad where the polygons' root is the answer; where the exact curves' is found from it, to
+        # 1e-9 rad: it only places the start of that search (2 gap / slope before it, ~1e-5 rad)
+        return brentq(f, min(a, b), max(a, b), xtol=1e-9 if exact else 1e-13)
 
     # with ``exact``: polygon figures are within ``gap`` of the curves' (docs/models.md 5)
     gap = scene.chord_gap if exact else 0.0
