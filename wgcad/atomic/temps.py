@@ -5,7 +5,6 @@ from __future__ import annotations
 import contextlib
 import os
 import re
-import secrets
 import stat
 import time
 from pathlib import Path
@@ -90,6 +89,8 @@ def _new_temp(final: Path) -> str:
     the usual permissions after the umask (``mkstemp`` makes it 0600, and that
     mode would survive the rename).
     """
+    import secrets  # here: its hashlib costs 4 ms of every command's start, and most write nothing
+
     for _ in range(100):
         temp = final.parent / f".{final.name}.{os.getpid()}-{secrets.token_hex(6)}{TEMP_SUFFIX}"
         try:
