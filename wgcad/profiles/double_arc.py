@@ -20,9 +20,9 @@ from __future__ import annotations
 from math import pi
 
 import numpy as np
-from scipy.optimize import brentq
 
 from ..errors import DesignError
+from ..roots import brentq
 from . import pieces as pc
 from .sampling import arc_points
 
@@ -64,7 +64,7 @@ def _first_crossing(center, radius: float, a0: float, sense: float, R: float) ->
     if hit.size == 0:
         return None
     i = int(hit[0])
-    return float(brentq(f, grid[i], grid[i + 1], xtol=1e-15, rtol=4 * np.finfo(float).eps))
+    return float(brentq(f, grid[i], grid[i + 1], xtol=1e-15))  # to 1e-15 + 4 eps |a|, as scipy's with rtol = 4 eps
 
 
 def _arc_to_circle(center, radius: float, start, direction, R: float, key: str, which: str, circle: str, fix: str):

@@ -78,7 +78,7 @@ def balanced_taper(drive, settings) -> dict | None:
     audited on the exact curves. None when the drive is not a coned internal-deformation cup or no taper
     within four times the depth-keeping one balances the ends.
     """
-    from scipy.optimize import brentq
+    from ..roots import brentq
 
     g = drive.design.generator
     if not drive.coned or drive.external:
