@@ -56,13 +56,15 @@ def _tip_wall(drive, cf, side: int = 1, clearance: float = 0.0, last=None) -> np
     rot, shift = cf.motion.pose(t)
     r_all, a_all = [], []
     for k in range(0, len(t), 500):
-        c, s = np.cos(rot[k : k + 500]), np.sin(rot[k : k + 500])
-        X = np.einsum("kij,nj->kni", np.stack([np.stack([c, -s], -1), np.stack([s, c], -1)], 1), pts)
-        X = X + shift[k : k + 500, None]
-        r = np.hypot(X[..., 0], X[..., 1])
+        c, s = np.cos(rot[k : k + 500])[:, None], np.sin(rot[k : k + 500])[:, None]
+        # turned and shifted by broadcasting (einsum's generic loop took 0.8 s of the 1.1 s here)
+        sh = shift[k : k + 500]
+        X0 = c * pts[:, 0] + (-s) * pts[:, 1] + sh[:, 0, None]
+        X1 = s * pts[:, 0] + c * pts[:, 1] + sh[:, 1, None]
+        r = np.hypot(X0, X1)
         sel = r > r_last
         r_all.append(r[sel])
-        a_all.append(np.arctan2(X[..., 1][sel], X[..., 0][sel]))
+        a_all.append(np.arctan2(X1[sel], X0[sel]))
     r, a = np.concatenate(r_all), np.concatenate(a_all)
     if not len(r):
         return np.empty((0, 2))

@@ -98,7 +98,10 @@ def _side_distance(piece, s0, x, rot, shift, with_gap: bool = False):
         d1, d2 = place(piece.deriv(s)), place(piece.deriv2(s))
         f = np.einsum("ij,ij->i", X - x, d1)
         df = np.einsum("ij,ij->i", d1, d1) + np.einsum("ij,ij->i", X - x, d2)
-        s = np.clip(s - f / df, lo, hi)
+        s_new = np.clip(s - f / df, lo, hi)
+        if np.array_equal(s_new, s):  # converged to the last bit: the remaining steps would change nothing
+            break
+        s = s_new
     X = place(piece.point(s)) + shift
     d1 = place(piece.deriv(s))
     travel = 1.0 if piece.t1 >= piece.t0 else -1.0
