@@ -6,6 +6,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .arrays import unique_sorted
 from .clearance.engine import AuditSettings, audit
 from .design import load_design
 from .design.budget import DEFAULT_MAX_MEMORY_MB
@@ -61,7 +62,7 @@ def _sections(drive, k: int) -> np.ndarray:
     """``k`` sections over the face width, and always both face ends (issue 13: ``--sections 1``
     checked only mid-face, -14.6 um where the open end was at -58.8 um)."""
     bw = drive.design.drive.face_width
-    return np.unique(np.concatenate([drive.sections(k), [0.0, bw]]))
+    return unique_sorted(np.concatenate([drive.sections(k), [0.0, bw]]))
 
 
 #: the CLI's flag of each RunSettings field, for its error lines

@@ -37,6 +37,7 @@ from math import pi
 
 import numpy as np
 
+from ..arrays import unique_sorted
 from ..placement import tooth_pose
 from .backlash import backlash
 from .cascade import FINE, refine_candidates
@@ -207,7 +208,7 @@ def audit(drive, settings: AuditSettings, progress=None) -> AuditResult:
         key = np.abs(key)
     n_samples = phi_all.size * len(sections)
     if settings.use_period:
-        phi_u = np.unique(np.round(key, 12))
+        phi_u = unique_sorted(np.round(key, 12))
     else:
         phi_u = key.ravel()
     order = np.argsort(phi_u, kind="stable")

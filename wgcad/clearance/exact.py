@@ -14,6 +14,8 @@ from __future__ import annotations
 import numpy as np
 import shapely
 
+from ..arrays import unique_sorted
+
 __all__ = ["ExactTooth", "point_signed_distance", "curv_h"]
 
 _SEED_GRID = 48  # samples per piece to seed the projection of a point
@@ -105,7 +107,7 @@ class ExactTooth:
         self.par = par
         self.rot = np.array([p.rot for p in self.pieces])
         self.flip = np.array([p.flip for p in self.pieces])
-        self.kinds = np.unique(self.kind)
+        self.kinds = unique_sorted(self.kind)
 
     def eval(self, idx: np.ndarray, t: np.ndarray, order: int = 2):
         """Point, first and second derivative ``(K, 2)`` each, for pieces ``idx`` at parameters ``t``."""
@@ -123,7 +125,7 @@ class ExactTooth:
             ii, tt = idx[sel], t[sel]
             if kd == 5:  # spline: each piece evaluates itself (rot and flip included)
                 where = np.flatnonzero(sel)
-                for j in np.unique(ii):
+                for j in unique_sorted(ii):
                     m = ii == j
                     pcs = self.pieces[j]
                     P[where[m]] = pcs.point(tt[m])

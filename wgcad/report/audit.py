@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..arrays import median
+
 __all__ = ["audit_json", "audit_summary", "worst_json", "entry_json", "backlash_at_json", "settings_json"]
 
 
@@ -138,7 +140,7 @@ def settings_json(run) -> dict:
     out = {
         "engine": "2d",
         "angles": int(A),
-        "angle_step_deg": round(float(np.rad2deg(np.median(np.diff(run.angles)))), 6) if A > 1 else None,
+        "angle_step_deg": round(float(np.rad2deg(median(np.diff(run.angles)))), 6) if A > 1 else None,
         "sections_z_mm": [None if z is None else round(z, 6) for z in run.sections],
         "sections_note": (
             "identical sections (no coning): one computed"
