@@ -68,9 +68,7 @@ def backlash(scene: Scene, phi_h: float, z=None, exact: bool = False) -> float:
             fb = f(b)
         if np.sign(fb) == np.sign(f0):
             return float("inf")
-        # to 1e-13 rad where the polygons' root is the answer; where the exact curves' is found from it, to
-        # 1e-9 rad: it only places the start of that search (2 gap / slope before it, ~1e-5 rad)
-        return brentq(f, min(a, b), max(a, b), xtol=1e-9 if exact else 1e-13)
+        return brentq(f, min(a, b), max(a, b), xtol=1e-13)
 
     # with ``exact``: polygon figures are within ``gap`` of the curves' (docs/models.md 5)
     gap = scene.chord_gap if exact else 0.0
@@ -87,6 +85,15 @@ def backlash(scene: Scene, phi_h: float, z=None, exact: bool = False) -> float:
         if d.min() < 0:
             return float("nan")  # teeth interfere here: there is no dead travel (no need to look further)
         sides.append((idx, direction, d))
+    if exact:
+        angles, bests = [], []
+        for idx, direction, d in sides:
+            roots = _polygon_roots(scene, turned, idx, direction, r_max, d, gap)
+            best = min(roots.values(), default=np.inf)
+            # a tooth needs at least (d - gap) / r_max to touch on the curves: the others cannot beat the best
+            angles.append({i: a for i, a in roots.items() if (d[i] - gap) / r_max < best})
+            bests.append(best)
+        return float(sum(_exact_sides(scene, turned, sides, angles, bests, gap)))
     bests, angles = [], []
     for idx, direction, d in sides:
         order = np.argsort(d)
@@ -97,18 +104,61 @@ def backlash(scene: Scene, phi_h: float, z=None, exact: bool = False) -> float:
             # the best found, no later tooth can beat it (less the polygon-curve gap when exact)
             if (d[i] - gap) / r_max >= best:
                 break
-            # (a pair the polygons overlap but the curves do not starts from no turn)
-            angle[int(i)] = (
-                max(contact_angle(int(i), int(idx[i]), direction), 0.0)
-                if exact
-                else contact_angle(int(i), int(idx[i]), direction)
-            )
+            angle[int(i)] = contact_angle(int(i), int(idx[i]), direction)
             best = min(best, angle[int(i)])
         bests.append(best)
         angles.append(angle)
-    if exact:
-        bests = _exact_sides(scene, turned, sides, angles, bests, gap)
     return float(sum(bests))
+
+
+def _polygon_roots(scene, turned, idx, direction, r_max, d=None, gap: float = 0.0) -> dict:
+    """Every tooth's polygon contact rotation (``{tooth: rad}``, inf where none within a rigid pitch), all teeth at once.
+
+    Where the exact curves' rotation is found from it (:func:`_exact_sides`) the polygon root only places the start
+    of that search, so it is found to 1e-9 rad, all teeth in one call per step: bracketed from ``d / r_max``
+    (doubling until the sign changes), then regula falsi (Illinois), leaving out (inf) the teeth that need more
+    than the smallest bracket's end to touch (``d``, less ``gap``, over ``r_max``: the same bound as the polygon
+    audit's loop). A pair the polygons overlap but the curves do not starts from no turn (its root reads 0).
+    """
+    n = len(idx)
+
+    def f(rows, x):
+        r, sh = turned(rows, direction * x)
+        return scene.clearance_to(r, sh, idx[rows])
+
+    rows = np.arange(n)
+    f0 = f(rows, np.zeros(n))
+    root = np.where(f0 == 0.0, 0.0, np.inf)
+    a, fa = np.zeros(n), f0.copy()
+    b = np.sign(f0) * np.maximum(np.abs(f0) / r_max, 1e-12)
+    fb = f(rows, b)
+    grow = np.nonzero((np.sign(fb) == np.sign(f0)) & (f0 != 0.0))[0]
+    while grow.size:
+        a[grow], fa[grow] = b[grow], fb[grow]
+        b[grow] *= 2.0
+        fb[grow] = f(grow, b[grow])
+        grow = grow[(np.sign(fb[grow]) == np.sign(f0[grow])) & (np.abs(b[grow]) < scene.gamma_b)]
+    live = np.nonzero((np.sign(fb) != np.sign(f0)) & (f0 != 0.0))[0]
+    if d is not None and live.size:
+        # every bracket's end bounds its root: a tooth that needs more than the smallest to touch is left out
+        best = min(float(np.abs(b[live]).min()), float(root.min()))
+        live = live[(d[live] - gap) / r_max < best]
+    for _ in range(200):
+        if live.size == 0:
+            break
+        done = (np.abs(b[live] - a[live]) <= 1e-9) | (fb[live] == 0.0)
+        root[live[done]] = b[live[done]]
+        live = live[~done]
+        if live.size == 0:
+            break
+        c = b[live] - fb[live] * (b[live] - a[live]) / (fb[live] - fa[live])
+        fc = f(live, c)
+        flip = np.sign(fc) != np.sign(fb[live])  # the root lies between c and b: b becomes the other end
+        keep = live[~flip]
+        fa[keep] *= 0.5  # Illinois: the end kept twice in a row has its value halved
+        a[live[flip]], fa[live[flip]] = b[live[flip]], fb[live[flip]]
+        b[live], fb[live] = c, fc
+    return {int(i): max(float(root[i]), 0.0) for i in range(n)}
 
 
 def _exact_sides(scene, turned, sides, angles, bests, gap) -> list:
