@@ -46,8 +46,10 @@ def refine_candidates(
     exact : callable
         ``exact(idx)``: the exact figures of candidates ``idx`` (indices into ``values``).
     fine : callable, optional
-        ``fine(idx)``: ``(figures on finer polygons, their gap)``, used when
-        there are more than :data:`FINE_ABOVE` candidates.
+        ``fine(idx, bar)``: ``(figures on finer polygons, their gap)``, used
+        when there are more than :data:`FINE_ABOVE` candidates; ``bar`` is the
+        best exact figure so far (a pair that cannot go below it need not be
+        measured: its figure may read inf).
     one_call : int
         Up to this many candidates are refined in a single call (no bar first).
     progress : callable, optional
@@ -81,7 +83,7 @@ def refine_candidates(
             return best, where, n_refined, n_fine
         order, v = order[rest], v[rest]
         if len(v) > FINE_ABOVE:
-            v, gap = fine(order)
+            v, gap = fine(order, best)
             n_fine = len(v)
             o = np.argsort(v, kind="stable")
             order, v = order[o], v[o]

@@ -321,7 +321,7 @@ def _refine(drive, scene: Scene, phi_sorted, sections, cands, settings: AuditSet
         # holds a sample's exact minimum is among them), about half the pairs of a flat minimum
         finer = {}
 
-        def fine(idx):
+        def fine(idx, bar=np.inf):
             # many samples within the polygon-curve margin (a flat minimum): polygons FINE times finer
             ref_scene = Scene(drive.sampled_at(drive.tol / FINE))
             n = len(cand_v)
@@ -335,6 +335,7 @@ def _refine(drive, scene: Scene, phi_sorted, sections, cands, settings: AuditSet
                 # polygon-curve gap of it: as scene.refine_min): about half of them
                 coarse = cand_pairs[k]
                 need = coarse <= np.nanmin(coarse, axis=1, keepdims=True) + 2.0 * scene.chord_gap
+                need &= coarse - scene.chord_gap < bar  # nor those that cannot go below the exact figures' best
                 det = clearance_at_poses(ref_scene, rot, shift, need=need)
                 for key, arr in finer.items():
                     arr[k] = det[key]

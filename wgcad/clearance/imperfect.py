@@ -349,7 +349,7 @@ def _refine(run: _Run, found: _Found) -> tuple[float, int, int, int]:
     finer = {}
     keys = ("lower", "upper", "third", "min", "lo", "up", "th")
 
-    def fine(idx):
+    def fine(idx, bar=None):
         ref = ImperfectScene.from_scene(Scene(run.drive.sampled_at(run.drive.tol / FINE)), run.imp)
         rot, shift = run.poses(found.a[idx], found.k[idx], found.s[idx])
         n = len(found.v)
