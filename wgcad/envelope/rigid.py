@@ -39,6 +39,22 @@ def _turn(p: np.ndarray, a: float) -> np.ndarray:
 WALL_MARGIN = 2e-4
 
 
+def _reaching(pts: np.ndarray, rot: np.ndarray, shift: np.ndarray, r_last: float):
+    """The poses at which some of the points ``pts`` can lie beyond the radius ``r_last``: every 8th point is placed,
+    and every point lies within ``reach`` of one of those (a rigid motion keeps distances), so a pose whose placed
+    points all stay within ``r_last - reach`` has none beyond it. The others are the only ones that count."""
+    n = len(pts)
+    i = np.arange(n)
+    i0 = (i // 8) * 8
+    i1 = np.minimum(i0 + 8, n - 1)
+    reach = float(np.minimum(np.hypot(*(pts - pts[i0]).T), np.hypot(*(pts - pts[i1]).T)).max())
+    sub = pts[::8]
+    c, s = np.cos(rot)[:, None], np.sin(rot)[:, None]
+    r = np.hypot(c * sub[:, 0] - s * sub[:, 1] + shift[:, 0, None], s * sub[:, 0] + c * sub[:, 1] + shift[:, 1, None])
+    keep = r.max(axis=1) + reach > r_last
+    return rot[keep], shift[keep]
+
+
 def _tip_wall(drive, cf, side: int = 1, clearance: float = 0.0, last=None) -> np.ndarray:
     """The wall's step beyond the flank's last point (rigid frame; none when the flank's own end angle is enough):
     the tooth's corners there trace paths, not envelopes (D1: the tip corner passed a radial wall by 2.3 um), so
@@ -54,8 +70,9 @@ def _tip_wall(drive, cf, side: int = 1, clearance: float = 0.0, last=None) -> np
     pts = pts[np.hypot(*pts.T) > drive.flex.r_f + 0.5 * (drive.flex.r_a - drive.flex.r_f)]  # the tooth's upper half
     t = np.arange(-0.6, 0.6, 2e-4)
     rot, shift = cf.motion.pose(t)
+    rot, shift = _reaching(pts, rot, shift, r_last)
     r_all, a_all = [], []
-    for k in range(0, len(t), 500):
+    for k in range(0, len(rot), 500):
         c, s = np.cos(rot[k : k + 500])[:, None], np.sin(rot[k : k + 500])[:, None]
         # turned and shifted by broadcasting (einsum's generic loop took 0.8 s of the 1.1 s here)
         sh = shift[k : k + 500]
@@ -65,7 +82,7 @@ def _tip_wall(drive, cf, side: int = 1, clearance: float = 0.0, last=None) -> np
         sel = r > r_last
         r_all.append(r[sel])
         a_all.append(np.arctan2(X1[sel], X0[sel]))
-    r, a = np.concatenate(r_all), np.concatenate(a_all)
+    r, a = (np.concatenate(v) if v else np.zeros(0) for v in (r_all, a_all))
     if not len(r):
         return np.empty((0, 2))
     bands = np.floor((r - r_last) / 1e-3).astype(int)
