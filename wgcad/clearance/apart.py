@@ -104,7 +104,7 @@ def apart_distance(A: ExactTooth, B: ExactTooth, rot, shift, seeds, edge, along)
         t[cross] = np.where(second, tb[m:], tb[:m])
     dist, done = _newton(A, B, rot[kk], shift[kk], ia, s, ib, t)
     ok = done & on
-    done[ok] = _kept(A, B, v[ok], ia[ok], s[ok], rot[kk[ok]], shift[kk[ok]], dist[ok])
+    done[ok] = _kept(A, B, kk[ok], v[ok], ia[ok], s[ok], rot[kk[ok]], shift[kk[ok]], dist[ok])
     done &= ok
     out = np.full(K, np.inf)
     point = np.full((K, 2), np.nan)
@@ -122,7 +122,7 @@ def apart_distance(A: ExactTooth, B: ExactTooth, rot, shift, seeds, edge, along)
     return out, solved & np.isfinite(out), point, other
 
 
-def _kept(A: ExactTooth, B: ExactTooth, v, ia, s, rot, shift, dist) -> np.ndarray:
+def _kept(A: ExactTooth, B: ExactTooth, kk, v, ia, s, rot, shift, dist) -> np.ndarray:
     """Rows whose end is the minimum their seed stands for: within two vertices of the seed along A's outline (a
     joint descent can slide along a valley into another basin, which the seed does not stand for: its own
     may be lower), at B's nearest point to it (:func:`wgcad.clearance.exact.point_signed_distance`)."""
@@ -134,7 +134,11 @@ def _kept(A: ExactTooth, B: ExactTooth, v, ia, s, rot, shift, dist) -> np.ndarra
     w = np.nonzero(within & np.isfinite(dist))[0]
     if w.size:
         pts = rotate(A.eval(ia[w], s[w], order=0)[0], rot[w]) + shift[w]
-        nearest[w] = point_signed_distance(B, pts) >= dist[w] - 1e-11
+        # rows of one pair that ended on one point (a seed's neighbours reach its minimum too) are measured once
+        key = np.column_stack([kk[w], np.round(pts * 1e9)])
+        _, first, back = np.unique(key, axis=0, return_index=True, return_inverse=True)
+        ok = point_signed_distance(B, pts[first]) >= dist[w][first] - 1e-11
+        nearest[w] = ok[back.ravel()]
     return nearest
 
 
