@@ -26,8 +26,10 @@ smallest is an upper bound of the exact distance, and it is the exact
 distance once a seed lies in the basin of the true minimum - the premise
 of the general refinement too, from the same vertices. A pair is solved
 only if every one of its rows converged (its last step moved the points by
-less than 1e-9 mm at a point where F is convex along the free parameters);
-the others are left to the general refinement. tests/test_apart.py checks
+less than 1e-7 mm at a point where F is convex along the free parameters),
+ended within two vertices of its seed along A's outline (a joint descent
+can slide into a basin its seed does not stand for) and at B's nearest
+point to it; the others are left to the general refinement. tests/test_apart.py checks
 the figures against it to 1e-9 mm on every template.
 """
 
