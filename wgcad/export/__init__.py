@@ -1,7 +1,7 @@
 """File exporters (DXF outlines and arcs, STL, 3MF, STEP, SVG; the part set in parts/) and the pictures; the atomic writes they use live in :mod:`wgcad.atomic`.
 
-The DXF and STL modules import ezdxf and manifold3d (together ~0.2 s warm, more
-on a cold start), so they are loaded on first use of a name that needs them
+Reading DXF imports ezdxf, a ring the zipper cannot triangulate manifold3d
+(together ~0.15 s warm, more on a cold start), so the modules are loaded on first use of a name that needs them
 (PEP 562 module ``__getattr__``): ``import wgcad.atomic`` or
 ``wgcad --help`` stays light.
 """
