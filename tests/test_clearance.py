@@ -4,6 +4,7 @@ from math import pi
 
 import numpy as np
 import pytest
+import shapely
 from conftest import TEMPLATES
 
 from wgcad.clearance.distance import Template, signed_clearance
@@ -300,3 +301,23 @@ def test_progress_moves_with_the_work(d1):
     assert len(calls) >= 10 and len({round(x, 3) for x in done}) >= 8
     stages = [s for _, _, s in calls]
     assert stages.index("entry gap") > stages.index("clearance")
+
+
+def test_pair_distance_on_two_threads_equals_shapely(monkeypatch):
+    """The split across the helper thread gives shapely's own figures, pair for pair, in order; an error in the
+    helper's half reaches the caller."""
+    import wgcad.clearance.distance as dist
+
+    rng = np.random.default_rng(5)
+    n = 1001
+    t = np.linspace(0, 2 * np.pi, 27, endpoint=False)
+    ring = np.c_[np.cos(t), np.sin(t)]
+    a = shapely.polygons(ring[None] * rng.uniform(0.5, 1, (n, 1, 1)) + rng.normal(0, 2, (n, 1, 2)))
+    b = shapely.polygons(ring[None] * rng.uniform(0.5, 1, (n, 1, 1)) + rng.normal(0, 2, (n, 1, 2)))
+    monkeypatch.setattr(dist, "_CORES", 2)
+    got = dist.pair_distance(a, b)
+    np.testing.assert_array_equal(got, shapely.distance(a, b))
+    assert (got == 0).any() and (got > 0).any()
+    np.testing.assert_array_equal(dist.pair_distance(a, b[0]), shapely.distance(a, b[0]))  # one against many
+    with pytest.raises(TypeError):
+        dist.pair_distance(np.array([1.0] * n, dtype=object), b)
