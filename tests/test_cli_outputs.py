@@ -161,6 +161,33 @@ def test_reader_closing_the_pipe_is_a_quiet_exit():
     assert p.wait(timeout=120) == 141 and err == ""
 
 
+def _run_in_python(code: str):
+    return subprocess.run(
+        [sys.executable, "-c", code],
+        env={**os.environ, "PYTHONPATH": str(ROOT)},
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
+
+
+def test_the_quick_exit_keeps_what_a_normal_exit_does():
+    """wgcad.cli.run leaves by os._exit: atexit handlers still run, buffered stdout (a pipe: block-buffered) is all
+    written, the exit code is main's; a live non-daemon thread is joined as by a normal exit."""
+    prelude = f"import atexit, sys, threading, time; from wgcad.cli import run; sys.argv = ['wgcad', 'kinematics', {str(D4)!r}]"
+    r = _run_in_python(prelude + "; atexit.register(lambda: print('atexit ran')); run()")
+    assert r.returncode == 0, r.stderr
+    assert r.stdout.startswith("D4") and r.stdout.rstrip().endswith("atexit ran"), r.stdout[-200:]
+    r = _run_in_python(
+        prelude + "; threading.Thread(target=lambda: (time.sleep(0.3), print('thread done'))).start(); run()"
+    )
+    assert r.returncode == 0 and r.stdout.rstrip().endswith("thread done"), r.stdout[-200:]
+    r = _run_in_python(prelude.replace("'kinematics'", "'audit', '--json', '-'") + "; run()")
+    assert r.returncode in (0, 1) and json.loads(r.stdout)  # the whole document reached the pipe
+    r = _run_in_python(prelude.replace("'kinematics'", "'kinematics', '--no-such-flag'") + "; run()")
+    assert r.returncode == 2 and r.stdout == ""
+
+
 def test_both_to_stdout_is_refused(capsys):
     code, out, err = run(["audit", D4, "--json", "-", "--write-baseline", "-"], capsys)
     one_line_error(code, err, "only one of them")
