@@ -85,10 +85,16 @@ def write_part_files(
                 raise GeometryError(f"{p.name}: mesh is not watertight")
             meshes[p.name] = m
             done += 1.0
-    solids = {}
+    solids, texts = {}, {}
     for p in step_parts:
         tick(done / total, f"STEP solid: {p.name}")
-        solids[p.name] = p.solid()
+        # the B-rep written without a CAD kernel where the part's recipe applies (OpenCASCADE is then not loaded)
+        brep = p.brep()
+        if brep is not None:
+            texts[p.name] = brep.text(p.name)
+            done += 4.0  # its file is written with the others
+        else:
+            solids[p.name] = p.solid()
         done += 4.0
     check_writable_dir(out)
     files = []
@@ -119,7 +125,9 @@ def write_part_files(
                 from .stl import write_stl
 
                 write_stl(target(f"{stem}_{p.name}.stl"), meshes[p.name])
-            if "step" in fmts and p.name in solids:
+            if "step" in fmts and p.name in texts:
+                Path(target(f"{stem}_{p.name}.step")).write_bytes(texts[p.name].encode("ascii"))
+            elif "step" in fmts and p.name in solids:
                 from .step import write_step
 
                 tick(done / total, f"STEP file: {p.name}")

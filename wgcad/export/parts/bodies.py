@@ -13,6 +13,7 @@ from wgcad.export.gear_data import data_lines, gear_data
 from wgcad.plane import signed_area
 from wgcad.profiles.band import gear_band_outline
 
+from . import breps
 from .part import Part
 from .solids import bolt_circle, circle_points, holes_m, loft_m, n_segments, prism_m, revolve_m, to_mesh
 
@@ -110,8 +111,12 @@ def flexspline(drive, sizes, style: str, tol: float) -> Part:
         def mesh():
             return to_mesh(prism_m(circle_points(R, tol), [band], 0.0, bw))
 
+        def brep():
+            teeth, _ = breps.teeth_loop(path, material_left=False)
+            return breps.ring(breps.circle_loop(0.0, 0.0, R), [teeth], 0.0, bw)
+
         info["kind"] = "toothed flexible ring (external deformation: no cup)"
-        return Part("flexspline", layers, solid, mesh, vol, ((-R, -R, 0.0), (R, R, bw)), info)
+        return Part("flexspline", layers, solid, mesh, vol, ((-R, -R, 0.0), (R, R, bw)), info, make_brep=brep)
     L, ts, td = sizes.cup_length, sizes.shell_thickness, sizes.diaphragm_thickness
     r_bore = 0.5 * sizes.hub_bore_diameter
     holes = bolt_circle(sizes.cup_bolt_circle_diameter, sizes.cup_bolt_count, sizes.cup_bolt_hole_diameter)
@@ -138,8 +143,14 @@ def flexspline(drive, sizes, style: str, tol: float) -> Part:
         n = n_segments(r_rim + ts, tol)
         return to_mesh(ring + (revolve_m(rz, n) - holes_m(holes, L - td, L, tol)))
 
+    def brep():
+        teeth, radii = breps.teeth_loop(path)
+        return breps.cup(teeth, radii, r_rim, ts, L, td, r_bore, holes, bw)
+
     info.update(_cup_info(sizes, r_bore))
-    return Part("flexspline", layers, solid, mesh, vol, ((-tip_r, -tip_r, 0.0), (tip_r, tip_r, L)), info)
+    return Part(
+        "flexspline", layers, solid, mesh, vol, ((-tip_r, -tip_r, 0.0), (tip_r, tip_r, L)), info, make_brep=brep
+    )
 
 
 def face_modification(drive) -> dict:
@@ -347,6 +358,9 @@ def plug(drive, sizes, tol: float) -> Part:
         def solid():
             return S.prism(S.bspline_wire(outline), [S.circle_wire(r_b)], width, z0)
 
+        def brep():
+            return breps.plug(outline, r_b, z0, z1)
+
         def mesh():
             return to_mesh(prism_m(outline, [circle_points(r_b, tol)], z0, z1))
 
@@ -365,6 +379,9 @@ def plug(drive, sizes, tol: float) -> Part:
         def solid():
             return S.prism(S.circle_wire(R_out), [S.bspline_wire(outline)], width, z0)
 
+        def brep():
+            return breps.generator_ring(outline, R_out, z0, z1)
+
         def mesh():
             return to_mesh(prism_m(circle_points(R_out, tol), [outline], z0, z1))
 
@@ -372,7 +389,7 @@ def plug(drive, sizes, tol: float) -> Part:
     info["volume_tol_mm3"] = tol * perim * width  # outline known to the chord tolerance along its whole length
     info["plug_outline"] = outline
     info["neutral_line"] = po["neutral"]
-    return Part(name, layers, solid, mesh, vol, ((-rmax, -rmax, z0), (rmax, rmax, z1)), info)
+    return Part(name, layers, solid, mesh, vol, ((-rmax, -rmax, z0), (rmax, rmax, z1)), info, make_brep=brep)
 
 
 def _rigid_teeth(drive, style: str, tol: float, sectored: dict | None) -> tuple:
@@ -454,6 +471,10 @@ def rigid(drive, sizes, style: str, tol: float, sectored: dict | None = None) ->
                 return body
             return S.cut(body, S.prism(S.circle_wire(Rf + 1.0), [S.circle_wire(R)], bw - tf + 1.0, -1.0))
 
+        def brep():
+            teeth, radii = breps.teeth_loop(path, None if path is not None else band, material_left=False)
+            return breps.flanged(teeth, radii, R, Rf, holes, bw, tf)
+
         def mesh():
             plate = prism_m(
                 circle_points(Rf, tol), [band] + [circle_points(0.5 * h, tol, x, y) for x, y, h in holes], bw - tf, bw
@@ -487,5 +508,9 @@ def rigid(drive, sizes, style: str, tol: float, sectored: dict | None = None) ->
                 )
             )
 
+        def brep():
+            teeth, _ = breps.teeth_loop(path)
+            return breps.ring(teeth, [breps.circle_loop(0.0, 0.0, R, False), *breps.hole_loops(holes)], 0.0, bw)
+
     info["gear_data"] = data
-    return Part("rigid", layers, solid, mesh, vol, ((-tip_r, -tip_r, 0.0), (tip_r, tip_r, bw)), info)
+    return Part("rigid", layers, solid, mesh, vol, ((-tip_r, -tip_r, 0.0), (tip_r, tip_r, bw)), info, make_brep=brep)

@@ -27,6 +27,9 @@ class Part:
         Expected bounding box, mm.
     info : dict
         Sizes and figures reported for the part.
+    make_brep : callable -> wgcad.export.brep.Brep or None, optional
+        The solid as B-rep text without a CAD kernel (:mod:`wgcad.export.parts.breps`), ``None`` where its recipe
+        does not apply; the STEP file is then made from :meth:`solid`.
     """
 
     name: str
@@ -36,6 +39,7 @@ class Part:
     volume_mm3: float
     bounds: tuple
     info: dict = field(default_factory=dict)
+    make_brep: Callable | None = field(default=None, repr=False)
     _solid: object = field(default=None, repr=False)
     _mesh: object = field(default=None, repr=False)
 
@@ -44,6 +48,10 @@ class Part:
         if self._solid is None:
             self._solid = self.make_solid()
         return self._solid
+
+    def brep(self):
+        """The B-rep of the solid written without OpenCASCADE, or ``None`` (then :meth:`solid`)."""
+        return self.make_brep() if self.make_brep is not None else None
 
     def mesh(self):
         """The mesh (built once)."""
