@@ -34,10 +34,13 @@ BOUNDS_MM = 1e-9
 # OpenCASCADE reads a STEP file in time that grows fast with the edges of a face's loop (D1 involute's 1,800-face
 # flexspline 4.6 s, its own file of it 9.1 s; D1 cycloidal's 7,800 faces 232 s, its own 617 s): the parts are read
 # back on these templates (a cup on arcs, a face-modified drive's plug and rigid gear, the external drive, small
-# discrete teeth); on every template every part's shell is checked closed and oriented as it is written
-READ = ["d1_involute", "d1_conjugate_modified", "d3_external", "d4_discrete"]
-# and built by OpenCASCADE's booleans for comparison (~1-15 s a part)
-COMPARED = ["d1_involute", "d3_external", "d4_discrete"]
+# discrete teeth; of the external drive its generator ring, whose toothed rings are prisms like D1's and take 25 s);
+# on every template every part's shell is checked closed and oriented as it is written
+READ = {"d1_involute": None, "d1_conjugate_modified": None, "d3_external": ("generator_ring",), "d4_discrete": None}
+# and built by OpenCASCADE's booleans for comparison (~1-15 s a part): a cup, a plug and a flanged rigid gear on arcs,
+# the external drive's generator ring (its B-spline as a hole; its toothed rings are D1's prisms again, 30 s), small
+# discrete teeth
+COMPARED = {"d1_involute": None, "d3_external": ("generator_ring",), "d4_discrete": None}
 
 
 def _read(text: str, tmp_path, name: str):
@@ -70,7 +73,7 @@ def test_every_template_part_is_a_closed_shell(name):
 def test_parts_read_back_as_one_valid_solid_of_their_volume(name, tmp_path):
     for p in _parts(name):
         b = p.brep()
-        if b is None:
+        if b is None or (READ[name] is not None and p.name not in READ[name]):
             continue
         _, pr = _read(b.text(p.name), tmp_path, p.name)
         assert pr["valid"], p.name
@@ -95,6 +98,8 @@ def test_straight_segments_and_holes_read_back(tmp_path):
 @pytest.mark.parametrize("name", COMPARED)
 def test_parts_equal_opencascade_booleans(name, tmp_path):
     for p in _parts(name):
+        if COMPARED[name] is not None and p.name not in COMPARED[name]:
+            continue
         _, ours = _read(p.brep().text(p.name), tmp_path, p.name)
         ref = solid_props(p.solid())
         rel = SPLINE_REL if "plug_outline" in p.info else EXACT_REL
