@@ -1,10 +1,11 @@
 """STEP AP214 B-rep solids bounded by vertical walls and horizontal faces, written as text (no CAD kernel).
 
-Every solid of the part set but the face-modified flexspline is of this
-kind: toothed rings, the cup on its ring, the flanged rigid gear, the plug.
-Such a solid is a set of *walls* - a closed loop of plane curves (lines,
-circular arcs, circles, a periodic cubic B-spline) swept straight along z
-between two heights - and *caps*, the plane faces at the walls' ends. Its
+Every solid of the part set is of this kind: toothed rings, the cup on its
+ring, the flanged rigid gear, the plug. Such a solid is a set of *walls* - a
+closed loop of plane curves (lines, circular arcs, circles, a periodic cubic
+B-spline) swept straight along z between two heights, or ruled between two
+loops of corresponding segments (the face-modified ring, docs/models.md
+13.4) - and *caps*, the plane faces at the walls' ends. Its
 boundary follows from the loops alone: no surface is intersected with
 another, so no boolean operation is needed and OpenCASCADE (235 MB resident
 once imported, docs/models.md appendix A) is not loaded for them.
@@ -19,6 +20,8 @@ used by exactly two faces in opposite directions (a closed, oriented shell).
 """
 
 from __future__ import annotations
+
+import math
 
 import numpy as np
 
@@ -150,6 +153,22 @@ def spline_loop(points, material_left: bool = True) -> list:
     return [Spline(spl.t, spl.c, 3, pts[0])]
 
 
+def _bezier(seg) -> tuple[np.ndarray, np.ndarray]:
+    """A segment as one rational Bezier piece: control points and weights (an arc under half a turn: the tangents'
+    meeting point in the middle, weighted ``cos(theta / 2)``)."""
+    if isinstance(seg, Line):
+        return np.array([seg.p0, seg.p1]), np.array([1.0, 1.0])
+    a0 = np.arctan2(*(seg.p0 - seg.center)[::-1])
+    a1 = np.arctan2(*(seg.p1 - seg.center)[::-1])
+    theta = (a1 - a0) % (2 * np.pi) if seg.ccw else -((a0 - a1) % (2 * np.pi))
+    if not abs(theta) < np.pi:
+        raise GeometryError("an arc of half a turn or more in a ruled face")
+    mid = a0 + 0.5 * theta
+    half = math.cos(0.5 * theta)
+    pm = seg.center + seg.radius / half * np.array([math.cos(mid), math.sin(mid)])
+    return np.array([seg.p0, pm, seg.p1]), np.array([1.0, half, 1.0])
+
+
 def _shoelace(v: np.ndarray) -> float:
     x, y = v[:, 0], v[:, 1]
     return 0.5 * float(np.dot(x, np.roll(y, -1)) - np.dot(np.roll(x, -1), y))
@@ -269,6 +288,80 @@ class Brep:
             surface, out = self._surface(seg, z0, z1)
             self._face([([(bottom[i], True), (up[j], True), (top[i], False), (up[i], False)], True)], surface, out)
         return _Wall(loop, z0, z1, bottom, top)
+
+    def ruled_wall(self, bottom: list, top: list, z0: float, z1: float) -> _Wall:
+        """The side faces ruled between two loops of corresponding segments, ``bottom`` at ``z0`` and ``top`` at
+        ``z1`` (both with the material on their left; segment ``i`` of one joined to segment ``i`` of the other by
+        straight lines between points of equal parameter, as a ruled loft).
+
+        A pair of segments that are translates of each other sweeps an oblique cylinder (a surface of linear
+        extrusion) or a plane; any other pair of arcs of one angle, or of lines, a rational B-spline surface of
+        degree 1 across and 2 (1 for lines) along, which is that ruled surface exactly.
+        """
+        if not z1 > z0:
+            raise GeometryError(f"a wall from z = {z0} to {z1} mm")
+        if len(bottom) != len(top) or any(type(a) is not type(b) or a.closed for a, b in zip(bottom, top)):
+            raise GeometryError("a ruled wall needs loops of corresponding open segments of the same kinds")
+        n = len(bottom)
+        vb = [self._vertex(s.p0[0], s.p0[1], z0) for s in bottom]
+        vt = [self._vertex(s.p0[0], s.p0[1], z1) for s in top]
+        side = []
+        for i in range(n):
+            a, b = np.array([*bottom[i].p0, z0]), np.array([*top[i].p0, z1])
+            d = (b - a) / np.linalg.norm(b - a)
+            side.append(self._edge(vb[i], vt[i], self._line(a, d), True))
+        out_b, out_t = [], []
+        for i, (sa, sb) in enumerate(zip(bottom, top)):
+            j = (i + 1) % n
+            curve, sense = self._curve(sa, z0)
+            out_b.append(self._edge(vb[i], vb[j], curve, sense))
+            out_t.append(self._edge(vt[i], vt[j], self._curve(sb, z1)[0], sense))
+            surface, outward = self._ruled(sa, sb, z0, z1, curve)
+            self._face(
+                [([(out_b[i], True), (side[j], True), (out_t[i], False), (side[i], False)], True)], surface, outward
+            )
+        return _Wall(bottom, z0, z1, out_b, out_t)
+
+    def _ruled(self, sa, sb, z0: float, z1: float, curve_a: int) -> tuple[int, bool]:
+        """The surface ruled between corresponding segments, and whether its normal points out of the material."""
+        shift = sb.p0 - sa.p0
+        vec = np.array([shift[0], shift[1], z1 - z0])
+        # translates within 1e-9 mm (the same curve moved: rounding of ~1e-13 mm), far inside the file's 1e-7 mm
+        translated = np.allclose(sb.p1 - sa.p1, shift, rtol=0, atol=1e-9) and (
+            isinstance(sa, Line) or (np.allclose(sb.center - sa.center, shift, rtol=0, atol=1e-9))
+        )
+        if translated and isinstance(sa, Line):
+            n = np.cross([sa.dir[0], sa.dir[1], 0.0], vec)
+            n /= np.linalg.norm(n)
+            axis = self._axis((sa.p0[0], sa.p0[1], z0), tuple(n), (sa.dir[0], sa.dir[1], 0.0))
+            return self._add(f"PLANE('',#{axis})"), True
+        if translated:
+            length = float(np.linalg.norm(vec))
+            v = self._add(f"VECTOR('',#{self._dir(*(vec / length))},{real(length)})")
+            # normal C'(u) x V: right of the circle's counter-clockwise run, out of the material where the arc runs so
+            return self._add(f"SURFACE_OF_LINEAR_EXTRUSION('',#{curve_a},#{v})"), sa.ccw
+        rows, w = [], None
+        for seg, z in ((sa, z0), (sb, z1)):
+            pts, wts = _bezier(seg)
+            if w is not None and not np.allclose(wts, w, rtol=0, atol=1e-12):
+                raise GeometryError("a ruled face between arcs of different angles")
+            w = wts
+            rows.append([(x, y, z) for x, y in pts])
+        net = ",".join("(" + ",".join(f"#{self._point(*p)}" for p in row) + ")" for row in rows)
+        deg = len(w) - 1
+        knots = f"(2,2),({deg + 1},{deg + 1}),(0.,1.),(0.,1.),.UNSPECIFIED."
+        if deg == 1:
+            surf = self._add(f"B_SPLINE_SURFACE_WITH_KNOTS('',1,1,({net}),.UNSPECIFIED.,.F.,.F.,.F.,{knots})")
+        else:
+            weights = "(" + ",".join("(" + ",".join(real(x) for x in w) + ")" for _ in rows) + ")"
+            surf = self._add(
+                f"( BOUNDED_SURFACE() B_SPLINE_SURFACE(1,{deg},({net}),.UNSPECIFIED.,.F.,.F.,.F.) "
+                f"B_SPLINE_SURFACE_WITH_KNOTS({knots}) GEOMETRIC_REPRESENTATION_ITEM() "
+                f"RATIONAL_B_SPLINE_SURFACE({weights}) REPRESENTATION_ITEM('') SURFACE() )"
+            )
+        # S_u (across, up the ruling) x S_v (along the segment's run): left of the run for a rising ruling, so the
+        # normal points into the material; the face's normal is the opposite one
+        return surf, False
 
     def cap(self, z: float, up: bool, parts: list) -> None:
         """The plane face at height ``z``, its outward normal +z if ``up``.

@@ -222,10 +222,19 @@ def _modified_cup(drive, sizes, tol: float, drawn: tuple, rz, holes, shell: floa
         ring = loft_m(bands[0], bands[1], 0.0, bw) - bore
         return to_mesh(ring + (revolve_m(rz, n) - holes_m(holes, L - sizes.diaphragm_thickness, L, tol)))
 
+    def brep():
+        (l0, r0), (l1, r1) = (breps.teeth_loop(fit_gear(g, tol, o)) for o in offs)
+        teeth_r = np.concatenate([r0, r1])
+        td = sizes.diaphragm_thickness
+        r_bore = 0.5 * sizes.hub_bore_diameter
+        return breps.cup((l0, l1), teeth_r, r_rim, sizes.shell_thickness, L, td, r_bore, holes, bw)
+
     info.update(_cup_info(sizes, 0.5 * sizes.hub_bore_diameter))
     info["face_modification"] = face_modification(drive)
     tip_r = float(np.hypot(*g.outline.T).max()) + max(0.0, *offs)
-    return Part("flexspline", layers, solid, mesh, vol, ((-tip_r, -tip_r, 0.0), (tip_r, tip_r, L)), info)
+    return Part(
+        "flexspline", layers, solid, mesh, vol, ((-tip_r, -tip_r, 0.0), (tip_r, tip_r, L)), info, make_brep=brep
+    )
 
 
 def plug_outline(drive, sizes, n: int | None = None) -> dict:

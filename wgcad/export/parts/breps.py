@@ -58,7 +58,9 @@ def cup(
     ``r_rim .. r_rim + ts`` up to ``z = L``, diaphragm ``L - td .. L`` with the hub bore ``r_bore`` and bolt holes).
 
     One bore face runs from the ring's open end to the diaphragm; the ring's top face is the annulus between the
-    teeth and the shell. ``None`` where the shell would reach the tooth roots or a hole leaves the diaphragm.
+    teeth and the shell. ``teeth`` is one loop, or the loops at ``z = 0`` and ``z = bw`` of a face-modified ring
+    (``teeth_r`` then the radii of both). ``None`` where the shell would reach the tooth roots or a hole leaves the
+    diaphragm.
     """
     r_shell = r_rim + ts
     if not (teeth_r.min() > r_shell + MARGIN and 0 < r_bore < r_rim - MARGIN and L - td > bw + MARGIN):
@@ -66,7 +68,8 @@ def cup(
     if not _holes_fit(holes, r_bore, r_rim):
         return None
     b = Brep()
-    w_teeth = b.wall(teeth, 0.0, bw)
+    # a pair of loops: the face-modified ring, ruled between its sections at z = 0 and z = bw
+    w_teeth = b.ruled_wall(*teeth, 0.0, bw) if isinstance(teeth, tuple) else b.wall(teeth, 0.0, bw)
     w_bore = b.wall(circle_loop(0.0, 0.0, r_rim, material_left=False), 0.0, L - td)
     w_shell = b.wall(circle_loop(0.0, 0.0, r_shell), bw, L)
     w_hub = b.wall(circle_loop(0.0, 0.0, r_bore, material_left=False), L - td, L)
