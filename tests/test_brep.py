@@ -122,8 +122,9 @@ def test_parts_equal_opencascade_booleans(name, tmp_path):
 @pytest.mark.skipif(shutil.which("freecadcmd") is None, reason="FreeCAD (freecadcmd) not installed")
 def test_freecad_reads_the_template_parts(tmp_path):
     files = []
-    for p in _parts("d1_involute"):
-        path, pr = _read(p.brep().text(p.name), tmp_path, p.name)
+    parts = _parts("d1_involute") + [p for p in _parts("d1_double_arc") if p.name == "flexspline"]  # + a ruled ring
+    for k, p in enumerate(parts):
+        path, pr = _read(p.brep().text(p.name), tmp_path, f"{k}_{p.name}")
         files.append((path, pr["volume"]))
     script = tmp_path / "read.py"
     script.write_text(
