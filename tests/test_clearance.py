@@ -5,7 +5,7 @@ from math import pi
 import numpy as np
 import pytest
 import shapely
-from conftest import TEMPLATES
+from conftest import TEMPLATES, edit_toml
 
 from wgcad.clearance.distance import Template, signed_clearance
 from wgcad.clearance.engine import AuditSettings, Scene, audit, brute_force_min, tooth_clearance
@@ -321,3 +321,22 @@ def test_pair_distance_on_two_threads_equals_shapely(monkeypatch):
     np.testing.assert_array_equal(dist.pair_distance(a, b[0]), shapely.distance(a, b[0]))  # one against many
     with pytest.raises(TypeError):
         dist.pair_distance(np.array([1.0] * n, dtype=object), b)
+
+
+def test_a_conjugate_space_deeper_than_its_root_circle_keeps_a_valid_tooth(tmp_path):
+    """Fuzz finding (seed 2078): D1 conjugate without the rigid gear's shift generates a tooth space 2.25 mm beyond
+    the nominal root circle; the tooth polygon's closure through the body then crossed the period and the audit
+    stopped with an internal error (GEOS TopologyException). The closure lies beyond the period's deepest point now:
+    a valid polygon, and the audit reports the interference (exit 1)."""
+    import shapely
+
+    from wgcad.cli import main
+
+    path = tmp_path / "d1c.toml"
+    path.write_text(edit_toml((TEMPLATES / "d1_conjugate.toml").read_text(), "rigid", "shift", None))
+    drive = build_drive(load_design(path))
+    r = np.hypot(*drive.rigid.period.T)
+    assert r.max() > drive.rigid.r_f + 2.0  # the premise: the space runs deeper than the root circle
+    for gear in (drive.flex, drive.rigid):
+        assert shapely.Polygon(gear.tooth_polygon()).is_valid
+    assert main(["audit", str(path), "--quiet", "--step-deg", "4", "--no-refine"]) == 1

@@ -161,7 +161,11 @@ class Gear:
         internal gear.
         """
         depth = 0.5 * self.spec.module if depth is None else depth
-        r_body = self.r_f + depth if self.spec.internal else self.r_f - depth
+        # beyond the period's own deepest point too: a conjugate space can run deeper than the nominal root circle
+        # (a rigid gear's envelope with its shift left out: 2.3 mm on D1 conjugate), and a closure inside the period
+        # made the polygon cross itself (an internal error in the audit, issue 21's fuzz)
+        r = np.hypot(self.period[:, 0], self.period[:, 1])
+        r_body = max(self.r_f, float(r.max())) + depth if self.spec.internal else min(self.r_f, float(r.min())) - depth
         a = pi / self.spec.z
         ends = polar(r_body, np.array([a, -a]))
         poly = np.concatenate([self.period, ends])
