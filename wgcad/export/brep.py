@@ -26,6 +26,8 @@ import math
 import numpy as np
 
 from wgcad.errors import GeometryError
+from wgcad.export.arcs import bulge_centres
+from wgcad.plane import signed_area
 
 __all__ = [
     "Line",
@@ -41,7 +43,7 @@ __all__ = [
     "real",
 ]
 
-#: FILE_NAME time stamp, fixed so the same design gives byte-identical files (as wgcad.export.step)
+#: FILE_NAME time stamp, fixed so the same design gives byte-identical files (wgcad.export.step stamps OCCT's too)
 FIXED_STAMP = "2000-01-01T00:00:00"
 
 
@@ -71,15 +73,16 @@ class Line:
 
 
 class Arc:
-    """A circular arc ``p0 -> p1`` about ``center``, counter-clockwise if ``ccw``."""
+    """A circular arc ``p0 -> p1`` about ``center`` through the signed angle ``theta`` (counter-clockwise if > 0)."""
 
     closed = False
 
-    def __init__(self, p0, p1, center, ccw: bool):
+    def __init__(self, p0, p1, center, theta: float):
         self.p0, self.p1 = np.asarray(p0, dtype=float), np.asarray(p1, dtype=float)
         self.center = np.asarray(center, dtype=float)
         self.radius = float(np.hypot(*(self.p0 - self.center)))
-        self.ccw = bool(ccw)
+        self.theta = float(theta)
+        self.ccw = self.theta > 0
 
 
 class Circle:
@@ -112,20 +115,11 @@ def path_loop(vertices, bulges, material_left: bool = True) -> list:
     clockwise (pass ``material_left=False`` for a hole)."""
     v = np.asarray(vertices, dtype=float)
     b = np.asarray(bulges, dtype=float)
-    if (_shoelace(v) > 0) != material_left:
+    if (signed_area(v) > 0) != material_left:
         v, b = v[::-1], -np.roll(b[::-1], -1)
-    out = []
-    for i in range(len(v)):
-        p0, p1 = v[i], v[(i + 1) % len(v)]
-        if b[i] == 0.0:
-            out.append(Line(p0, p1))
-            continue
-        c = p1 - p0
-        d = float(np.hypot(*c))
-        left = np.array([-c[1], c[0]]) / d
-        center = 0.5 * (p0 + p1) + left * (0.5 * d) * (1.0 - b[i] ** 2) / (2.0 * b[i])
-        out.append(Arc(p0, p1, center, b[i] > 0))
-    return out
+    e = np.roll(v, -1, axis=0)
+    centre, _, theta = bulge_centres(v, e, b)
+    return [Line(v[i], e[i]) if b[i] == 0.0 else Arc(v[i], e[i], centre[i], theta[i]) for i in range(len(v))]
 
 
 def polygon_loop(points, material_left: bool = True) -> list:
@@ -145,7 +139,7 @@ def spline_loop(points, material_left: bool = True) -> list:
     from scipy.interpolate import make_interp_spline
 
     pts = np.asarray(points, dtype=float)
-    if (_shoelace(pts) > 0) != material_left:
+    if (signed_area(pts) > 0) != material_left:
         pts = pts[::-1]
     closed = np.vstack([pts, pts[:1]])
     t = np.concatenate([[0.0], np.cumsum(np.hypot(*np.diff(closed, axis=0).T))])
@@ -159,19 +153,13 @@ def _bezier(seg) -> tuple[np.ndarray, np.ndarray]:
     if isinstance(seg, Line):
         return np.array([seg.p0, seg.p1]), np.array([1.0, 1.0])
     a0 = np.arctan2(*(seg.p0 - seg.center)[::-1])
-    a1 = np.arctan2(*(seg.p1 - seg.center)[::-1])
-    theta = (a1 - a0) % (2 * np.pi) if seg.ccw else -((a0 - a1) % (2 * np.pi))
+    theta = seg.theta
     if not abs(theta) < np.pi:
         raise GeometryError("an arc of half a turn or more in a ruled face")
     mid = a0 + 0.5 * theta
     half = math.cos(0.5 * theta)
     pm = seg.center + seg.radius / half * np.array([math.cos(mid), math.sin(mid)])
     return np.array([seg.p0, pm, seg.p1]), np.array([1.0, half, 1.0])
-
-
-def _shoelace(v: np.ndarray) -> float:
-    x, y = v[:, 0], v[:, 1]
-    return 0.5 * float(np.dot(x, np.roll(y, -1)) - np.dot(np.roll(x, -1), y))
 
 
 class _Wall:

@@ -9,6 +9,7 @@ import numpy as np
 
 from wgcad.atomic import atomic_write
 from wgcad.errors import GeometryError
+from wgcad.export.brep import FIXED_STAMP  # the fixed FILE_NAME time stamp: byte-identical files
 
 __all__ = [
     "wire_from_path",
@@ -25,9 +26,6 @@ __all__ = [
     "solid_props",
     "step_text",
 ]
-
-#: Fixed FILE_NAME time stamp, so the same design gives byte-identical STEP files.
-FIXED_STAMP = "2000-01-01T00:00:00"
 
 
 def _pnt(x, y, z=0.0):
