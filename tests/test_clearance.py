@@ -314,13 +314,35 @@ def test_pair_distance_on_two_threads_equals_shapely(monkeypatch):
     ring = np.c_[np.cos(t), np.sin(t)]
     a = shapely.polygons(ring[None] * rng.uniform(0.5, 1, (n, 1, 1)) + rng.normal(0, 2, (n, 1, 2)))
     b = shapely.polygons(ring[None] * rng.uniform(0.5, 1, (n, 1, 1)) + rng.normal(0, 2, (n, 1, 2)))
-    monkeypatch.setattr(dist, "_CORES", 2)
+    from wgcad.clearance import threads
+
+    monkeypatch.setattr(threads, "CORES", 2)
     got = dist.pair_distance(a, b)
     np.testing.assert_array_equal(got, shapely.distance(a, b))
     assert (got == 0).any() and (got > 0).any()
     np.testing.assert_array_equal(dist.pair_distance(a, b[0]), shapely.distance(a, b[0]))  # one against many
     with pytest.raises(TypeError):
         dist.pair_distance(np.array([1.0] * n, dtype=object), b)
+
+
+def test_jobs_on_the_helper_return_raise_and_never_wait_on_themselves():
+    """A job's value or exception reaches the caller; a job run on the helper that hands the helper another job
+    runs it there and then (queued, it would wait on itself for ever)."""
+    import threading
+
+    from wgcad.clearance import threads
+
+    h = threads.helper()
+    assert h.submit(divmod, 7, 2).result() == (3, 1)
+    with pytest.raises(ZeroDivisionError):
+        h.submit(divmod, 1, 0).result()
+    assert h.submit(sorted, [3, 1, 2]).result() == [1, 2, 3]
+    out = []
+    waiter = threading.Thread(target=lambda: out.append(h.submit(lambda: h.submit(abs, -4).result() + 1).result()))
+    waiter.daemon = True
+    waiter.start()
+    waiter.join(10)
+    assert out == [5], "a nested job waited on the helper for ever"
 
 
 def test_a_conjugate_space_deeper_than_its_root_circle_keeps_a_valid_tooth(tmp_path):

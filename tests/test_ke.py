@@ -473,12 +473,13 @@ def _table_arrays(tab):
 def test_closing_measurements_split_between_threads_equal_one_thread(d2, monkeypatch):
     """The closing rotation's nearest points are measured on two threads when a call has many pairs (shapely
     releases the GIL): the contact table is the one a single thread builds, to the bit."""
-    from wgcad.clearance import halves
+    from wgcad.clearance import threads
 
     imp = Imperfections(flex_runout=0.01, rigid_ecc=0.005)
-    monkeypatch.setattr(halves, "SPLIT", 10**9)
+    monkeypatch.setattr(threads, "CORES", 2)
+    monkeypatch.setattr(threads, "SPLIT", 10**9)
     one = _table_arrays(K.contact_table(d2, imp, 4, sections=[None]))
-    monkeypatch.setattr(halves, "SPLIT", 2)
+    monkeypatch.setattr(threads, "SPLIT", 2)
     two = _table_arrays(K.contact_table(d2, imp, 4, sections=[None]))
     assert one.keys() == two.keys() and one
     for key in one:
@@ -486,15 +487,17 @@ def test_closing_measurements_split_between_threads_equal_one_thread(d2, monkeyp
 
 
 def test_a_forked_process_measures_with_threads_of_its_own(d2, monkeypatch):
-    """A sweep's worker forked after the parent measured has none of the parent's pool threads: it starts its own
-    (a pool inherited across a fork would take the work and never run it)."""
+    """A sweep's worker forked after the parent measured has none of the parent's helper thread: it starts its own
+    (a helper inherited across a fork would take the work and never run it)."""
     import multiprocessing
+    import os
 
-    from wgcad.clearance import halves
+    from wgcad.clearance import threads
 
-    monkeypatch.setattr(halves, "SPLIT", 2)
-    K.contact_table(d2, Imperfections(), 2, sections=[None])  # the parent's pool exists now
-    assert halves._POOL is not None
+    monkeypatch.setattr(threads, "SPLIT", 2)
+    monkeypatch.setattr(threads, "CORES", 2)
+    K.contact_table(d2, Imperfections(), 2, sections=[None])  # the parent's helper thread exists now
+    assert threads._HELPER is not None and threads._HELPER.pid == os.getpid()
     ctx = multiprocessing.get_context("fork")
     q = ctx.Queue()
     p = ctx.Process(target=_child_table, args=(d2, q))
@@ -503,7 +506,7 @@ def test_a_forked_process_measures_with_threads_of_its_own(d2, monkeypatch):
     alive = p.is_alive()
     if alive:
         p.kill()
-    assert not alive, "the forked child hung on the inherited pool"
+    assert not alive, "the forked child hung on the inherited helper"
     assert q.get(timeout=5) > 0
 
 

@@ -30,7 +30,7 @@ from ..placement import transform
 from ..placement.imperfect import Imperfections, flex_poses, rigid_poses
 from ..plane import rotate
 from .distance import Template, overlap_depth
-from .halves import in_halves
+from .threads import in_halves
 
 __all__ = ["Contact", "closing_rotation", "closing_direct"]
 

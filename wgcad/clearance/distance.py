@@ -2,53 +2,17 @@
 
 from __future__ import annotations
 
-import os
-import threading
-from concurrent.futures import Future
-from queue import SimpleQueue
-
 import numpy as np
 import shapely
 
 from ..placement import transform
 from ..plane import relative_pose
+from .threads import in_halves
 
 __all__ = ["Template", "outline_distance", "overlap_depth", "signed_clearance", "pair_distance"]
 
 #: below this many pairs one thread measures them all (handing half to the helper costs ~30 us)
 SPLIT_MIN = 64
-_HELPER: SimpleQueue | None = None
-_HELPER_LOCK = threading.Lock()
-
-
-def _cores() -> int:
-    try:
-        return len(os.sched_getaffinity(0))
-    except AttributeError:  # not on Linux
-        return os.cpu_count() or 1
-
-
-_CORES = _cores()
-
-
-def _helper() -> SimpleQueue:
-    """The queue of one daemon thread that runs ``(future, function, args)`` jobs (GEOS releases the GIL)."""
-    global _HELPER
-    with _HELPER_LOCK:
-        if _HELPER is None:
-            jobs: SimpleQueue = SimpleQueue()
-
-            def work():
-                while True:
-                    fut, fn, args = jobs.get()
-                    try:
-                        fut.set_result(fn(*args))
-                    except BaseException as exc:  # noqa: BLE001 (handed to the caller, raised there)
-                        fut.set_exception(exc)
-
-            threading.Thread(target=work, name="wgcad-geos", daemon=True).start()
-            _HELPER = jobs
-    return _HELPER
 
 
 def pair_distance(a, b) -> np.ndarray:
@@ -59,14 +23,10 @@ def pair_distance(a, b) -> np.ndarray:
     6,700 pairs of 27-vertex teeth, 36 -> ~20 ms). The figures are the same
     (the same GEOS call on each pair).
     """
-    if _CORES < 2 or np.size(a) < SPLIT_MIN:
+    if np.size(a) < SPLIT_MIN:
         return shapely.distance(a, b)
-    a, b = np.broadcast_arrays(np.asarray(a, dtype=object), np.asarray(b, dtype=object))
-    half = len(a) // 2
-    fut: Future = Future()
-    _helper().put((fut, shapely.distance, (a[:half], b[:half])))
-    tail = shapely.distance(a[half:], b[half:])
-    return np.concatenate([fut.result(), tail])
+    pairs = np.broadcast_arrays(np.asarray(a, dtype=object), np.asarray(b, dtype=object))
+    return in_halves(shapely.distance, tuple(pairs), least=SPLIT_MIN)
 
 
 class Template:
