@@ -2,13 +2,12 @@
 
 from __future__ import annotations
 
-import difflib
 import math
 import tomllib
 from dataclasses import dataclass, fields
 from pathlib import Path
 
-from ..errors import DesignError, InputFileError
+from ..errors import DesignError, InputFileError, close_matches
 from ..numbers import read_float
 
 __all__ = ["PartsSpec", "PartSizes", "parse_parts", "load_parts", "part_sizes", "MAX_PART_MM", "MAX_BOLTS", "PARTS_DOC"]
@@ -89,7 +88,7 @@ def parse_parts(data) -> PartsSpec:
     kw = {}
     for key, value in data.items():
         if key not in known:
-            near = difflib.get_close_matches(key, known, n=1)
+            near = close_matches(key, known)
             hint = f"; did you mean '{near[0]}'?" if near else ""
             raise DesignError(f"parts.{key}", f"unknown key{hint}")
         where = f"parts.{key}"

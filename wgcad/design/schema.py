@@ -2,12 +2,11 @@
 
 from __future__ import annotations
 
-import difflib
 import math
 import typing
 from dataclasses import MISSING, dataclass, fields, replace
 
-from ..errors import DesignError
+from ..errors import DesignError, close_matches
 from ..numbers import read_float, read_int
 from .imperfections import ImperfectionsSpec
 from .load import BearingSpec, LoadSpec, MaterialSpec
@@ -252,7 +251,7 @@ def _build(table: str, cls: type, data) -> object:
     known = {f.name: f for f in fields(cls)}
     for key in data:
         if key not in known:
-            near = difflib.get_close_matches(key, known, n=1)
+            near = close_matches(key, known)
             hint = f"; did you mean '{near[0]}'?" if near else f"; valid keys: {', '.join(known)}"
             raise DesignError(f"{table}.{key}", f"unknown key{hint}")
     kwargs = {}
@@ -395,7 +394,7 @@ def parse_design(data: dict, source: str = "<memory>") -> Design:
         raise DesignError("<file>", "must be a TOML document with tables")
     for key in data:
         if key not in TABLES and key not in _OTHER_TABLES:
-            near = difflib.get_close_matches(key, TABLES, n=1)
+            near = close_matches(key, TABLES)
             hint = f"; did you mean [{near[0]}]?" if near else f"; valid tables: {', '.join(TABLES)}"
             raise DesignError(key, f"unknown table{hint}")
     parts = {}

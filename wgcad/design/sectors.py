@@ -2,10 +2,9 @@
 
 from __future__ import annotations
 
-import difflib
 from dataclasses import dataclass, fields
 
-from ..errors import DesignError
+from ..errors import DesignError, close_matches
 from ..numbers import read_float, read_int
 from .rules import key as _key
 
@@ -120,7 +119,7 @@ class SectorsSpec:
         known = [f.name for f in fields(cls)]
         for key in data:
             if key not in known:
-                near = difflib.get_close_matches(key, known, n=1)
+                near = close_matches(key, known)
                 hint = f"; did you mean '{near[0]}'?" if near else f"; valid keys: {', '.join(known)}"
                 raise DesignError(f"{table}.{key}", f"unknown key{hint}")
         for key in ("kinds", "teeth"):

@@ -15,10 +15,9 @@ Three models, each run once per sample for all its figures:
 
 from __future__ import annotations
 
-import difflib
 import re
 
-from ..errors import DesignError
+from ..errors import DesignError, close_matches
 
 __all__ = ["FIGURES", "LOADED", "MODELS", "parse_figure", "check_figures", "figure_doc"]
 
@@ -67,7 +66,7 @@ def parse_figure(name: str) -> tuple[str, str, float | None]:
     if m:
         base, t = m.group(1), float(m.group(2))
         if base not in LOADED:
-            near = difflib.get_close_matches(base, LOADED, n=1)
+            near = close_matches(base, LOADED)
             raise DesignError(
                 "figures.record",
                 f"'{name}': no loaded figure '{base}'"
@@ -79,7 +78,7 @@ def parse_figure(name: str) -> tuple[str, str, float | None]:
     if "@" in name:
         raise DesignError("figures.record", f"'{name}': a loaded figure reads NAME@TORQUENm, e.g. entry_gap_um@500Nm")
     if name not in FIGURES:
-        near = difflib.get_close_matches(name, list(FIGURES) + [f"{k}@500Nm" for k in LOADED], n=1)
+        near = close_matches(name, list(FIGURES) + [f"{k}@500Nm" for k in LOADED])
         raise DesignError(
             "figures.record",
             f"unknown figure '{name}'"

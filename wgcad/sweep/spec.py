@@ -31,14 +31,13 @@ not an error of the spec.
 
 from __future__ import annotations
 
-import difflib
 import hashlib
 import json
 import tomllib
 from dataclasses import dataclass, fields
 from pathlib import Path
 
-from ..errors import DesignError, InputFileError
+from ..errors import DesignError, InputFileError, close_matches
 from ..numbers import read_float, show_value
 
 __all__ = ["Parameter", "SweepSpec", "parse_spec", "load_spec", "MAX_SAMPLES", "DISTRIBUTIONS"]
@@ -166,7 +165,7 @@ class SweepSpec:
 def _unknown(where: str, keys, known) -> None:
     for k in keys:
         if k not in known:
-            near = difflib.get_close_matches(str(k), known, n=1)
+            near = close_matches(str(k), known)
             hint = f"; did you mean '{near[0]}'?" if near else f"; valid keys: {', '.join(known)}"
             raise DesignError(f"{where}.{k}" if where else str(k), f"unknown key{hint}")
 
@@ -198,13 +197,13 @@ def _parameter(name: str, table: str, key: str, d) -> Parameter:
     where = f"parameters.{name}"
     types = _field_types()
     if table not in types:
-        near = difflib.get_close_matches(table, types, n=1)
+        near = close_matches(table, types)
         raise DesignError(
             where,
             "unknown design table" + (f"; did you mean '{near[0]}'?" if near else f"; tables: {', '.join(types)}"),
         )
     if key not in types[table]:
-        near = difflib.get_close_matches(key, types[table], n=1)
+        near = close_matches(key, types[table])
         raise DesignError(where, f"not a key of [{table}]" + (f"; did you mean '{table}.{near[0]}'?" if near else ""))
     if table == "drive" and key == "name":
         raise DesignError(where, "the drive's name cannot be swept")
@@ -400,7 +399,7 @@ def _limits(lim, record) -> dict:
     for k, v in lim.items():
         where = f"limits.{k}"
         if k not in record:
-            near = difflib.get_close_matches(k, record, n=1)
+            near = close_matches(k, record)
             raise DesignError(
                 where, "not a recorded figure (figures.record)" + (f"; did you mean '{near[0]}'?" if near else "")
             )
