@@ -286,3 +286,25 @@ def test_each_command_lists_its_own_exit_codes(capsys):
         text = capsys.readouterr().out
         listed = set(re.findall(r"^  ([0-4])    ", text.split("exit codes:")[1], flags=re.M))
         assert listed == want, (cmd, listed)
+
+
+@pytest.mark.parametrize("columns", [None, "50", "130", "0", "wide"])
+def test_help_is_wrapped_to_the_width_argparse_itself_takes(columns, monkeypatch):
+    """The parser finds the terminal's width without shutil: every command's help is the text argparse's own
+    formatter gives, whatever COLUMNS says (unset, a width, zero, not a number)."""
+    import argparse
+
+    from wgcad.cli import build_parser
+    from wgcad.cli.common import Parser
+
+    if columns is None:
+        monkeypatch.delenv("COLUMNS", raising=False)
+    else:
+        monkeypatch.setenv("COLUMNS", columns)
+    parser = build_parser()
+    commands = parser._subparsers._group_actions[0].choices
+    ours = [parser.format_help()] + [sp.format_help() for sp in commands.values()]
+    monkeypatch.setattr(Parser, "_get_formatter", argparse.ArgumentParser._get_formatter)
+    stock = [parser.format_help()] + [sp.format_help() for sp in commands.values()]
+    assert ours == stock
+    assert len(commands) >= 9

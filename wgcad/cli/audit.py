@@ -2,12 +2,12 @@
 
 from __future__ import annotations
 
-import json
 import os
 import sys
 
 from ..errors import DesignError
 from .common import EXIT_INTERFERENCE, EXIT_OK, add_memory_flag, angle_count, epilog, positive_float, whole_number
+from .outputs import json_text
 
 __all__ = ["register", "cmd_audit"]
 
@@ -140,9 +140,9 @@ def cmd_audit(args) -> int:
     bar.set(1.0, "done")
     bar.close()
     if args.json == STDOUT:
-        write_stdout(json.dumps(res, allow_nan=False, indent=2) + "\n")
+        write_stdout(json_text(res) + "\n")
     if args.write_baseline == STDOUT:
-        write_stdout(json.dumps(base_doc, allow_nan=False, indent=2) + "\n")
+        write_stdout(json_text(base_doc) + "\n")
     if not args.quiet:
         # with a JSON document on stdout, the summary for people goes to stderr
         stream = sys.stderr if STDOUT in (args.json, args.write_baseline) else sys.stdout

@@ -2,11 +2,11 @@
 
 from __future__ import annotations
 
-import json
 import sys
 import time
 
 from .common import EXIT_OK, add_memory_flag, angles_deg, epilog, out_dir, positive_float
+from .outputs import json_text
 
 __all__ = ["register", "cmd_generate"]
 
@@ -41,7 +41,7 @@ def cmd_generate(args) -> int:
         print(f"wgcad: warning: kept {out / name}: an earlier run wrote it, but it was changed since", file=sys.stderr)
     rep = res.report
     if args.json:
-        write_stdout(json.dumps(rep, allow_nan=False, indent=2) + "\n")
+        write_stdout(json_text(rep) + "\n")
     elif not args.quiet:
         removed = f", removed {len(res.removed)} of the previous run's files" if res.removed else ""
         write_stdout(

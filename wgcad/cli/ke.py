@@ -2,12 +2,12 @@
 
 from __future__ import annotations
 
-import json
 from pathlib import Path
 
 from wgcad.units import ARCSEC_PER_RAD
 
 from .common import EXIT_OK, epilog, whole_number
+from .outputs import json_text
 
 __all__ = ["register", "cmd_ke"]
 
@@ -63,7 +63,7 @@ def cmd_ke(args) -> int:
         print("\n".join(add_install_scan(run)))
     with atomic_batch() as batch:
         if args.json:
-            Path(batch.temp_path(Path(args.json))).write_text(json.dumps(run.doc, allow_nan=False, indent=2))
+            Path(batch.temp_path(Path(args.json))).write_text(json_text(run.doc))
         if args.html:
             from ..export.ke_html import ke_html
 

@@ -2,12 +2,12 @@
 
 from __future__ import annotations
 
-import json
 import sys
 from pathlib import Path
 
 from ..errors import DesignError
 from .common import EXIT_INTERFERENCE, EXIT_OK, Progress, key_float
+from .outputs import json_text
 
 __all__ = ["register_args", "run_load", "torque_levels", "RATED", "RATED_STEPS"]
 
@@ -114,7 +114,7 @@ def run_load(args) -> int:
         res["compare"] = compare
     with atomic_batch() as batch:
         if args.json:
-            Path(batch.temp_path(args.json)).write_text(json.dumps(res, allow_nan=False, indent=2) + "\n")
+            Path(batch.temp_path(args.json)).write_text(json_text(res) + "\n")
         if args.html:
             from ..export.load_html import load_html
 

@@ -3,11 +3,11 @@
 from __future__ import annotations
 
 import argparse
-import json
 import time
 
 from ..export.part_files import FORMATS
 from .common import EXIT_OK, angles_deg, epilog, out_dir, positive_float
+from .outputs import json_text
 
 __all__ = ["register", "cmd_parts", "FORMATS"]
 
@@ -50,7 +50,7 @@ def cmd_parts(args) -> int:
     )
     bar.close()
     if args.json:
-        print(json.dumps(res.report, allow_nan=False, indent=2))
+        print(json_text(res.report))
     elif not args.quiet:
         print(f"{design.drive.name}: {len(res.parts)} parts ({', '.join(p.name for p in res.parts)})")
         for p in res.parts:

@@ -2,10 +2,10 @@
 
 from __future__ import annotations
 
-import json
 from pathlib import Path
 
 from .common import EXIT_INTERFERENCE, EXIT_OK, epilog, key_float, positive_float, whole_number
+from .outputs import json_text
 
 __all__ = ["register", "cmd_rating"]
 
@@ -40,7 +40,7 @@ def cmd_rating(args) -> int:
     with atomic_batch() as batch:
         if args.json:
             doc = rating_document(ds, str(args.design))
-            Path(batch.temp_path(Path(args.json))).write_text(json.dumps(doc, allow_nan=False, indent=2))
+            Path(batch.temp_path(Path(args.json))).write_text(json_text(doc))
         if args.plot:
             from ..export.rating_figures import rating_png
 

@@ -3,13 +3,12 @@
 from __future__ import annotations
 
 from .common import EXIT_INTERFERENCE, EXIT_OK, add_memory_flag, epilog, out_dir, positive_float
+from .outputs import json_text
 
 __all__ = ["register", "cmd_sector"]
 
 
 def cmd_sector(args) -> int:
-    import json
-
     from ..atomic import check_writable_dir
     from ..design import load_design
     from ..design.budget import check_sector_budget
@@ -36,7 +35,7 @@ def cmd_sector(args) -> int:
     bar.set(1.0, "done")
     bar.close()
     if args.json:
-        print(json.dumps(summ, allow_nan=False, indent=2))
+        print(json_text(summ))
     else:
         print(sector_summary_text(design.drive.name, res, summ, out), end="")
     return EXIT_INTERFERENCE if res["audit_built"].has_tip_to_tip else EXIT_OK

@@ -2,10 +2,10 @@
 
 from __future__ import annotations
 
-import json
 from pathlib import Path
 
 from .common import EXIT_OK, epilog
+from .outputs import json_text
 
 __all__ = ["register", "cmd_sweep"]
 
@@ -78,9 +78,7 @@ def cmd_sweep(args) -> int:
         summ["run"] = {k: v for k, v in info.__dict__.items()}
     summ["results"] = {"folder": str(out), "format": store.fmt, "chunks": len(store.done_ranges())}
     with atomic_batch() as batch:
-        Path(batch.temp_path(out / "summary.json")).write_text(
-            json.dumps(summ, allow_nan=False, indent=2, default=str) + "\n"
-        )
+        Path(batch.temp_path(out / "summary.json")).write_text(json_text(summ, default=str) + "\n")
         if not args.no_plots and len(cols["sample"]):
             from ..export.sweep_figures import sweep_pngs
 

@@ -4,7 +4,6 @@ bar, printing."""
 
 from __future__ import annotations
 
-import json
 from pathlib import Path
 
 __all__ = ["plot_paths", "write_audit_files"]
@@ -26,6 +25,8 @@ def write_audit_files(
     from ..atomic import atomic_batch
 
     texts = []
+    if json_path or baseline_path:
+        import json  # only for the documents asked for (an audit that writes none never loads it)
     if json_path:
         texts.append((Path(json_path), json.dumps(run.doc, allow_nan=False, indent=2) + "\n"))
     if baseline_path:
