@@ -16,7 +16,7 @@ ROOT = Path(__file__).resolve().parent.parent / "wgcad"
 
 #: ground first; a unit is a top-level module or package of wgcad
 FLOORS = [
-    {"errors", "constants", "roots", "units", "plane", "arrays"},
+    {"errors", "constants", "roots", "units", "plane", "arrays", "records"},
     {"numbers", "userfiles", "atomic"},
     {"design"},
     {"laws"},

@@ -2,8 +2,6 @@
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-
 import numpy as np
 
 from .arrays import unique_sorted
@@ -12,11 +10,12 @@ from .design import load_design
 from .design.budget import DEFAULT_MAX_MEMORY_MB
 from .drive import build_drive
 from .errors import DesignError
+from .records import record
 
 __all__ = ["RunSettings", "run_audit"]
 
 
-@dataclass(frozen=True)
+@record(frozen=True)
 class RunSettings:
     """Settings of an audit run as a user gives them (units in the names)."""
 

@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 from collections import OrderedDict
-from dataclasses import dataclass, replace
+from dataclasses import replace
 from math import pi
 
 import numpy as np
@@ -14,6 +14,7 @@ from .design.budget import DEFAULT_MAX_MEMORY_MB, check_budget, estimate_run
 from .errors import DesignError
 from .laws import Law, coned_w0, make_law
 from .profiles.gear import Gear, ToothSpec, make_gear, tooth_radii
+from .records import record
 
 __all__ = ["Drive", "build_drive", "tooth_spec"]
 
@@ -69,7 +70,7 @@ def _double_arc(d: Design) -> dict:
     }
 
 
-@dataclass(frozen=True)
+@record(frozen=True)
 class Drive:
     """Geometry of a whole drive, undeformed, plus its deformation law.
 

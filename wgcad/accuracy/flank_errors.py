@@ -30,11 +30,13 @@ from __future__ import annotations
 
 import math
 import numbers
-from dataclasses import dataclass, fields
+from dataclasses import fields
 
 import numpy as np
 
 from wgcad.errors import DesignError
+
+from ..records import record
 
 __all__ = [
     "ENGAGEMENTS",
@@ -60,7 +62,7 @@ def _real(value, name: str) -> float:
     return float(value)
 
 
-@dataclass(frozen=True)
+@record(frozen=True)
 class Eccentricities:
     """Eccentricities of both gears and the phases of the kinematic ones. Lengths mm, angles rad.
 
@@ -95,7 +97,7 @@ class Eccentricities:
             object.__setattr__(self, f.name, val)
 
 
-@dataclass(frozen=True)
+@record(frozen=True)
 class FlankErrors:
     """Radial and tangential mesh displacements, mm, read-only arrays of one shape.
 

@@ -44,7 +44,6 @@ What is exploited (tested against the direct computation in tests/test_ke.py):
 
 from __future__ import annotations
 
-from dataclasses import dataclass
 from math import pi
 
 import numpy as np
@@ -55,6 +54,7 @@ from ..clearance.closing import closing_direct
 from ..errors import DesignError, ModelError
 from ..kinematics import gear_ratios
 from ..placement.imperfect import Imperfections
+from ..records import record
 from .ke_lanes import LanePlan, candidate_lanes, harmonics, lane_minimum
 from .ke_table import DEFAULT_N, ContactTable, contact_table
 
@@ -105,7 +105,7 @@ def _theta(tab, dw, dn):
     return tab.side_w * (dw - 0.5 * np.minimum(lm, 0.0)), lm
 
 
-@dataclass
+@record
 class KEResult:
     """No-load KE over a flexspline revolution (radians; arrays over the generator angles)."""
 

@@ -25,7 +25,7 @@ loaded KE is sampled, not followed within a mesh period.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import field
 from math import pi
 
 import numpy as np
@@ -33,11 +33,12 @@ import numpy as np
 from ..errors import DesignError
 from ..kinematics import gear_ratios
 from ..placement.imperfect import Imperfections, cam_offset, flex_deviations, rigid_translation
+from ..records import record
 
 __all__ = ["LoadedKE", "sample_periods", "tooth_errors", "loaded_ke", "LoadedLever", "install_lever", "SCAN_ANGLES"]
 
 
-@dataclass
+@record
 class LoadedKE:
     """Loaded KE at whole mesh periods (radians; arrays over the samples)."""
 
@@ -178,7 +179,7 @@ def loaded_ke(
 SCAN_ANGLES = 18
 
 
-@dataclass
+@record
 class LoadedLever:
     """The rigid gear's installation angle under load (radians inside).
 

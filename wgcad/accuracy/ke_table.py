@@ -9,7 +9,7 @@ the root fillet) that surface is tabulated too (``_second_features``).
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import field
 from math import pi
 
 import numpy as np
@@ -22,6 +22,7 @@ from ..errors import DesignError
 from ..kinematics import gear_ratios
 from ..placement import tooth_pose
 from ..placement.imperfect import Imperfections, cam_offset, coning_factor
+from ..records import record
 from .ke_lanes import candidate_lanes, fold_angle
 
 __all__ = ["ContactTable", "contact_table", "DEFAULT_N", "NT_MAX"]
@@ -36,7 +37,7 @@ _CHUNK = 8192
 NT_MAX = 2.0
 
 
-@dataclass
+@record
 class ContactTable:
     """Contacts of the perfect drive (plus the cam-borne offset) on the tooth-angle lattice, per side.
 
@@ -155,7 +156,7 @@ def contact_table(
     return tab
 
 
-@dataclass
+@record
 class _Lattice:
     """What every stage of the table shares: the drive, the teeth's outlines, the lattice of tooth angles."""
 
@@ -233,7 +234,7 @@ def _more_features(lat: _Lattice, tab: ContactTable, imp: Imperfections, side: i
     return out
 
 
-@dataclass
+@record
 class _Poses:
     """Tooth pairs of the lattice: ``idx`` the lattice points (into ``rot``, ``shift``: the lattice's poses), and per
     pair the pose's derivatives along the rim (``drot``, ``dshift``), the rigid tooth ``j``; the lattice indices
@@ -253,7 +254,7 @@ class _Poses:
         return _Poses(self.idx[k], self.rot, self.shift, self.drot[k], self.dshift[k], self.m_all, self.j[k], self.cz)
 
 
-@dataclass
+@record
 class _Solved:
     """One section's and side's first contacts: their table rows, which engaged pairs they are (``k``, into
     ``poses``), and the rigid teeth's angles ``rb`` of the engaged pairs."""

@@ -32,13 +32,14 @@ Why it can skip work (each switchable, each tested against the full computation)
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass, field
+from dataclasses import field
 from math import pi
 
 import numpy as np
 
 from ..arrays import unique_sorted
 from ..placement import tooth_pose
+from ..records import record
 from .backlash import backlash
 from .cascade import FINE, refine_candidates
 from .entry import (
@@ -77,7 +78,7 @@ __all__ = [
 ]
 
 
-@dataclass
+@record
 class AuditResult:
     """Figures of an audit as :class:`~wgcad.clearance.findings.Finding` records (mm, rad inside).
 

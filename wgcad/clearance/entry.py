@@ -22,12 +22,12 @@ audit, the load audit and the imperfect audit share one definition.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
 from math import pi
 
 import numpy as np
 
 from ..placement import transform
+from ..records import record
 from .scene import Scene, _classify
 
 __all__ = [
@@ -61,7 +61,7 @@ TIP_BAND = 0.3
 _NEST, _NEST_PTS = 4, 17
 
 
-@dataclass(frozen=True)
+@record(frozen=True)
 class EntryPassage:
     """The entry of one passage (mm, rad inside).
 

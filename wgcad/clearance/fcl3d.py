@@ -3,13 +3,14 @@
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass, field
+from dataclasses import field
 
 import fcl
 import manifold3d
 import numpy as np
 
 from ..placement import transform
+from ..records import record
 from .engine import Scene
 from .scene import clearance_at_poses
 
@@ -34,7 +35,7 @@ __all__ = [
 FCL_TOL = 1e-6
 
 
-@dataclass
+@record
 class PairCheck:
     """One rigid tooth against the flexspline tooth: FCL's distance and the 2D engine's over the sections (mm).
 
@@ -52,7 +53,7 @@ class PairCheck:
     clearance_2d_at_witness: float | None = None
 
 
-@dataclass
+@record
 class ToothCheck:
     """The 3D check of one flexspline tooth (:func:`check_tooth`), mm and rad; times in seconds.
 
@@ -79,7 +80,7 @@ class ToothCheck:
     tooth: int | None = None
 
 
-@dataclass
+@record
 class Check3D:
     """The 3D check of the pairs the 2D audit singles out (:func:`verify_worst`): a :class:`ToothCheck` per pair,
     the loft's sections (``n_sections``: 2 for the prisms of a drive without coning), whether all agree."""

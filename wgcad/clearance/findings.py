@@ -8,9 +8,11 @@ and words them for people. Nothing here formats text.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import field
 
 import numpy as np
+
+from ..records import record
 
 __all__ = ["Finding", "FIGURES", "METHODS", "AuditRun", "ImperfectRun"]
 
@@ -25,7 +27,7 @@ METHODS = {
 }
 
 
-@dataclass(frozen=True)
+@record(frozen=True)
 class Finding:
     """One figure of an audit and where it lies.
 
@@ -78,7 +80,7 @@ class Finding:
             raise ValueError(f"unknown method {self.method!r}")
 
 
-@dataclass(frozen=True)
+@record(frozen=True)
 class ImperfectRun:
     """How an imperfect drive's audit swept (:func:`wgcad.clearance.imperfect.audit_imperfect`): the generator turns
     swept and the whole error cycle's, which work-skipping facts still hold (and why), the generator angles per
@@ -91,7 +93,7 @@ class ImperfectRun:
     chunk: int
 
 
-@dataclass(frozen=True)
+@record(frozen=True)
 class AuditRun:
     """What an audit ran with, in mm and rad (the report states it in the units of its keys, with its notes).
 

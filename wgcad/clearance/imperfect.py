@@ -24,7 +24,7 @@ What still saves work (docs/models.md 7, last paragraph):
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass, replace
+from dataclasses import replace
 from math import pi
 
 import numpy as np
@@ -32,6 +32,7 @@ import shapely
 
 from ..placement import transform
 from ..placement.imperfect import Imperfections, flex_poses_batch, full_cycle_turns, rigid_translation, shortcuts
+from ..records import record
 from .cascade import FINE, refine_candidates
 from .findings import AuditRun, Finding, ImperfectRun
 from .imperfect_bounds import ErrorBound, PerfectBound, PerfectBounds, chunk_bounds
@@ -191,7 +192,7 @@ def audit_imperfect(drive, settings, imp: Imperfections, progress=None, chunk_sa
     return res
 
 
-@dataclass
+@record
 class _Run:
     """What every step of an imperfect audit shares: the drive and its errors, the scenes, the samples' axes."""
 
@@ -228,7 +229,7 @@ class _Run:
         return _poses_of(self.drive, self.imp, self.angles, a_, k_, s_, self.sections)
 
 
-@dataclass
+@record
 class _Found:
     """The polygon search's result: its best figure, the candidates within the margin of it, what it cost."""
 

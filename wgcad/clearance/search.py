@@ -2,18 +2,18 @@
 
 from __future__ import annotations
 
-from dataclasses import dataclass
 from math import pi
 
 import numpy as np
 
 from .. import constants
+from ..records import record
 from .scene import Scene, tooth_clearance_sections
 
 __all__ = ["AuditSettings", "SectionSearch", "evaluate", "sample_phi", "fold"]
 
 
-@dataclass(frozen=True)
+@record(frozen=True)
 class AuditSettings:
     """What an audit computes.
 

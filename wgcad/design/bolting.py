@@ -27,9 +27,9 @@ is refused, naming the key to change.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
 
 from ..errors import DesignError
+from ..records import record
 
 __all__ = ["METRIC", "BoltChoice", "carry", "choose_bolts", "RULE"]
 
@@ -59,7 +59,7 @@ RULE = (
 )
 
 
-@dataclass(frozen=True)
+@record(frozen=True)
 class BoltChoice:
     """A bolt circle: ``count`` bolts of ``size`` in ``hole_mm`` holes at ``radius_mm``, and the torque it carries."""
 

@@ -12,11 +12,11 @@ err on the high side.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
 from math import ceil, sqrt
 
 from .. import constants
 from ..errors import DesignError
+from ..records import record
 
 __all__ = [
     "DEFAULT_MAX_MEMORY_MB",
@@ -58,7 +58,7 @@ _PER_BATCH_VERTEX_B = 100.0
 _BOUND_BATCH_DIVISOR = 256
 
 
-@dataclass(frozen=True)
+@record(frozen=True)
 class RunEstimate:
     """What a run is expected to need.
 

@@ -2,14 +2,15 @@
 
 from __future__ import annotations
 
-from dataclasses import dataclass, fields
+from dataclasses import fields
 
+from ..records import record
 from .rules import Rel, key
 
 __all__ = ["ImperfectionsSpec"]
 
 
-@dataclass(frozen=True)
+@record(frozen=True)
 class ImperfectionsSpec:
     """``[imperfections]``: manufacturing and mounting errors of a drive (all optional, default a perfect drive).
 

@@ -2,15 +2,14 @@
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-
 from ..errors import DesignError
+from ..records import record
 from .rules import key as _key
 
 __all__ = ["MaterialSpec", "BearingSpec", "LoadSpec", "require_bearing"]
 
 
-@dataclass(frozen=True)
+@record(frozen=True)
 class MaterialSpec:
     """``[material]``: the flexspline and bearing material and the rim's bending section."""
 
@@ -103,7 +102,7 @@ class MaterialSpec:
     )
 
 
-@dataclass(frozen=True)
+@record(frozen=True)
 class BearingSpec:
     """``[bearing]``: the flexible bearing between cam and flexspline."""
 
@@ -172,7 +171,7 @@ class BearingSpec:
     )
 
 
-@dataclass(frozen=True)
+@record(frozen=True)
 class LoadSpec:
     """``[load]``: the operating load of the drive."""
 

@@ -4,16 +4,17 @@ from __future__ import annotations
 
 import math
 import tomllib
-from dataclasses import dataclass, fields
+from dataclasses import fields
 from pathlib import Path
 
 from ..errors import DesignError, InputFileError, close_matches
 from ..numbers import read_float
+from ..records import record
 
 __all__ = ["PartsSpec", "PartSizes", "parse_parts", "load_parts", "part_sizes", "MAX_PART_MM", "MAX_BOLTS", "PARTS_DOC"]
 
 
-@dataclass(frozen=True)
+@record(frozen=True)
 class PartsSpec:
     """``[parts]``: every key optional (mm, counts); ``None`` means "derive from the gear size" (:func:`part_sizes`)."""
 
@@ -60,7 +61,7 @@ PARTS_DOC = {
 }
 
 
-@dataclass(frozen=True)
+@record(frozen=True)
 class PartSizes:
     """The resolved sizes (mm): every field of :class:`PartsSpec` with a value, which were derived, the rule each
     derived size follows, the keys the drive's parts use, and warnings on given sizes that break a rule."""

@@ -15,9 +15,10 @@ from __future__ import annotations
 import math
 import reprlib
 from collections.abc import Callable
-from dataclasses import MISSING, dataclass, field, fields
+from dataclasses import MISSING, field, fields
 
 from ..errors import DesignError
+from ..records import record
 
 __all__ = ["Rel", "key", "key_meta", "check_bounds", "show", "context", "WHEN_BUILT"]
 
@@ -25,7 +26,7 @@ __all__ = ["Rel", "key", "key_meta", "check_bounds", "show", "context", "WHEN_BU
 WHEN_BUILT = " (checked when the gears are built)"
 
 
-@dataclass(frozen=True)
+@record(frozen=True)
 class Rel:
     """A bound relative to the design's own sizes: ``text`` for people, ``fn(ctx)`` for the check (mm)."""
 

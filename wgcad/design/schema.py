@@ -4,10 +4,11 @@ from __future__ import annotations
 
 import math
 import typing
-from dataclasses import MISSING, dataclass, fields, replace
+from dataclasses import MISSING, fields, replace
 
 from ..errors import DesignError, close_matches
 from ..numbers import read_float, read_int
+from ..records import record
 from .imperfections import ImperfectionsSpec
 from .load import BearingSpec, LoadSpec, MaterialSpec
 from .rules import WHEN_BUILT, Rel, check_bounds, show
@@ -33,7 +34,7 @@ LAW_NAMES = ("harmonic", "disc", "four_force", "ellipse", "external_ring")
 _BETA_LAWS = ("disc", "four_force", "external_ring")
 
 
-@dataclass(frozen=True)
+@record(frozen=True)
 class DriveSpec:
     """``[drive]``: the pair of gears and how the drive is used."""
 
@@ -98,7 +99,7 @@ class DriveSpec:
     rotation: str = _key("generator direction seen from the open end", choices=("ccw", "cw"), default="ccw")
 
 
-@dataclass(frozen=True)
+@record(frozen=True)
 class GeneratorSpec:
     """``[generator]``: the wave generator and its deformation law (docs/models.md 3)."""
 
@@ -163,7 +164,7 @@ class GeneratorSpec:
     )
 
 
-@dataclass(frozen=True)
+@record(frozen=True)
 class Design:
     """A whole design file."""
 

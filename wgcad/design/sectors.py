@@ -2,10 +2,11 @@
 
 from __future__ import annotations
 
-from dataclasses import dataclass, fields
+from dataclasses import fields
 
 from ..errors import DesignError, close_matches
 from ..numbers import read_float, read_int
+from ..records import record
 from .rules import key as _key
 
 __all__ = ["SectorsSpec", "KINDS", "HEIGHT_MODES", "validate_sectors", "sector_pitch_z"]
@@ -22,7 +23,7 @@ HEIGHT_MODES = ("closed_form", "simulated", "full", "list")
 _FILL_TOL = 1e-9
 
 
-@dataclass(frozen=True)
+@record(frozen=True)
 class SectorsSpec:
     """``[sectors]``: the rigid gear built from sectors (docs/models.md 2.3), listed counter-clockwise.
 

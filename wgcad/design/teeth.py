@@ -3,15 +3,14 @@
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-
+from ..records import record
 from .rules import WHEN_BUILT, Rel
 from .rules import key as _key
 
 __all__ = ["ToothFormSpec", "GearSpec"]
 
 
-@dataclass(frozen=True)
+@record(frozen=True)
 class ToothFormSpec:
     """``[tooth]``: tooth form shared by both gears (docs/models.md 2)."""
 
@@ -83,7 +82,7 @@ class ToothFormSpec:
     )
 
 
-@dataclass(frozen=True)
+@record(frozen=True)
 class GearSpec:
     """``[flexspline]`` / ``[rigid]``: one gear's teeth and body."""
 

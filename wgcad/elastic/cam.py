@@ -2,10 +2,9 @@
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-
 import numpy as np
 
+from ..records import record
 from .solve import ContactSolveError, solve_supported
 from .tables import Compliance
 
@@ -19,7 +18,7 @@ _HERTZ_PASSES = 12
 _FLOOR = 1e-2
 
 
-@dataclass(frozen=True)
+@record(frozen=True)
 class BallRows:
     """The balls' rows of the linearised contact problem (docs/models.md 4.1).
 
@@ -74,7 +73,7 @@ def ball_rows(model, excess: float, e=(0.0, 0.0)) -> BallRows:
     return BallRows(b, A, q, normal)
 
 
-@dataclass(frozen=True)
+@record(frozen=True)
 class MountedState:
     """The rim pressed onto the cam by the balls alone (no teeth, no torque): the drive at no load before the mesh.
 

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import field
 from math import pi
 
 import numpy as np
@@ -11,6 +11,7 @@ from wgcad.clearance.engine import Scene
 from wgcad.design.load import require_bearing
 from wgcad.errors import DesignError
 
+from ..records import record
 from .bearing import FlexibleBearing, ball_contact
 from .ring import Ring
 from .tables import RingTables, ring_tables
@@ -19,7 +20,7 @@ from .teeth import ToothCompliance
 __all__ = ["ElasticModel", "build_model"]
 
 
-@dataclass(frozen=True)
+@record(frozen=True)
 class ElasticModel:
     """Everything the contact solver needs that does not depend on the load.
 

@@ -2,12 +2,14 @@
 
 from __future__ import annotations
 
-from dataclasses import dataclass, replace
+from dataclasses import replace
 
 import numpy as np
 from scipy.linalg import cho_factor, cho_solve
 
 from wgcad.errors import ModelError
+
+from ..records import record
 
 __all__ = ["ContactSolveError", "QPSolution", "solve_contact_qp", "solve_supported"]
 
@@ -16,7 +18,7 @@ class ContactSolveError(ModelError):
     """The contact problem has no solution or the solver did not converge (never returned silently; exit code 4)."""
 
 
-@dataclass(frozen=True)
+@record(frozen=True)
 class QPSolution:
     """Solution of ``min 1/2 F'MF + q'F  s.t.  F >= 0,  A'F = f`` and its checks.
 

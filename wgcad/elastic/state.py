@@ -3,13 +3,14 @@
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass, field, replace
+from dataclasses import field, replace
 from typing import NamedTuple
 
 import numpy as np
 
 from wgcad.errors import DesignError
 
+from ..records import record
 from .anderson import Anderson
 from .cam import ball_rows, cam_excess, generator_torque, mounted
 from .loaded import LoadedLaw
@@ -53,7 +54,7 @@ _HERTZ_TOL = 0.1
 _TRACE = None  # a list to record (pass, change, relaxation, pairs, loaded contacts) while debugging
 
 
-@dataclass(frozen=True)
+@record(frozen=True)
 class LoadState:
     """A solved load state (lengths mm, angles rad, forces N inside).
 
@@ -271,7 +272,7 @@ def _check_load_inputs(torque_nm, cam_offset_um, tol) -> None:
         raise DesignError("tol", f"must be > 0 mm, got {tol:g}")
 
 
-@dataclass
+@record
 class _Iterate:
     """The fixed-point iteration's state between linearisations: the loads on the rim, the rim's rigid-body
     position, the ball and tooth forces, which teeth carried load, and the relaxation."""
@@ -354,7 +355,7 @@ def _start(model: ElasticModel, e: np.ndarray, warm: LoadState | None):
     return loads, rigid, F_ball, model.cache[key].copy()
 
 
-@dataclass
+@record
 class _Pass:
     """One linearisation: the pairs measured at the current poses and the contact problem's solution there."""
 

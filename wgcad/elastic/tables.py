@@ -2,17 +2,17 @@
 
 from __future__ import annotations
 
-from dataclasses import dataclass
 from math import pi
 
 import numpy as np
 
+from ..records import record
 from .ring import Ring
 
 __all__ = ["RingTables", "ring_tables", "Compliance"]
 
 
-@dataclass(frozen=True)
+@record(frozen=True)
 class RingTables:
     """Everything of the ring that one load state evaluates again and again, at the only angles that occur.
 

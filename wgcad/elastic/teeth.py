@@ -2,8 +2,6 @@
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-
 import numpy as np
 import shapely
 
@@ -11,10 +9,12 @@ from wgcad.clearance.engine import Scene
 from wgcad.placement import transform
 from wgcad.plane import rotate
 
+from ..records import record
+
 __all__ = ["ContactGeometry", "flank_contacts", "pair_contacts", "ToothCompliance"]
 
 
-@dataclass(frozen=True)
+@record(frozen=True)
 class ContactGeometry:
     """Linearised contacts between placed flexspline teeth and rigid teeth (rigid-gear frame), arrays of length K.
 
@@ -212,7 +212,7 @@ def pair_contacts(scene: Scene, rot: np.ndarray, shift: np.ndarray, rigid: np.nd
     return ContactGeometry(gap, point, normal, idx)
 
 
-@dataclass(frozen=True)
+@record(frozen=True)
 class ToothCompliance:
     """Compliance of one tooth pair along the contact normal over a face-width slice (docs/models.md 4.1).
 

@@ -19,11 +19,11 @@ bound the rigid tooth is the caller's choice, stated where it is made.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-
 import numpy as np
 
 from wgcad.plane import rotate
+
+from ..records import record
 
 __all__ = ["EnvelopePoints", "envelope", "flank_pieces"]
 
@@ -32,7 +32,7 @@ STEP_TOL = 1e-13
 _MAX_ITER = 60
 
 
-@dataclass(frozen=True)
+@record(frozen=True)
 class EnvelopePoints:
     """Points of the envelope (read-only arrays, ``M`` of them).
 

@@ -16,7 +16,7 @@ the design's tooth count, module and radii; only its flanks change.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, replace
+from dataclasses import replace
 from math import pi
 
 import numpy as np
@@ -24,6 +24,7 @@ import numpy as np
 from wgcad.profiles import pieces as pc
 from wgcad.profiles.gear import Gear
 
+from ..records import record
 from .space import conjugate_flank
 
 __all__ = ["conjugate_rigid_gear"]
@@ -178,7 +179,7 @@ def conjugate_rigid_gear(drive, z: float | None = None, clearance: float = 0.0) 
     return gear, cf
 
 
-@dataclass(frozen=True)
+@record(frozen=True)
 class _ConjugateSampler:
     """A conjugate rigid gear's outline sampled at a chord tolerance from its exact pieces and flank points (a record,
     so a drive holding the gear pickles): arcs by their sagitta, the flank's exact points thinned (Douglas-Peucker

@@ -15,19 +15,18 @@ sagitta is reported.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-
 import numpy as np
 
 from wgcad.plane import rotate
 
+from ..records import record
 from .conjugate import envelope, flank_pieces
 from .motion import LawMotion
 
 __all__ = ["ConjugateFlank", "conjugate_flank"]
 
 
-@dataclass(frozen=True)
+@record(frozen=True)
 class ConjugateFlank:
     """One flank of the rigid tooth space conjugate to the flexspline tooth (rigid frame, mm, rad).
 

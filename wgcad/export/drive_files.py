@@ -6,10 +6,10 @@ from __future__ import annotations
 
 import json
 import os
-from dataclasses import dataclass
 from pathlib import Path
 
 from ..plane import circle_polygon
+from ..records import record
 
 __all__ = ["DriveFiles", "angle_tag", "report_name", "planned_names", "write_drive_files"]
 
@@ -42,7 +42,7 @@ def planned_names(stem: str, angles_deg, stl: bool) -> list[str]:
     return names
 
 
-@dataclass
+@record
 class DriveFiles:
     """What :func:`write_drive_files` did: the report document, the files written (report last), the previous
     run's files it removed, and the names it kept because they changed since that run wrote them."""

@@ -5,7 +5,7 @@ from __future__ import annotations
 import contextlib
 import math
 import os
-from dataclasses import dataclass, field
+from dataclasses import field
 
 import numpy as np
 
@@ -15,6 +15,8 @@ from wgcad.errors import InputFileError
 from wgcad.export.arcs import arc_points
 from wgcad.export.dxf_tags import CENTER_DESCRIPTION, CENTER_PATTERN, dxf_text
 from wgcad.export.rings import clean_outline, min_spacing
+
+from ..records import record
 
 __all__ = [
     "DxfLayer",
@@ -58,7 +60,7 @@ def _readonly(a: np.ndarray) -> np.ndarray:
     return a
 
 
-@dataclass(frozen=True)
+@record(frozen=True)
 class DxfLayer:
     """One DXF layer: closed outlines and circles, in mm.
 
@@ -134,7 +136,7 @@ class DxfLayer:
         object.__setattr__(self, "color", int(self.color))
 
 
-@dataclass(frozen=True)
+@record(frozen=True)
 class Prepared:
     """A layer as it is written: outlines and paths cleaned (see :func:`prepare`)."""
 

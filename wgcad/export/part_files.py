@@ -4,8 +4,9 @@ after everything is built. ``wgcad parts`` wraps it: flags, the bar, printing.""
 
 from __future__ import annotations
 
-from dataclasses import dataclass
 from pathlib import Path
+
+from ..records import record
 
 __all__ = ["FORMATS", "PartFiles", "write_part_files"]
 
@@ -23,7 +24,7 @@ def _jsonable(v):
     return v
 
 
-@dataclass
+@record
 class PartFiles:
     """What :func:`write_part_files` did: the parts built, the report document (``<design>_parts.json``) and the
     files written (the report last)."""

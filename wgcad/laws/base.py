@@ -5,12 +5,14 @@ from __future__ import annotations
 import abc
 import math
 import numbers
-from dataclasses import dataclass, replace
+from dataclasses import replace
 from typing import ClassVar
 
 import numpy as np
 
 from wgcad.errors import DesignError
+
+from ..records import record
 
 __all__ = ["RimState", "Law"]
 
@@ -32,7 +34,7 @@ _W0_MAX_DIVISOR = 4.0
 # state container
 
 
-@dataclass(frozen=True)
+@record(frozen=True)
 class RimState:
     """Neutral-line state at angles phi; every field an array with phi's shape (read-only).
 

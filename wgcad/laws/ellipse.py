@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import field
 from typing import ClassVar
 
 import numpy as np
@@ -11,6 +11,7 @@ import numpy as np
 from wgcad.constants import NEWTON_TOL
 from wgcad.errors import DesignError, GeometryError
 
+from ..records import record
 from .base import _HALF_PI, _check_w0_rm, _real, _TwoWaveLaw
 
 __all__ = ["Ellipse", "ellipe", "ellipeinc"]
@@ -50,7 +51,7 @@ def _solve_ellipe(target: float) -> float:
             hi = mid
 
 
-@dataclass(frozen=True)
+@record(frozen=True)
 class Ellipse(_TwoWaveLaw):
     """Exact elliptical cam: the neutral line is an ellipse offset outward by `offset`.
 

@@ -3,13 +3,13 @@
 from __future__ import annotations
 
 import numbers
-from dataclasses import dataclass
 from typing import ClassVar
 
 import numpy as np
 
 from wgcad.errors import DesignError
 
+from ..records import record
 from .base import Law, RimState, _check_w0_rm
 
 __all__ = ["Harmonic"]
@@ -18,7 +18,7 @@ __all__ = ["Harmonic"]
 # harmonic law
 
 
-@dataclass(frozen=True)
+@record(frozen=True)
 class Harmonic(Law):
     """Harmonic law w = W0 cos(n_w phi), any number of waves (docs/models.md 3.2).
 

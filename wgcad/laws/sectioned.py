@@ -3,13 +3,14 @@
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import field
 from typing import ClassVar
 
 import numpy as np
 
 from wgcad.errors import DesignError
 
+from ..records import record
 from .base import _HALF_PI, RimState, _check_beta, _check_w0_rm, _TwoWaveLaw
 
 __all__ = ["Disc", "ExternalRing", "FourForce"]
@@ -44,7 +45,7 @@ _FF_BETA_HI = _HALF_PI - _FF_BETA_LO
 # disc law and its mirror image, the external ring
 
 
-@dataclass(frozen=True)
+@record(frozen=True)
 class _SectionedLaw(_TwoWaveLaw):
     """A two-wave law given by two closed-form sections meeting at ``beta`` (docs/models.md 3.3, 3.4).
 
@@ -76,7 +77,7 @@ class _SectionedLaw(_TwoWaveLaw):
         return tuple(np.where(on_section_one, a, b) for a, b in zip(sec1, sec2))
 
 
-@dataclass(frozen=True)
+@record(frozen=True)
 class _DiscShape(_SectionedLaw):
     """Disc-generator shape of docs/models.md 3.3 times a sign (+1 disc, -1 external ring)."""
 
@@ -140,7 +141,7 @@ class _DiscShape(_SectionedLaw):
         return sec1, sec2
 
 
-@dataclass(frozen=True)
+@record(frozen=True)
 class Disc(_DiscShape):
     """Disc generator with wrap half-angle beta (docs/models.md 3.3), two waves.
 
@@ -164,7 +165,7 @@ class Disc(_DiscShape):
     _sign: ClassVar[float] = 1.0
 
 
-@dataclass(frozen=True)
+@record(frozen=True)
 class ExternalRing(_DiscShape):
     """External-deformation ring generator (docs/models.md 3.5): the disc law with the opposite sign.
 
@@ -196,7 +197,7 @@ class ExternalRing(_DiscShape):
 # four-force law
 
 
-@dataclass(frozen=True)
+@record(frozen=True)
 class FourForce(_SectionedLaw):
     """Cam shaped as a ring deformed by four radial forces at +-beta, pi+-beta (docs/models.md 3.4).
 

@@ -10,12 +10,11 @@ and everything is drawn in the flexspline's frame.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-
 import numpy as np
 
 from ..errors import GeometryError
 from ..kinematics import gear_ratios
+from ..records import record
 from .law import deformed_curve, join_teeth, place_flex_teeth, tooth_angles, transform
 
 __all__ = ["DeformedState", "deformed_state", "generator_frame", "rim_samples", "rotate"]
@@ -47,7 +46,7 @@ def rim_samples(drive, tol: float) -> np.ndarray:
     return np.linspace(0.0, 2 * np.pi, n, endpoint=False)
 
 
-@dataclass(frozen=True)
+@record(frozen=True)
 class DeformedState:
     """Outlines (mm, the fixed member's frame) of the drive at one generator angle."""
 

@@ -27,12 +27,12 @@ docs/models.md 6.1, 6.2):
 
 from __future__ import annotations
 
-from dataclasses import dataclass
 from math import pi, radians
 
 import numpy as np
 
 from ..kinematics import gear_ratios
+from ..records import record
 from .law import pose_from_displacements, tooth_pose
 
 __all__ = [
@@ -71,7 +71,7 @@ SPEC_KEYS = {
 }
 
 
-@dataclass(frozen=True)
+@record(frozen=True)
 class Imperfections:
     """The errors of :class:`~wgcad.design.imperfections.ImperfectionsSpec` in mm and rad.
 

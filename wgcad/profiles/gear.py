@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import field
 from math import pi
 
 import numpy as np
@@ -10,6 +10,7 @@ import numpy as np
 from .. import constants
 from ..errors import DesignError
 from ..plane import signed_area
+from ..records import record
 from . import cycloid as cy
 from . import involute as iv
 from . import pieces as pc
@@ -25,7 +26,7 @@ def rotate(points: np.ndarray, angle: float) -> np.ndarray:
     return np.stack([c * pts[..., 0] - s * pts[..., 1], s * pts[..., 0] + c * pts[..., 1]], axis=-1)
 
 
-@dataclass(frozen=True)
+@record(frozen=True)
 class ToothSpec:
     """Everything that fixes one gear's teeth. Lengths mm, angles rad.
 
@@ -57,7 +58,7 @@ class ToothSpec:
     tangent_length: float = 0.0
 
 
-@dataclass(frozen=True)
+@record(frozen=True)
 class Gear:
     """One gear's teeth, undeformed. Read-only arrays; lengths mm, angles rad.
 

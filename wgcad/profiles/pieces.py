@@ -30,10 +30,11 @@ turned by ``rot`` about the origin: ``point = R(rot) diag(1, flip) base(t)``.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
 from functools import lru_cache
 
 import numpy as np
+
+from ..records import record
 
 __all__ = [
     "Piece",
@@ -70,7 +71,7 @@ def gauss_legendre(n: int) -> tuple[np.ndarray, np.ndarray]:
     return x, w
 
 
-@dataclass(frozen=True)
+@record(frozen=True)
 class Piece:
     """One analytic piece of an outline (module docstring). Lengths mm, angles rad.
 

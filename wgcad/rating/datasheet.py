@@ -12,7 +12,7 @@ limit *above* that torque, which the datasheet says.
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass, field
+from dataclasses import field
 from math import pi
 
 import numpy as np
@@ -23,6 +23,7 @@ from wgcad.elastic.mesh import entry_gaps
 from wgcad.errors import DesignError, ModelError
 from wgcad.units import UM_PER_MM
 
+from ..records import record
 from .fatigue import strength
 from .flexspline import state_stresses, stress_setup
 from .life import bearing_life
@@ -46,7 +47,7 @@ _BISECTIONS = 5
 _DOUBLINGS = 9
 
 
-@dataclass(frozen=True)
+@record(frozen=True)
 class Level:
     """The figures of one solved torque (internal units: N m, mm, MPa, rad, h)."""
 
@@ -72,7 +73,7 @@ class Level:
         }
 
 
-@dataclass(frozen=True)
+@record(frozen=True)
 class Limit:
     """The torque at which one criterion stops being met (N m); ``above``: met up to ``torque_nm``, where the model
     stopped, so the limit lies beyond; ``note`` why the model stopped or how the figure was found."""
@@ -83,7 +84,7 @@ class Limit:
     note: str = ""
 
 
-@dataclass
+@record
 class Datasheet:
     """The whole rating of one drive (internal units; ``report.rating`` words it)."""
 
@@ -130,7 +131,7 @@ def _level(sheet_ctx, T: float, warm, offset) -> Level:
     )
 
 
-@dataclass(frozen=True)
+@record(frozen=True)
 class _Stop:
     """Why a search stopped: ``static`` when a ball reached the bearing's static limit (the model refuses the
     load), else no convergence or the search's own end."""

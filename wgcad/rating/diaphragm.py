@@ -16,9 +16,9 @@ and translation of the rim) are left to the supports.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-
 import numpy as np
+
+from ..records import record
 
 __all__ = ["Diaphragm", "edge_stress_factors", "diaphragm_stress"]
 
@@ -26,7 +26,7 @@ _SAMPLES = 720
 _HARMONICS = 40
 
 
-@dataclass(frozen=True)
+@record(frozen=True)
 class Diaphragm:
     """The plate: clamped at ``r_i``, joined to the wall at ``r_o`` (mm), ``h`` thick; the wall pivots ``arm`` (mm,
     ``l - z_h``) from the generator's centre section."""

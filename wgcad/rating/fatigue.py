@@ -12,11 +12,12 @@ sensitivity of Neuber ``q = 1 / (1 + sqrt(a/r))`` with Kuhn and Hardraht's
 
 from __future__ import annotations
 
-from dataclasses import dataclass
 from math import sqrt
 from statistics import NormalDist
 
 from wgcad.errors import DesignError
+
+from ..records import record
 
 __all__ = ["Strength", "strength", "goodman_safety", "SURFACE_FACTORS"]
 
@@ -31,7 +32,7 @@ _KPSI_PER_MPA = 1.0 / 6.894757
 _MM_PER_IN = 25.4
 
 
-@dataclass(frozen=True)
+@record(frozen=True)
 class Strength:
     """The flexspline material's strengths and fatigue factors (MPa, dimensionless)."""
 

@@ -2,11 +2,11 @@
 
 from __future__ import annotations
 
-from dataclasses import dataclass
 from math import pi, sqrt
 
 import numpy as np
 
+from ..records import record
 from .diaphragm import Diaphragm, diaphragm_stress
 from .fatigue import Strength, goodman_safety
 from .rim import RimCycle, curvature_change, torque_shear
@@ -25,7 +25,7 @@ def tooth_stress_factor(s_f: float, h_f: float, rho_f: float) -> float:
     return (1.2 + 0.13 * L) * qs ** (1.0 / (1.21 + 2.3 / L))
 
 
-@dataclass(frozen=True)
+@record(frozen=True)
 class StressSetup:
     """What the stresses of every state share: geometry, the root's concentration, the material (mm, MPa)."""
 
@@ -99,7 +99,7 @@ def stress_setup(drive, kt: float, strength: Strength) -> StressSetup:
     )
 
 
-@dataclass(frozen=True)
+@record(frozen=True)
 class SectionStress(RimCycle):
     """One place of the flexspline over a turn of the generator (MPa): its cycle (:class:`RimCycle`: ``psi``,
     ``sigma``, the surface stress at each angle from the major axis), and

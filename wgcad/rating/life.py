@@ -19,9 +19,9 @@ speed relative to the flexspline.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-
 import numpy as np
+
+from ..records import record
 
 __all__ = ["B_M", "raceway_ratings", "BearingLife", "bearing_life"]
 
@@ -39,7 +39,7 @@ def raceway_ratings(ball_d: float, pitch_d: float, balls: int, f_inner: float, f
     return float(qi), float(qo)
 
 
-@dataclass(frozen=True)
+@record(frozen=True)
 class BearingLife:
     """L10 of the flexible bearing.
 

@@ -15,15 +15,16 @@ of scikit-fem on a mesh of its own.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
 from math import pi
 
 import numpy as np
 
+from ..records import record
+
 __all__ = ["RootConcentration", "root_concentration"]
 
 
-@dataclass(frozen=True)
+@record(frozen=True)
 class RootConcentration:
     """The tooth root's stress concentration in rim bending.
 

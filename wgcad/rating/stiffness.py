@@ -2,15 +2,16 @@
 
 from __future__ import annotations
 
-from dataclasses import dataclass
 from math import pi, sqrt
 
 import numpy as np
 
+from ..records import record
+
 __all__ = ["ThreeSegmentFit", "fit_three_segments", "natural_frequency_hz"]
 
 
-@dataclass(frozen=True)
+@record(frozen=True)
 class ThreeSegmentFit:
     """``theta(T) = theta0 + T/K1`` up to ``T1``, then slope ``1/K2`` to ``T2``, then ``1/K3`` (N m, rad, N m/rad).
 

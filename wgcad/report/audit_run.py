@@ -7,16 +7,15 @@ from :func:`audit_document` without the CLI.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-
 from ..audit import RunSettings, run_audit
+from ..records import record
 from .audit import audit_json
 from .notes import not_modelled
 
 __all__ = ["AuditRun", "audit_document", "baseline_document", "imperfect_not_checked"]
 
 
-@dataclass
+@record
 class AuditRun:
     """An audit with its document: ``doc`` is the JSON of ``wgcad audit --json``; ``drifts`` the baseline's (or None)."""
 

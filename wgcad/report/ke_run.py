@@ -4,10 +4,11 @@ load, the installation-angle scans (docs/models.md 6.2, 6.3). ``wgcad ke`` wraps
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import field
 
 import numpy as np
 
+from ..records import record
 from ..units import ARCSEC_PER_RAD
 
 __all__ = ["KERun", "no_load", "add_loaded", "add_install_scan"]
@@ -15,7 +16,7 @@ __all__ = ["KERun", "no_load", "add_loaded", "add_install_scan"]
 _AS = ARCSEC_PER_RAD
 
 
-@dataclass
+@record
 class KERun:
     """A KE run: the drive and its errors, the contact table, the no-load results, and the JSON document ``doc``
     that ``wgcad ke --json`` writes; ``loaded`` and ``scan`` once :func:`add_loaded` / :func:`add_install_scan` ran."""

@@ -3,11 +3,12 @@
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass, field
+from dataclasses import field
 
 import numpy as np
 
 from ..profiles.sector import MIN_HEIGHT_COEF, SectorLayout, TeethByHeight
+from ..records import record
 from .scene import DEFAULT_CULL, DEFAULT_STEP_DEG, SectoredScene, sweep_angles
 
 __all__ = [
@@ -21,7 +22,7 @@ __all__ = [
 ]
 
 
-@dataclass(frozen=True)
+@record(frozen=True)
 class ClosedFormHeights:
     """Heights by ``h_i = r_fix - (r_cr + w(phi_i) + h_s)``, at most the full height (docs/models.md 2.3, [S5]).
 
@@ -164,7 +165,7 @@ def closed_form_heights(
     )
 
 
-@dataclass(frozen=True)
+@record(frozen=True)
 class SimulatedHeights:
     """Heights found by sweeping the generator (largest that keeps ``tip_clearance`` where tips face).
 

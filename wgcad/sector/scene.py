@@ -21,7 +21,7 @@ Which shortcuts of docs/models.md 7 still hold:
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import field
 from math import pi
 
 import numpy as np
@@ -31,6 +31,7 @@ from ..clearance.distance import Template, signed_clearance
 from ..placement import tooth_pose, transform
 from ..profiles.sampling import polar
 from ..profiles.sector import SectorLayout, TeethByHeight
+from ..records import record
 from .motion import MotionLaw, motion_law
 
 __all__ = [
@@ -222,7 +223,7 @@ class SectoredScene:
         return out
 
 
-@dataclass(frozen=True)
+@record(frozen=True)
 class SweepPairs:
     """Tooth pairs of a sweep: generator-angle index, flexspline tooth, rigid tooth, the flexspline tooth's pose and angle from the major axis."""
 
@@ -243,7 +244,7 @@ class SweepPairs:
         return len(self.rigid)
 
 
-@dataclass
+@record
 class SectoredAudit:
     """Findings of a sectored sweep (lengths mm, angles rad; :func:`wgcad.report.sector.sectored_audit_document`
     rounds and converts them).
@@ -271,7 +272,7 @@ class SectoredAudit:
         return len(self.tip_to_tip) > 0
 
 
-@dataclass
+@record
 class SectorSpot:
     """Where a sectored sweep found a figure: the pair's clearance (mm), the generator angle (rad), the flexspline tooth
     and its angle from the major axis (rad), the rigid tooth, its sector (index, kind, place in it), its angle from the

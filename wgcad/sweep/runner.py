@@ -25,9 +25,10 @@ import math
 import os
 import statistics
 import time
-from dataclasses import dataclass, field
+from dataclasses import field
 
 from ..errors import WgcadError
+from ..records import record
 from .store import Store
 from .tasks import columns_of, noop, run_batch
 
@@ -50,7 +51,7 @@ TASKS_PER_WORKER = 4
 TASK_MIN_S = 1.0
 
 
-@dataclass
+@record
 class RunInfo:
     """What a run did: samples computed and skipped (already stored), grain, timings."""
 

@@ -34,11 +34,12 @@ from __future__ import annotations
 import hashlib
 import json
 import tomllib
-from dataclasses import dataclass, fields
+from dataclasses import fields
 from pathlib import Path
 
 from ..errors import DesignError, InputFileError, close_matches
 from ..numbers import read_float, show_value
+from ..records import record
 
 __all__ = ["Parameter", "SweepSpec", "parse_spec", "load_spec", "MAX_SAMPLES", "DISTRIBUTIONS"]
 
@@ -58,7 +59,7 @@ _PARAM_KEYS = {
 }
 
 
-@dataclass(frozen=True)
+@record(frozen=True)
 class Parameter:
     """One varied design key: ``table.key`` and how it varies.
 
@@ -92,7 +93,7 @@ class Parameter:
         return max(float(v) for v in self.values)
 
 
-@dataclass(frozen=True)
+@record(frozen=True)
 class SweepSpec:
     """A validated sweep specification."""
 

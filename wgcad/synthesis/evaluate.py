@@ -22,13 +22,14 @@ from __future__ import annotations
 
 import math
 import time
-from dataclasses import dataclass, field
+from dataclasses import field
 
 import numpy as np
 
 from ..design import Design
 from ..design.schema import with_changes
 from ..errors import DesignError, ModelError
+from ..records import record
 
 __all__ = ["Evaluation", "evaluate", "apply", "STAGES"]
 
@@ -40,7 +41,7 @@ RATED = ("fatigue", "yield", "bearing_life")
 PEAK = ("entry_gap", "ratcheting", "bearing_static", "yield")
 
 
-@dataclass
+@record
 class Evaluation:
     """The judgement of one candidate: the free keys' values, each constraint's margin (>= 0: met; None: not reached),
     the objectives' values where they were computed, the stage it stopped at and why."""

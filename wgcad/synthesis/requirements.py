@@ -30,12 +30,13 @@ Bad input is a :class:`~wgcad.errors.DesignError` naming ``requirements.<key>`` 
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, fields
+from dataclasses import fields
 from pathlib import Path
 
 from ..design.files import parse_toml
 from ..design.schema import Design
 from ..errors import DesignError
+from ..records import record
 
 __all__ = ["FreeKey", "Requirements", "OBJECTIVES", "load_requirements", "parse_requirements"]
 
@@ -70,7 +71,7 @@ _KEYS = {
 }
 
 
-@dataclass(frozen=True)
+@record(frozen=True)
 class FreeKey:
     """A design key the search chooses: ``table.key`` in ``[low, high]`` (``integer``: whole numbers)."""
 
@@ -85,7 +86,7 @@ class FreeKey:
         return f"{self.table}.{self.key}"
 
 
-@dataclass(frozen=True)
+@record(frozen=True)
 class Requirements:
     """A parsed requirements file (lengths mm, torques N m; None: not required)."""
 

@@ -16,11 +16,12 @@ from __future__ import annotations
 
 import math
 import time
-from dataclasses import dataclass, field
+from dataclasses import field
 from itertools import product
 
 from ..design import load_design
 from ..errors import WgcadError
+from ..records import record
 from .evaluate import PEAK, RATED, STAGES, Evaluation, evaluate
 from .requirements import OBJECTIVES, Requirements
 
@@ -53,7 +54,7 @@ def constraint_names(req: Requirements) -> list[str]:
     return names
 
 
-@dataclass
+@record
 class SearchResult:
     """Every candidate judged (resumed ones included), the feasible ones ranked, and how the search ran."""
 

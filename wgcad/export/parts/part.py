@@ -3,12 +3,14 @@
 from __future__ import annotations
 
 from collections.abc import Callable
-from dataclasses import dataclass, field
+from dataclasses import field
+
+from ...records import record
 
 __all__ = ["Part"]
 
 
-@dataclass
+@record
 class Part:
     """One part of the drive.
 
