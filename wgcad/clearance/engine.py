@@ -158,7 +158,7 @@ def _stage(tick, name):
     return lambda f: tick(a + (b - a) * f, name)
 
 
-def _canonical(scene: Scene, phi_all: np.ndarray, period: float, phi_w: float, z, exact: bool):
+def _canonical(scene: Scene, folded: np.ndarray, phi_w: float, z, exact: bool):
     """The worst spot folded to the nearest major axis: ``(phi >= 0, location, mirror location, sample index)``.
 
     Teeth and laws are symmetric: the tooth at ``-phi`` is the mirror image
@@ -166,10 +166,11 @@ def _canonical(scene: Scene, phi_all: np.ndarray, period: float, phi_w: float, z
     the spot is reported at ``+|phi|`` whichever sample the search met
     first (issue 13: the printed spot no longer depends on the shortcuts).
     The sample is the first (generator angle, tooth) in order whose tooth
-    angle folds to ``+|phi|`` (else ``-|phi|``).
+    angle folds to ``+|phi|`` (else ``-|phi|``); ``folded`` holds every
+    sample's tooth angle folded to the nearest major axis, ``(A, z_g)``.
     """
     a = abs(float(_fold(np.array([phi_w]), 2 * pi / scene.n_w)[0]))
-    folded = _fold(phi_all.ravel(), 2 * pi / scene.n_w)
+    folded = folded.ravel()
     hit = np.nonzero(np.abs(folded - a) <= 1e-9)[0]
     sgn = 1.0
     if hit.size == 0:
@@ -205,6 +206,8 @@ def audit(drive, settings: AuditSettings, progress=None) -> AuditResult:
     phi_all = _sample_phi(scene, angles)  # (A, z_g)
     period = 2 * pi / scene.n_w if settings.use_waves else 2 * pi
     key = _fold(phi_all, period)
+    # every sample's tooth angle folded to the nearest major axis (where the worst spot is named)
+    folded = key if settings.use_waves else _fold(phi_all, 2 * pi / scene.n_w)
     if settings.use_mirror:
         key = np.abs(key)
     n_samples = phi_all.size * len(sections)
@@ -222,7 +225,7 @@ def audit(drive, settings: AuditSettings, progress=None) -> AuditResult:
     best, where, n_refined, n_fine = _refine(drive, scene, phi_sorted, sections, cands, settings, best_poly, stg)
     si, i = where
     z_w = sections[si]
-    worst = _worst_finding(scene, phi_all, period, float(phi_sorted[i]), z_w, settings.refine, angles, best, best_poly)
+    worst = _worst_finding(scene, folded, float(phi_sorted[i]), z_w, settings.refine, angles, best, best_poly)
     ste = _stage(tick, "entry gap")
     ste(0.0)
     entry, crossing_f, pinch_f = entry_findings(scene, sections, settings.refine, settings.interference_tol)
@@ -231,8 +234,7 @@ def audit(drive, settings: AuditSettings, progress=None) -> AuditResult:
         best = float(pinch_f.value)
         worst = _worst_finding(
             scene,
-            phi_all,
-            period,
+            folded,
             float(pinch_f.tooth_angle),
             pinch_f.section_z,
             settings.refine,
@@ -457,10 +459,10 @@ def entry_findings(scene: Scene, sections: list, refine: bool, interference_tol:
 
 
 def _worst_finding(
-    scene: Scene, phi_all, period, phi_w: float, z_w, exact: bool, angles, best: float, best_poly: float
+    scene: Scene, folded, phi_w: float, z_w, exact: bool, angles, best: float, best_poly: float
 ) -> Finding:
     """The smallest clearance as a :class:`Finding`: its canonical spot, the mirror image, the overlap area."""
-    phi_c, loc, mirror_loc, flat, sgn_c = _canonical(scene, phi_all, period, phi_w, z_w, exact)
+    phi_c, loc, mirror_loc, flat, sgn_c = _canonical(scene, folded, phi_w, z_w, exact)
     ai, k = divmod(flat, scene.z_g)
     phi_rep = sgn_c * phi_c
     detail = tooth_clearance(scene, np.array([phi_rep]), z_w, area=True)
