@@ -308,3 +308,54 @@ def test_help_is_wrapped_to_the_width_argparse_itself_takes(columns, monkeypatch
     stock = [parser.format_help()] + [sp.format_help() for sp in commands.values()]
     assert ours == stock
     assert len(commands) >= 9
+
+
+LINES = [
+    ["audit", "d.toml"],
+    ["audit", "d.toml", "--quiet", "--no-refine", "--step-deg", "0.25", "--json", "-"],
+    ["--traceback", "audit", "d.toml", "--sections", "5"],
+    ["audit", "d.toml", "--traceback", "--bogus"],
+    ["audit"],
+    ["audit", "--step-deg", "x", "d.toml"],
+    ["generate", "d.toml", "--generator-angle", "0,15,30", "--out", "o"],
+    ["generate", "d.toml", "--dxf-style", "nope"],
+    ["kinematics", "d.toml"],
+    ["ke", "d.toml", "--torque-nm", "100"],
+    ["rating", "d.toml"],
+    ["sector", "d.toml", "--out", "o"],
+    ["parts", "d.toml", "--format", "dxf,step"],
+    ["parts", "d.toml", "--format", "dwg"],
+    ["sweep", "s.toml", "--workers", "2"],
+    ["design", "r.toml"],
+    ["audti", "d.toml"],
+    ["d.toml"],
+    [],
+    ["--", "audit", "d.toml"],
+]
+
+
+@pytest.mark.parametrize("line", LINES, ids=[" ".join(x) or "(none)" for x in LINES])
+def test_a_line_parses_the_same_with_its_command_alone(line, capsys):
+    """main() registers only the command a line names: every line reads as with every command registered, the
+    same arguments or the same error and exit code."""
+    from wgcad.cli import _named_command, build_parser
+
+    def outcome(parser):
+        try:
+            ns = vars(parser.parse_args(line))
+        except SystemExit as e:
+            return ("exit", e.code, capsys.readouterr().err)
+        return ("ok", {k: getattr(v, "__qualname__", v) for k, v in ns.items()}, capsys.readouterr().err)
+
+    only = _named_command(line)
+    assert outcome(build_parser(only=only)) == outcome(build_parser())
+
+
+def test_the_command_named_on_a_line():
+    from wgcad.cli import _named_command, build_parser
+
+    assert _named_command(["audit", "d.toml"]) == "audit"
+    assert _named_command(["--traceback", "ke", "d.toml"]) == "ke"
+    for line in (["--help", "audit"], ["--version"], ["audti", "d.toml"], [], ["--", "audit"], ["d.toml", "audit"]):
+        assert _named_command(line) is None, line
+    assert list(build_parser(only="audit")._subparsers._group_actions[0].choices) == ["audit"]
