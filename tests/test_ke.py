@@ -513,3 +513,30 @@ def test_a_forked_process_measures_with_threads_of_its_own(d2, monkeypatch):
 def _child_table(d2, q):
     tab = K.contact_table(d2, Imperfections(), 2, sections=[None])
     q.put(int(sum(len(S["g"]) for S in tab.sides.values())))
+
+
+@pytest.mark.parametrize("value", ["0", "-1", "x", "101"])
+def test_bad_chord_tolerance_exits_2(value, capsys):
+    with pytest.raises(SystemExit) as e:
+        main(["ke", str(TEMPLATES / "d2_imperfect.toml"), "--chord-tol-um", value])
+    assert e.value.code == 2 and "--chord-tol-um" in capsys.readouterr().err
+
+
+def test_the_chord_tolerance_shapes_the_outlines_and_the_record_says_which(tmp_path):
+    """``--chord-tol-um`` is the tolerance of the outlines the KE measures (the record equals the library's at that
+    tolerance, not at the default) and the JSON carries it."""
+    import json
+
+    from wgcad.report.ke_run import no_load
+
+    path = TEMPLATES / "d2_imperfect.toml"
+    out = tmp_path / "k.json"
+    assert main(["ke", str(path), "--per-mesh", "2", "--chord-tol-um", "0.3", "--json", str(out)]) == 0
+    doc = json.loads(out.read_text())
+    assert doc["chord_tol_um"] == 0.3
+    design = load_design(path)
+    imp = Imperfections.from_spec(design.imperfections)
+    run, lines = no_load(build_drive(design, tol=3e-4), imp, 2, str(path))
+    assert run.doc == doc and any("within 0.3 um of the exact curves" in line for line in lines)
+    default, _ = no_load(build_drive(design), imp, 2, str(path))
+    assert default.doc["chord_tol_um"] == 1.0 and np.abs(default.res.ke - run.res.ke).max() > 1e-9

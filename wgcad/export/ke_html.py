@@ -133,6 +133,7 @@ def ke_html(run) -> str:
             str(doc["samples"]),
             f"{doc['per_mesh_period']} per mesh period, {fmt(doc['generator_turns'], 3)} generator turns",
         ),
+        ("chord tolerance", f"{fmt(doc['chord_tol_um'])} um", "outlines to the exact curves (docs/models.md 6.2)"),
     ]
     for L in run.loaded:
         rows.append(

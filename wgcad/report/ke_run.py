@@ -65,6 +65,7 @@ def no_load(drive, imp, per_mesh: int, source: str, progress=None) -> tuple[KERu
         },
         "samples": int(len(res.ke)),
         "per_mesh_period": per_mesh,
+        "chord_tol_um": round(drive.tol * 1e3, 6),
         "generator_turns": round(res.turns, 6),
         "shortcuts": shortcuts(imp),
         "expected_orders": expected,
@@ -80,6 +81,8 @@ def no_load(drive, imp, per_mesh: int, source: str, progress=None) -> tuple[KERu
         f"{out['intrinsic_ke_pp_arcsec']:.3f} arcsec",
         "  strongest orders: "
         + ", ".join(f"{s['order']:g} ({s['amplitude_arcsec']:.2f}'')" for s in out["spectrum_top"][:4]),
+        f"  contacts measured on outlines within {out['chord_tol_um']:g} um of the exact curves (--chord-tol-um; "
+        "docs/models.md 6.2: how the KE moves with it)",
     ]
     out["deep_overlap_fraction"] = round(res.deep_overlap_fraction, 4)
     if res.deep_overlap_fraction > 0:
