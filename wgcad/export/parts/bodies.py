@@ -259,14 +259,33 @@ def plug_outline(drive, sizes, n: int | None = None) -> dict:
     bw = d.drive.face_width
     z_g = d.generator.generator_z if d.generator.generator_z is not None else 0.5 * bw
     law = drive.law_at(z_g) if drive.coned else drive.law
-    if n is None:
-        n = max(720, int(np.ceil(2 * np.pi / np.sqrt(8 * drive.tol / drive.r_m))))
-    ph = np.linspace(0.0, 2 * np.pi, n, endpoint=False)
     half = drive.flex_rim_radius - drive.r_m  # -h1/2 (internal), +h1/2 (external)
     off = half + (1.0 if drive.external else -1.0) * sizes.bearing_thickness
+    if n is None:
+        # a circle of the neutral radius's count, then as many more as the chords' measured sagitta asks: an
+        # outline outside the neutral line (an external drive's ring bore) has longer chords over the same angle
+        # (D3's sagged 1.15 um at the circle's count against the 1 um tolerance)
+        n = max(720, int(np.ceil(2 * np.pi / np.sqrt(8 * drive.tol / drive.r_m))))
+        for _ in range(5):
+            sag = _chord_sagitta(law, drive.r_m, off, n)
+            if sag <= drive.tol:
+                break
+            n = int(np.ceil(n * np.sqrt(sag / (0.95 * drive.tol))))
+    ph = np.linspace(0.0, 2 * np.pi, n, endpoint=False)
     neutral = deformed_curve(law, drive.r_m, 0.0, ph)
     outline = deformed_curve(law, drive.r_m, off, ph)
     return {"outline": outline, "neutral": neutral, "offset_mm": off, "z_mm": z_g, "phi": ph}
+
+
+def _chord_sagitta(law, r_m: float, off: float, n: int) -> float:
+    """Largest distance of the offset curve from its ``n`` equal-angle chords, at the chords' middle angles, mm."""
+    from wgcad.placement import deformed_curve
+
+    ph = np.linspace(0.0, 2 * np.pi, n, endpoint=False)
+    a = deformed_curve(law, r_m, off, ph)
+    ab = np.roll(a, -1, axis=0) - a
+    m = deformed_curve(law, r_m, off, ph + np.pi / n) - a
+    return float(np.max(np.abs(ab[:, 0] * m[:, 1] - ab[:, 1] * m[:, 0]) / np.hypot(ab[:, 0], ab[:, 1])))
 
 
 def _plug_arcs(drive, po: dict, tol: float):
