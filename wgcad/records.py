@@ -19,6 +19,7 @@ from __future__ import annotations
 
 import dataclasses
 from dataclasses import MISSING, FrozenInstanceError
+from typing import dataclass_transform
 
 __all__ = ["record"]
 
@@ -114,8 +115,10 @@ def _check_order(cls) -> None:
             seen_default = f.name
 
 
+@dataclass_transform(field_specifiers=(dataclasses.field, dataclasses.Field))
 def record(cls=None, /, *, frozen: bool = False):
-    """Use as ``@record`` or ``@record(frozen=True)`` where ``@dataclass`` would stand (module note)."""
+    """Use as ``@record`` or ``@record(frozen=True)`` where ``@dataclass`` would stand (module note); type checkers
+    and editors read the fields as a dataclass's (``typing.dataclass_transform``)."""
 
     def wrap(c):
         own = dict(c.__dict__)
