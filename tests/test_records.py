@@ -17,6 +17,7 @@ from __future__ import annotations
 import copy
 import dataclasses
 import importlib
+import inspect
 import pkgutil
 import re
 from dataclasses import MISSING, FrozenInstanceError, field
@@ -125,6 +126,7 @@ def test_record_behaves_as_the_standard_dataclass(seed):
             (f.name, f.init, f.repr, f.compare) for f in dataclasses.fields(rec)
         ]
         assert std.__match_args__ == rec.__match_args__
+        assert str(inspect.signature(std)) == str(inspect.signature(rec))
         for trial in range(6):
             args, kw = _args(std, np.random.default_rng([seed, trial]))
             a, b = std(*args, **kw), rec(*args, **kw)
@@ -206,6 +208,11 @@ def test_a_frozen_records_subclass_takes_attributes_that_are_no_fields():
                 self.text = text
                 return self
 
+        class Own(Point):
+            def __init__(self, x, note):
+                super().__init__(x)
+
+        assert list(inspect.signature(Own).parameters) == ["x", "note"]
         p = Labelled(1.0).label("a")
         assert p.text == "a"
         with pytest.raises(FrozenInstanceError):
