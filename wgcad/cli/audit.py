@@ -6,8 +6,8 @@ import os
 import sys
 
 from ..errors import DesignError
+from ..export.json_text import json_text
 from .common import EXIT_INTERFERENCE, EXIT_OK, add_memory_flag, angle_count, epilog, positive_float, whole_number
-from .outputs import json_text
 
 __all__ = ["register", "cmd_audit"]
 

@@ -5,8 +5,8 @@ from __future__ import annotations
 import sys
 import time
 
+from ..export.json_text import json_text
 from .common import EXIT_OK, add_memory_flag, angles_deg, epilog, out_dir, positive_float
-from .outputs import json_text
 
 __all__ = ["register", "cmd_generate"]
 

@@ -6,8 +6,8 @@ from pathlib import Path
 
 from wgcad.units import ARCSEC_PER_RAD
 
+from ..export.json_text import json_text
 from .common import EXIT_OK, epilog, positive_float, whole_number
-from .outputs import json_text
 
 __all__ = ["register", "cmd_ke"]
 

@@ -6,8 +6,8 @@ import sys
 from pathlib import Path
 
 from ..errors import DesignError
+from ..export.json_text import json_text
 from .common import EXIT_INTERFERENCE, EXIT_OK, Progress, key_float
-from .outputs import json_text
 
 __all__ = ["register_args", "run_load", "torque_levels", "RATED", "RATED_STEPS"]
 

@@ -8,7 +8,7 @@ from pathlib import Path
 
 from ..errors import OutputError
 
-__all__ = ["STDOUT", "check_output_file", "check_output_dir", "json_text", "write_stdout"]
+__all__ = ["STDOUT", "check_output_file", "check_output_dir", "write_stdout"]
 
 #: the output path that means standard output
 STDOUT = "-"
@@ -74,10 +74,3 @@ def write_stdout(text: str) -> None:
         raise  # the reader stopped (``| head``): main() exits quietly
     except OSError as exc:
         raise OutputError(f"standard output: cannot write ({exc.strerror or type(exc).__name__})") from exc
-
-
-def json_text(doc, **kw) -> str:
-    """``doc`` as the indented JSON the CLI writes, NaN refused (``json`` loads here, in a run that writes JSON)."""
-    import json
-
-    return json.dumps(doc, allow_nan=False, indent=2, **kw)

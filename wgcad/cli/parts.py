@@ -5,9 +5,9 @@ from __future__ import annotations
 import argparse
 import time
 
+from ..export.json_text import json_text
 from ..export.part_files import FORMATS
 from .common import EXIT_OK, angles_deg, epilog, out_dir, positive_float
-from .outputs import json_text
 
 __all__ = ["register", "cmd_parts", "FORMATS"]
 

@@ -4,8 +4,8 @@ from __future__ import annotations
 
 from pathlib import Path
 
+from ..export.json_text import json_text
 from .common import EXIT_INTERFERENCE, EXIT_OK, epilog, key_float, positive_float, whole_number
-from .outputs import json_text
 
 __all__ = ["register", "cmd_rating"]
 

@@ -2,8 +2,8 @@
 
 from __future__ import annotations
 
+from ..export.json_text import json_text
 from .common import EXIT_INTERFERENCE, EXIT_OK, add_memory_flag, epilog, out_dir, positive_float
-from .outputs import json_text
 
 __all__ = ["register", "cmd_sector"]
 

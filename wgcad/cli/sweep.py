@@ -4,8 +4,8 @@ from __future__ import annotations
 
 from pathlib import Path
 
+from ..export.json_text import json_text
 from .common import EXIT_OK, epilog
-from .outputs import json_text
 
 __all__ = ["register", "cmd_sweep"]
 

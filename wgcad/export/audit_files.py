@@ -6,6 +6,8 @@ from __future__ import annotations
 
 from pathlib import Path
 
+from .json_text import json_text
+
 __all__ = ["plot_paths", "write_audit_files"]
 
 
@@ -25,12 +27,10 @@ def write_audit_files(
     from ..atomic import atomic_batch
 
     texts = []
-    if json_path or baseline_path:
-        import json  # only for the documents asked for (an audit that writes none never loads it)
     if json_path:
-        texts.append((Path(json_path), json.dumps(run.doc, allow_nan=False, indent=2) + "\n"))
+        texts.append((Path(json_path), json_text(run.doc) + "\n"))
     if baseline_path:
-        texts.append((Path(baseline_path), json.dumps(baseline, allow_nan=False, indent=2) + "\n"))
+        texts.append((Path(baseline_path), json_text(baseline) + "\n"))
     if not (texts or plot or html):
         return []
     files = []

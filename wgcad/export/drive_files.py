@@ -4,12 +4,12 @@ generator angles, ``<design>.report.json`` and the folder's manifest, written in
 
 from __future__ import annotations
 
-import json
 import os
 from pathlib import Path
 
 from ..plane import circle_polygon
 from ..records import record
+from .json_text import json_text
 
 __all__ = ["DriveFiles", "angle_tag", "report_name", "planned_names", "write_drive_files"]
 
@@ -213,7 +213,7 @@ def write_drive_files(
         report_path = out / report_name(stem)
         rep["files"] = [p.name for p in files] + [report_path.name]
         # no timings in the report: the same design must give byte-identical files
-        Path(batch.temp_path(report_path)).write_text(json.dumps(rep, allow_nan=False, indent=2) + "\n")
+        Path(batch.temp_path(report_path)).write_text(json_text(rep) + "\n")
         files.append(report_path)
         # the previous run's files for this design that this run does not write again go with the commit
         stale, kept = manifest.stale_files(p.name for p in files)

@@ -7,6 +7,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from ..records import record
+from .json_text import json_text
 
 __all__ = ["FORMATS", "PartFiles", "write_part_files"]
 
@@ -146,8 +147,6 @@ def write_part_files(
                     write_3mf(target(f"{stem}_{p.name}.3mf"), {f"{p.name}_{k}": m for k, m in p.info["meshes"].items()})
         # named by the design, as every other file here: two designs can share a folder
         report["files"] = [f.name for f in files] + [f"{stem}_parts.json"]
-        import json  # here, not at the top: the CLI loads this module for FORMATS in every command
-
-        Path(target(f"{stem}_parts.json")).write_text(json.dumps(report, allow_nan=False, indent=2) + "\n")
+        Path(target(f"{stem}_parts.json")).write_text(json_text(report) + "\n")
     tick(1.0, "done")
     return PartFiles(parts, report, files)

@@ -4,12 +4,12 @@ wraps it: flags, the bar, printing."""
 
 from __future__ import annotations
 
-import json
 from pathlib import Path
 
 import numpy as np
 
 from ..plane import circle_polygon
+from .json_text import json_text
 
 __all__ = ["write_sector_files"]
 
@@ -74,7 +74,7 @@ def write_sector_files(res: dict, source, out, *, stl: bool = True) -> tuple[dic
     texts = {
         "heights.csv": heights_csv(res),
         "motion.csv": motion_csv(law),
-        "sector.json": json.dumps(summ, allow_nan=False, indent=2) + "\n",
+        "sector.json": json_text(summ) + "\n",
     }
     pngs = {"heights.png": png_h, "motion.png": png_m, "sector_audit.png": png_a}
     files = []

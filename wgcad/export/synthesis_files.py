@@ -5,11 +5,11 @@ from __future__ import annotations
 
 import csv
 import io
-import json
 from pathlib import Path
 
 from ..report.synthesis import design_text, search_json, trial_rows
 from ..synthesis.requirements import OBJECTIVES
+from .json_text import json_text
 from .mpl import png_bytes, pyplot
 
 __all__ = ["write_search_files", "search_figure"]
@@ -90,7 +90,7 @@ def write_search_files(res, out_dir, stem: str, base_text: str, plot: bool = Tru
             header, [r for r, ev in zip(rows, res.evaluations) if id(ev) in idx]
         ).encode()
     files[out_dir / f"{stem}_trials.csv"] = _csv(*trial_rows(res)).encode()
-    files[out_dir / f"{stem}_search.json"] = (json.dumps(search_json(res), indent=2, allow_nan=False) + "\n").encode()
+    files[out_dir / f"{stem}_search.json"] = (json_text(search_json(res)) + "\n").encode()
     if plot:
         files[out_dir / f"{stem}_search.png"] = search_figure(res)
     with atomic_batch() as batch:
