@@ -26,13 +26,14 @@ __all__ = ["record"]
 
 
 def _spec(cls) -> tuple:
-    """``(init fields as (name, default, factory), other fields as (name, default, factory), repr names,
-    compare names)`` of a record class, kept on the class."""
+    """``(init fields as (name, default, factory), other fields with a default factory as (name, factory), repr
+    names, compare names)`` of a record class, kept on the class."""
     spec = cls.__dict__.get("__record_spec__")
     if spec is None:
         fs = dataclasses.fields(cls)
         init = tuple((f.name, f.default, f.default_factory) for f in fs if f.init)
-        rest = tuple((f.name, f.default, f.default_factory) for f in fs if not f.init)
+        # (another field with a plain default reads it from the class, as the standard decorator's do)
+        rest = tuple((f.name, f.default_factory) for f in fs if not f.init and f.default_factory is not MISSING)
         spec = (init, rest, tuple(f.name for f in fs if f.repr), tuple(f.name for f in fs if f.compare))
         type.__setattr__(cls, "__record_spec__", spec)
     return spec
@@ -60,9 +61,8 @@ def _init(self, *args, **kwargs):
         put(self, name, value)
     if kwargs:
         raise TypeError(f"{cls.__qualname__}() got an unexpected keyword argument '{next(iter(kwargs))}'")
-    for name, _, factory in rest:  # (one with a plain default reads it from the class, as the standard's)
-        if factory is not MISSING:
-            put(self, name, factory())
+    for name, factory in rest:
+        put(self, name, factory())
     post = getattr(cls, "__post_init__", None)
     if post is not None:
         post(self)
