@@ -4,7 +4,7 @@ Run from the repository root (not part of the test run):
 
     .venv/bin/python benchmarks/export.py                 # D1 involute and D1 cycloidal
     .venv/bin/python benchmarks/export.py --no-step       # skip STEP
-    .venv/bin/python benchmarks/export.py --step-parts    # also STEP of the whole part set (slow: OCCT booleans)
+    .venv/bin/python benchmarks/export.py --step-parts    # also STEP of the whole part set (slow: OCCT writes and reads)
 
 Prints a Markdown table and writes it with the raw figures to
 output/bench/export.{md,json}. Times are wall-clock best-of-N (N = 3, STEP
@@ -109,19 +109,19 @@ def bench(design_path: Path, step: bool, tmp: Path, parts_step: bool = False) ->
         p = tmp / f"{stem}_{prt.name}_part.dxf"
         t, _ = best_of(lambda: write_dxf(p, prt.layers))
         row("dxf part (arcs + gear data)", prt.name, t, p)
-        t_m, mesh = best_of(lambda: prt.make_mesh(), n=1)
+        t_m, mesh = best_of(lambda: prt.mesh(), n=1)
         p = tmp / f"{stem}_{prt.name}_part.stl"
         t_s, _ = best_of(lambda: write_stl(p, mesh))
         row("stl part", prt.name, t_m + t_s, p, triangles=len(mesh.faces))
-        prt._mesh = mesh
     p = tmp / f"{stem}_parts.3mf"
     t, _ = best_of(lambda: write_3mf(p, {q.name: q.mesh() for q in parts}))
     row("3mf", "3 parts", t, p)
     if step:
-        from wgcad.export import step as S
+        from wgcad.export.parts import kernel, recipe
         from wgcad.export.step import read_step, solid_props, write_step
+        from wgcad.profiles.band import gear_band_outline
 
-        # the two toothed rings as B-rep prisms of their arc outlines (the gears alone, no booleans)
+        # the two toothed rings as prisms of their arc outlines (the gears alone)
         for which, gear, rim in (
             ("flexspline", drive.flex, drive.flex_rim_radius),
             ("rigid", drive.rigid, drive.rigid_rim_radius),
@@ -129,14 +129,15 @@ def bench(design_path: Path, step: bool, tmp: Path, parts_step: bool = False) ->
             path = fit_gear(gear, 1e-3)
 
             def ring():
-                teeth = S.wire_from_path(path.vertices, path.bulges)
+                teeth = recipe.path_loop(path, gear_band_outline(gear), "teeth")
+                circle = recipe.circle_loop(rim, 1e-3, "rim")
                 if rim < min(gear.r_a, gear.r_f):
-                    return S.prism(teeth, [S.circle_wire(rim)], bw)
-                return S.prism(S.circle_wire(rim), [teeth], bw)
+                    return kernel.solid(recipe.prism(teeth, [circle], 0.0, bw), which)
+                return kernel.solid(recipe.prism(circle, [teeth], 0.0, bw), which)
 
             t_sol, solid = best_of(ring, n=1)
             p = tmp / f"{stem}_{which}_ring.step"
-            t_w, _ = best_of(lambda: write_step(p, {which: solid}), n=1)
+            t_w, _ = best_of(lambda: write_step(p, solid), n=1)
             t_r, back = best_of(lambda: read_step(p), n=1)
             t_c, props = best_of(lambda: solid_props(back[0]), n=1)
             from wgcad.export.arcs import path_area
@@ -157,9 +158,9 @@ def bench(design_path: Path, step: bool, tmp: Path, parts_step: bool = False) ->
         from wgcad.export.step import read_step, solid_props, write_step
 
         for prt in parts:
-            t_sol, solid = best_of(lambda: prt.make_solid(), n=1)
+            t_sol, solid = best_of(lambda: prt.solid(), n=1)
             p = tmp / f"{stem}_{prt.name}.step"
-            t_w, _ = best_of(lambda: write_step(p, {prt.name: solid}), n=1)
+            t_w, _ = best_of(lambda: write_step(p, solid), n=1)
             t_r, back = best_of(lambda: read_step(p), n=1)
             t_c, props = best_of(lambda: solid_props(back[0]), n=1)
             row(

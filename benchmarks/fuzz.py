@@ -14,8 +14,14 @@ temporary output folder, under an address-space cap; the checks:
 - nothing written on a refusal: the output folder and the JSON target absent or empty;
 - no run longer than ``--timeout`` seconds (a hang), none above the memory cap (a MemoryError is exit 3).
 
+Every run draws its inputs afresh from its own seed (the mutation values are copies: nothing one run changes reaches
+another), so a run is reproduced by its seed alone. A crash of the fuzzer itself while it builds or judges a run (a
+bug of the fuzzer, RecursionError included) is a finding with that seed and run index, not the end of the fuzz.
+
 Prints a JSON line per failure (command, mutation, exit, stderr) and a summary (runs per command and exit code,
-failures, wall time). ``tests/test_fuzz.py`` is the short, seeded version run by the test suite.
+failures, wall time); progress goes to stderr every ``--progress-s`` seconds. ``--budget-s`` ends the fuzz cleanly
+after that long (the runs in flight are dropped, the summary printed), as does Ctrl-C. ``tests/test_fuzz.py`` is
+the short, seeded version run by the test suite; ``tests/test_fuzz_bench.py`` tests this script.
 """
 
 from __future__ import annotations
@@ -23,6 +29,7 @@ from __future__ import annotations
 import argparse
 import collections
 import contextlib
+import copy
 import io
 import json
 import math
@@ -31,6 +38,7 @@ import os
 import random
 import resource
 import shutil
+import signal
 import sys
 import tempfile
 import time
@@ -50,9 +58,17 @@ def _is_table(v) -> bool:
 
 
 # ------------------------------------------------------------------ mutations
-NUMBERS = [0, -1, 1, 2, 7, 3000, 10**6, 10**12, 10**40, -(10**40), 2**63 - 1, 0.0, -0.0, 1e-300, -1e-9, 1e-6, 0.5]
-NUMBERS += [1e5, 1e9, 1e39, 1e308, -1e308, math.inf, -math.inf, math.nan]
-OTHERS = ["", "x", "ellipse", True, False, [], [1], [[1]], {"a": 1}, ["x", 1.5]]
+NUMBERS = (0, -1, 1, 2, 7, 3000, 10**6, 10**12, 10**40, -(10**40), 2**63 - 1, 0.0, -0.0, 1e-300, -1e-9, 1e-6, 0.5)
+NUMBERS += (1e5, 1e9, 1e39, 1e308, -1e308, math.inf, -math.inf, math.nan)
+#: the non-numbers put into a mutant: each use takes a copy (:func:`_draw`). Put in as they are, the lists and the
+#: table were shared by every later run of a worker and mutated there in turn, until the table held itself
+#: (``{"a": {...}}``, seed 778, run 232) and listing the mutant's tables recursed without end
+OTHERS = ("", "x", "ellipse", True, False, [], [1], [[1]], {"a": 1}, ["x", 1.5])
+
+
+def _draw(rng: random.Random, values):
+    """A value drawn from ``values``, as a copy of its own."""
+    return copy.deepcopy(rng.choice(values))
 
 
 def _tables(data, path=()):
@@ -80,16 +96,16 @@ def mutate(data: dict, rng: random.Random) -> list[str]:
             t[k] = type(t[k])(t[k] * f) if isinstance(t[k], float) or f == int(f) else t[k] * f
             done.append(f"{where} *= {f}")
         elif kind == "number" and k is not None:
-            t[k] = rng.choice(NUMBERS)
+            t[k] = _draw(rng, NUMBERS)
             done.append(f"{where} = {t[k]!r}")
         elif kind == "other" and k is not None:
-            t[k] = rng.choice(OTHERS)
+            t[k] = _draw(rng, OTHERS)
             done.append(f"{where} = {t[k]!r}")
         elif kind == "drop_key" and k is not None:
             del t[k]
             done.append(f"del {where}")
         elif kind == "add_key":
-            t[rng.choice(["bogus", "w0", "teeth", "shift_x"])] = rng.choice(NUMBERS + OTHERS)
+            t[rng.choice(["bogus", "w0", "teeth", "shift_x"])] = _draw(rng, NUMBERS + OTHERS)
             done.append(f"add key to {'.'.join(path)}")
         elif kind == "drop_table" and len(path) >= 1:
             parent = data
@@ -99,7 +115,7 @@ def mutate(data: dict, rng: random.Random) -> list[str]:
             done.append(f"del [{'.'.join(path)}]")
         elif kind == "list_item" and k is not None and isinstance(t[k], list) and t[k]:
             i = rng.randrange(len(t[k]))
-            t[k][i] = rng.choice(NUMBERS + OTHERS)
+            t[k][i] = _draw(rng, NUMBERS + OTHERS)
             done.append(f"{where}[{i}] = {t[k][i]!r}")
     return done
 
@@ -174,11 +190,38 @@ def _init() -> None:
 
 
 def run_one(job: dict) -> dict:
+    """One run (:func:`_run_one`); a crash of the fuzzer's own code in it is returned as a finding, with the
+    run's seed and index, so that one bug of the fuzzer does not end the fuzz without a summary."""
+    try:
+        return _run_one(job)
+    except Exception as e:  # noqa: BLE001 (RecursionError, MemoryError, a bug of the fuzzer: all findings)
+        return crash_finding(job, e)
+
+
+def crash_finding(job: dict, e: BaseException) -> dict:
+    """The finding of a run the fuzzer itself could not build, run or judge."""
+    import traceback
+
+    frames = traceback.extract_tb(e.__traceback__)
+    where = f"{Path(frames[-1].filename).name}:{frames[-1].lineno}" if frames else "?"
+    text = " ".join(str(e).split())[:300]
+    return {
+        "seed": job["seed"],
+        "run": job.get("run"),
+        "cmd": "fuzzer",
+        "code": "crash",
+        "bad": [f"fuzzer crash: {type(e).__name__}: {text} at {where}"],
+        "s": 0.0,
+        "args": [],
+    }
+
+
+def _run_one(job: dict) -> dict:
     from wgcad.cli import main
     from wgcad.testing import to_toml
 
     rng = random.Random(job["seed"])
-    tmp = Path(tempfile.mkdtemp(prefix="wgcad-fuzz-"))
+    tmp = Path(tempfile.mkdtemp(prefix="run-", dir=job.get("tmp")))
     try:
         design = rng.choice(DESIGNS)
         data = tomllib.loads(design.read_text())
@@ -203,6 +246,10 @@ def run_one(job: dict) -> dict:
         with contextlib.redirect_stderr(err), contextlib.redirect_stdout(sink):
             try:
                 code = main(args)
+                if code == 128 + signal.SIGTERM:
+                    # Pool.terminate ending the fuzz (a budget, Ctrl-C): wgcad turned its SIGTERM into the command's
+                    # clean exit, and the worker would go on waiting for work while the pool waits for it to end
+                    os._exit(code)
             except SystemExit as e:  # argparse
                 code = e.code if isinstance(e.code, int) else 2
             except BaseException as e:  # noqa: BLE001  (anything escaping main is what the fuzz looks for)
@@ -221,6 +268,7 @@ def run_one(job: dict) -> dict:
             bad.append(f"wrote on refusal: {written[:3]}")
         return {
             "seed": job["seed"],
+            "run": job.get("run"),
             "cmd": cmd,
             "code": code,
             "bad": bad,
@@ -233,53 +281,106 @@ def run_one(job: dict) -> dict:
         shutil.rmtree(tmp, ignore_errors=True)
 
 
-def main() -> None:
+#: shortest wait between two looks at a run's result, s (a --progress-s of 0 does not spin)
+_POLL_S = 0.05
+
+
+def _collect(pool, jobs: list, a, t0: float, tally) -> str:
+    """Submit every job, take each result in order and ``tally`` it; stderr hears of the progress every
+    ``a.progress_s`` seconds, also while a long run is awaited. Returns why it stopped: "done", "budget"
+    (``a.budget_s`` spent: the runs in flight are dropped) or "interrupted" (Ctrl-C)."""
+    pending = [(j, pool.apply_async(run_one, (j,))) for j in jobs]
+    budget_end = math.inf if a.budget_s is None else t0 + a.budget_s
+    next_progress = time.monotonic()
+    try:
+        for k, (j, r) in enumerate(pending):
+            hang_at = time.monotonic() + a.timeout
+            res = None
+            while res is None:
+                now = time.monotonic()
+                if now >= next_progress:
+                    tally.progress(k, len(jobs), now - t0)
+                    next_progress = now + a.progress_s
+                if now >= budget_end:
+                    return "budget"
+                if now >= hang_at:
+                    res = {"seed": j["seed"], "run": j["run"], "cmd": "hang", "code": "hang", "bad": ["hang"]}
+                    res["s"] = a.timeout
+                    break
+                try:
+                    res = r.get(timeout=max(_POLL_S, min(next_progress, budget_end, hang_at) - now))
+                except mp.TimeoutError:
+                    continue
+                except Exception as e:  # noqa: BLE001 (a result that did not come back: a finding too)
+                    res = crash_finding(j, e)
+            tally(res)
+        tally.progress(len(jobs), len(jobs), time.monotonic() - t0)
+    except KeyboardInterrupt:
+        return "interrupted"
+    return "done"
+
+
+class _Tally:
+    """The findings printed as they come (stdout, a JSON line each), the counts of the summary, progress (stderr)."""
+
+    def __init__(self):
+        self.counts = collections.Counter()
+        self.runs = self.failures = self.hangs = self.crashes = 0
+        self.slowest = (0.0, None)
+
+    def __call__(self, res: dict) -> None:
+        self.runs += 1
+        self.counts[(res["cmd"], str(res["code"]))] += 1
+        if res["s"] > self.slowest[0] and res["cmd"] != "hang":
+            self.slowest = (res["s"], res["args"])
+        if res["bad"]:
+            self.failures += 1
+            self.hangs += res["cmd"] == "hang"
+            self.crashes += res["cmd"] == "fuzzer"
+            print(json.dumps(res), flush=True)
+
+    def progress(self, k: int, n: int, elapsed: float) -> None:
+        line = {"progress": k, "of": n, "failures": self.failures, "hangs": self.hangs, "elapsed_s": round(elapsed)}
+        print(json.dumps(line), file=sys.stderr, flush=True)
+
+
+def main(argv=None) -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--runs", type=int, default=200)
     ap.add_argument("--workers", type=int, default=max(1, (os.cpu_count() or 2)))
     ap.add_argument("--seed", type=int, default=1)
     ap.add_argument("--timeout", type=float, default=300.0, help="seconds a run may take before it counts as a hang")
-    a = ap.parse_args()
+    ap.add_argument(
+        "--budget-s", type=float, default=None, help="stop after this many seconds (the summary counts the runs done)"
+    )
+    ap.add_argument("--progress-s", type=float, default=10.0, help="seconds between progress lines on stderr")
+    a = ap.parse_args(argv)
     os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
-    t0 = time.time()
-    jobs = [{"seed": a.seed * 1_000_003 + i} for i in range(a.runs)]
-    counts = collections.Counter()
-    failures = hangs = 0
-    slowest = (0.0, None)
-    with mp.get_context("fork").Pool(a.workers, initializer=_init, maxtasksperchild=20) as pool:
-        pending = [(j, pool.apply_async(run_one, (j,))) for j in jobs]
-        for k, (j, r) in enumerate(pending):
-            try:
-                res = r.get(timeout=a.timeout)
-            except mp.TimeoutError:
-                hangs += 1
-                print(json.dumps({"seed": j["seed"], "bad": ["hang"]}), flush=True)
-                continue
-            counts[(res["cmd"], str(res["code"]))] += 1
-            if res["s"] > slowest[0]:
-                slowest = (res["s"], res["args"])
-            if res["bad"]:
-                failures += 1
-                print(json.dumps(res), flush=True)
-            if (k + 1) % 500 == 0:
-                print(
-                    json.dumps(
-                        {"progress": k + 1, "failures": failures, "hangs": hangs, "elapsed_s": round(time.time() - t0)}
-                    ),
-                    flush=True,
-                )
+    t0 = time.monotonic()
+    # every run's folder under one, removed at the end: the runs a budget or Ctrl-C cut short leave none behind
+    tmp = tempfile.mkdtemp(prefix="wgcad-fuzz-")
+    jobs = [{"seed": a.seed * 1_000_003 + i, "run": i, "tmp": tmp} for i in range(a.runs)]
+    tally = _Tally()
+    try:
+        with mp.get_context("fork").Pool(a.workers, initializer=_init, maxtasksperchild=20) as pool:
+            stopped = _collect(pool, jobs, a, t0, tally)
+    finally:
+        shutil.rmtree(tmp, ignore_errors=True)
     summary = {
         "runs": a.runs,
+        "runs_done": tally.runs,
+        "stopped": stopped,
         "seed": a.seed,
         "workers": a.workers,
-        "failures": failures,
-        "hangs": hangs,
-        "wall_s": round(time.time() - t0, 1),
-        "slowest_s": slowest[0],
-        "slowest_args": slowest[1],
-        "by_command_and_exit": {f"{c} {e}": n for (c, e), n in sorted(counts.items())},
+        "failures": tally.failures,
+        "hangs": tally.hangs,
+        "fuzzer_crashes": tally.crashes,
+        "wall_s": round(time.monotonic() - t0, 1),
+        "slowest_s": tally.slowest[0],
+        "slowest_args": tally.slowest[1],
+        "by_command_and_exit": {f"{c} {e}": n for (c, e), n in sorted(tally.counts.items())},
     }
-    print(json.dumps(summary, indent=1))
+    print(json.dumps(summary, indent=1), flush=True)
 
 
 if __name__ == "__main__":

@@ -23,7 +23,8 @@ machine may be shared):
   average): more workers than free cores cannot scale, and the figures say so;
 * tasks of 1 sample against the measured grain on the same samples: what the
   per-task overhead costs when tasks are too small;
-* with --full: the 10,000 samples of the template on 2 workers, end to end.
+* with --full: the 10,000 samples of the template on 2 workers, end to end, and each worker's resident
+  memory after its first and its last task (benchmarks/montecarlo.py compares the KE's two paths).
 """
 
 from __future__ import annotations
@@ -164,6 +165,8 @@ def main():
             "batch": info.batch,
             "worker_s_per_sample": round(info.worker_s / info.computed, 4),
             "worker_cpu_s_per_sample": round(info.worker_cpu_s / info.computed, 4),
+            # each worker's resident memory after its first and its last task: flat, or the run leaks
+            "worker_rss_mb_first_last": {str(p): [round(x, 1) for x in v] for p, v in info.worker_rss_mb.items()},
             "load": load(),
         }
     print(json.dumps(out, indent=2))

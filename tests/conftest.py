@@ -9,6 +9,13 @@ ROOT = Path(__file__).resolve().parent.parent
 TEMPLATES = ROOT / "templates"
 
 
+def d1_with_parts(tmp_path, parts: str) -> Path:
+    """A copy of D1 in ``tmp_path`` with a ``[parts]`` table of ``parts`` (TOML lines) appended."""
+    p = tmp_path / "d1_parts.toml"
+    p.write_text((TEMPLATES / "d1_involute.toml").read_text() + "\n[parts]\n" + parts + "\n")
+    return p
+
+
 @pytest.fixture
 def template_text():
     def read(name: str) -> str:

@@ -9,7 +9,11 @@ pass (no tables, no lazily built columns), every tooth pair near engagement is
 measured again on the exact geometry at every pass (no Lipschitz skipping), the
 compliance is a dense matrix with the supports added in full, and the passes
 are a plain fixed-point iteration, halved steps once it stops contracting (no
-Anderson acceleration, no warm start).
+Anderson acceleration, no warm start). The members' supports (docs/models.md 4.2)
+are folded into the compliance the old way, ``A_j A_j' / k_j`` for a sprung
+freedom (wgcad solves ``A'F + K a = f`` instead), and the cup's field added in
+full; the freedoms' columns and the planes' motions are the model's own
+(``model.supports``: their definition, not a shortcut).
 """
 
 from __future__ import annotations
@@ -24,18 +28,18 @@ from wgcad.placement import pose_from_displacements, transform
 FLOOR = 1e-2  # N, the force floor of the contact secants (as wgcad's)
 
 
-def _rim(model, psi, loads, rigid):
-    """w, v, theta (S, z_g) of every section at the tooth angles, from the kernels."""
+def _rim(model, psi, loads, motion):
+    """w, v, theta (S, z_g) of every section at the tooth angles, from the kernels (``motion`` (S, 3): each
+    section's rim motion against the rigid gear)."""
     z_g = model.drive.design.drive.z_flex
     phi = 2 * np.pi * np.arange(z_g) / z_g
     phi = np.where(phi > np.pi, phi - 2 * np.pi, phi)
     w, v, th = model.ring.displacements(phi, psi, loads)
-    dx, dy, rot = rigid
     nom = [
         model.drive.law_at(float(z)).state(phi) if model.drive.coned else model.drive.law.state(phi) for z in model.zs
     ]
     out = []
-    for f, n in zip(model.scales, nom):
+    for f, n, (dx, dy, rot) in zip(model.scales, nom, motion):
         out.append(
             (
                 f * w + dx * np.cos(phi) + dy * np.sin(phi) - rot * n.v,
@@ -46,19 +50,25 @@ def _rim(model, psi, loads, rigid):
     return phi, out
 
 
-def _supported(M, q, A, f, k):
-    """The dense form of wgcad's supported solve: sprung freedoms folded into M, held ones dropped."""
+def _supported(M, q, A, f, k, field):
+    """The dense supported solve: the cup's field and the sprung freedoms folded into M (a sprung freedom's external
+    load moves it by f/k first), the free ones equalities, the held ones dropped."""
     eq = k == 0
     sp = np.isfinite(k) & (k > 0)
     Ms = M + (A[:, sp] / k[sp]) @ A[:, sp].T
-    sol = solve_contact_qp(Ms, q, A[:, eq], f[eq])
+    if field is not None:
+        U, W = field
+        Ms = Ms + U @ W @ U.T
+    qs = q - A[:, sp] @ (f[sp] / k[sp])
+    sol = solve_contact_qp(Ms, qs, A[:, eq], f[eq])
     a = np.zeros(len(k))
     a[eq] = sol.a
-    a[sp] = -(A[:, sp].T @ sol.F) / k[sp]
-    return sol.F, a
+    a[sp] = -(A[:, sp].T @ sol.F - f[sp]) / k[sp]
+    disp = None if field is None else -(field[1] @ (field[0].T @ sol.F))
+    return sol.F, a, disp
 
 
-def plain_solve(model, torque_nm: float, cam_offset_um: float = 0.0, tol: float = 5e-5, max_pass: int = 400):
+def plain_solve(model, torque_nm: float, cam_offset_um: float = 0.0, tol: float = 5e-5, max_pass: int = 1000):
     """The load state at ``torque_nm`` (generator at angle 0): rim motion (3,), ball forces (Z,), tooth forces by
     (section, tooth, flank), the rim's (w, v) per section at the tooth angles, and the passes taken."""
     d = model.drive.design.drive
@@ -69,18 +79,19 @@ def plain_solve(model, torque_nm: float, cam_offset_um: float = 0.0, tol: float 
     Z = len(br.psi)
     psi_t = 2 * np.pi * np.arange(z_g) / z_g
     psi_t = np.where(psi_t > np.pi, psi_t - 2 * np.pi, psi_t)
-    k = model.support_stiffness
-    f_ext = np.array([0.0, 0.0, model.torque_sign * 1e3 * torque_nm, 0.0, 0.0])
+    sup = model.supports
+    k = sup.stiffness
+    f_ext = sup.f_ext(model.torque_sign * 1e3 * torque_nm)
     # start: the rim pressed onto the cam by the balls alone (wgcad's mounted state, checked by its own tests)
     from wgcad.elastic.cam import mounted
 
     mt = mounted(model, e)
     F_ball, F_teeth, keys = mt.force.copy(), np.zeros(0), np.zeros(0, dtype=int)
     psi_all = np.concatenate([psi_t, br.psi])
-    loads, rigid = mt.loads.copy(), mt.rigid.copy()
+    loads, motion = mt.loads.copy(), mt.motion
     omega, last = 1.0, np.inf
     for it in range(max_pass):
-        phi, rim = _rim(model, psi_all, loads, rigid)
+        phi, rim = _rim(model, psi_all, loads, motion.sections)
         rots, shifts, origins = [], [], []
         for w, v, th in rim:
             r, s = pose_from_displacements(phi, w, v, th, model.drive.r_m)
@@ -118,7 +129,7 @@ def plain_solve(model, torque_nm: float, cam_offset_um: float = 0.0, tol: float 
         width = model.widths[sec]
         # the current elastic field at each contact's angle: the linear gap is exact at the current state
         U = np.stack(model.ring.displacements(ph, psi_all, loads), axis=-1)
-        q_t = gap + (b_t * (f_t[:, None] * U)).sum(axis=1) + A_t[:, :3] @ rigid
+        q_t = gap + (b_t * (f_t[:, None] * U)).sum(axis=1) + (A_t[:, :3] * motion.sections[sec]).sum(axis=1)
         new_keys = t2 * 2 + flank
         Fprev = np.zeros(len(new_keys))
         if keys.size:
@@ -133,32 +144,44 @@ def plain_solve(model, torque_nm: float, cam_offset_um: float = 0.0, tol: float 
         blk = model.ring.block(ang[:, None] - ang[None, :])
         M = np.einsum("ia,ijab,jb->ij", fb, blk, fb) + np.diag(np.concatenate([s_b, s_t]))
         q = np.concatenate([rows.q + o_b, q_t + o_t])
-        A = np.concatenate([rows.A, A_t])
-        F, a = _supported(M, q, A, f_ext, k)
+        A3 = np.concatenate([rows.A[:, :3], A_t[:, :3]])
+        cam = np.concatenate([rows.A[:, 3:5], np.zeros((len(A_t), 2))])
+        plane = np.concatenate([np.full(Z, sup.ball_plane), sec])
+        tooth_row = np.concatenate([np.zeros(Z, dtype=bool), np.ones(len(A_t), dtype=bool)])
+        A = sup.columns(A3, cam, plane, tooth_row)
+        F, a, disp = _supported(M, q, A, f_ext, k, sup.field(A3, plane))
+        new_motion = sup.plane_motion(a, disp)
         new_loads = np.zeros_like(loads)
         idx = np.concatenate([z_g + np.arange(Z), tooth])
         np.add.at(new_loads, idx, -(F * np.concatenate([np.ones(Z), f_t]))[:, None] * b)
         # convergence on the teeth's rim points (the fixed point of the re-linearisation)
-        _, rim2 = _rim(model, psi_all, new_loads, a[:3])
+        _, rim2 = _rim(model, psi_all, new_loads, new_motion.sections)
         move = max(
             float(np.abs(np.concatenate([r2[0] - r1[0] for r1, r2 in zip(rim, rim2)])).max()),
             float(np.abs(np.concatenate([r2[1] - r1[1] for r1, r2 in zip(rim, rim2)])).max()),
         )
         if move < tol:
-            loads, rigid, F_ball, F_teeth, keys = new_loads, a[:3], F[:Z], F[Z:], new_keys
+            loads, motion, F_ball, F_teeth, keys = new_loads, new_motion, F[:Z], F[Z:], new_keys
             break
         if it > 5 and move > 0.95 * last:
             omega = max(omega / 2, 1 / 64)
         last = move
         loads = (1 - omega) * loads + omega * new_loads
-        rigid = (1 - omega) * rigid + omega * a[:3]
+        motion = motion.mix(new_motion, omega)
         F_ball = (1 - omega) * F_ball + omega * F[:Z]
         F_teeth, keys = F[Z:], new_keys
     else:
         raise RuntimeError(f"plain solve did not converge in {max_pass} passes (last move {last:.2e} mm)")
-    _, rim = _rim(model, psi_all, loads, rigid)
+    _, rim = _rim(model, psi_all, loads, motion.sections)
     forces = {}
     for kk, FF in zip(keys.tolist(), F_teeth.tolist()):
         if FF > 0:
             forces[(kk // 2) // z_g, (kk // 2) % z_g, kk % 2] = FF
-    return {"rigid": rigid, "ball_force": F_ball, "tooth_force": forces, "rim": rim, "passes": it + 1}
+    return {
+        "rigid": motion.centre,
+        "motion": motion,
+        "ball_force": F_ball,
+        "tooth_force": forces,
+        "rim": rim,
+        "passes": it + 1,
+    }

@@ -325,24 +325,25 @@ def test_pair_distance_on_two_threads_equals_shapely(monkeypatch):
         dist.pair_distance(np.array([1.0] * n, dtype=object), b)
 
 
-def test_jobs_on_the_helper_return_raise_and_never_wait_on_themselves():
-    """A job's value or exception reaches the caller; a job run on the helper that hands the helper another job
-    runs it there and then (queued, it would wait on itself for ever)."""
+def test_halves_on_the_helper_return_raise_and_never_wait_on_themselves(monkeypatch):
+    """Both halves' values reach the caller in order, an exception in the helper's half is raised there; in_halves
+    called on the helper thread itself measures both halves there (queued, it would wait on itself for ever)."""
     import threading
 
     from wgcad.clearance import threads
 
-    h = threads.helper()
-    assert h.submit(divmod, 7, 2).result() == (3, 1)
+    monkeypatch.setattr(threads, "CORES", 2)
+    x = np.arange(10.0)
+    np.testing.assert_array_equal(threads.in_halves(np.negative, (x,), least=2), -x)
     with pytest.raises(ZeroDivisionError):
-        h.submit(divmod, 1, 0).result()
-    assert h.submit(sorted, [3, 1, 2]).result() == [1, 2, 3]
+        threads.in_halves(lambda a: [1 / int(v) for v in a], (x,), least=2)
     out = []
-    waiter = threading.Thread(target=lambda: out.append(h.submit(lambda: h.submit(abs, -4).result() + 1).result()))
-    waiter.daemon = True
+    nested = lambda: threads.pool().submit(threads.in_halves, np.negative, (x,), (), 2).result()  # noqa: E731
+    waiter = threading.Thread(target=lambda: out.append(nested()), daemon=True)
     waiter.start()
     waiter.join(10)
-    assert out == [5], "a nested job waited on the helper for ever"
+    assert len(out) == 1, "a nested split waited on the helper for ever"
+    np.testing.assert_array_equal(out[0], -x)
 
 
 def test_a_conjugate_space_deeper_than_its_root_circle_keeps_a_valid_tooth(tmp_path):

@@ -194,7 +194,7 @@ def test_audit_cli_honours_imperfections(tmp_path, capsys):
         assert (tmp_path / f"pic_{suffix}.png").stat().st_size > 10_000
     text_out = capsys.readouterr().out
     assert "imperfect parts" in text_out and "entry gap Delta" in text_out and "NOT CHECKED: entry gap" not in text_out
-    assert "None" not in text_out and "by the working edge" in text_out  # the edge of the smallest passage is named
+    assert "None" not in text_out and "by the working flank" in text_out  # the edge of the smallest passage is named
 
 
 def test_fixed_flexspline_keeps_the_perfect_audit_and_says_so(tmp_path):
@@ -394,14 +394,14 @@ def test_entry_gap_of_every_passage_against_a_dense_reference(d1):
     assert abs(ph - e.generator_angle) < 1e-7
     assert abs(e.value - ref_gap(ph, e.tooth, e.section_z)) <= REFINE_TOL + 1e-6
     # the edge it names faces the rigid tooth the reference finds closest, and the summary names it
-    from wgcad.clearance.entry import EDGES, _edge_idx
+    from wgcad.clearance.entry import EDGES, edge_index
 
     rot, shift = flex_poses(d1, S4, ph, teeth=np.array([e.tooth]), z=e.section_z)
     tooth = shapely.Polygon(transform(fine.flex.tooth_polygon(), rot, shift)[0])
     nearest = int(np.argmin([tooth.distance(shapely.Polygon(p)) for p in rigid_fine]))
     isc = IM.ImperfectScene.from_scene(sc, S4)
     assert e.details["edge"] in EDGES and e.location in ("tip", "flank", "root")
-    assert int(_edge_idx(isc, rot, isc.relative(shift))[EDGES.index(e.details["edge"])][0]) == nearest
+    assert int(edge_index(isc, rot, isc.relative(shift))[EDGES.index(e.details["edge"])][0]) == nearest
     assert got.findings["entry_gap"].details["edge"] in EDGES
     # other passages (a sample of each section's): none below the reported gap
     from wgcad.clearance.entry import entry_crossings

@@ -171,21 +171,15 @@ def _run_in_python(code: str):
     )
 
 
-def test_the_quick_exit_keeps_what_a_normal_exit_does():
-    """wgcad.cli.run leaves by os._exit: atexit handlers still run, buffered stdout (a pipe: block-buffered) is all
-    written, the exit code is main's; a live non-daemon thread is joined as by a normal exit."""
-    prelude = f"import atexit, sys, threading, time; from wgcad.cli import run; sys.argv = ['wgcad', 'kinematics', {str(D4)!r}]"
-    r = _run_in_python(prelude + "; atexit.register(lambda: print('atexit ran')); run()")
-    assert r.returncode == 0, r.stderr
-    assert r.stdout.startswith("D4") and r.stdout.rstrip().endswith("atexit ran"), r.stdout[-200:]
-    r = _run_in_python(
-        prelude + "; threading.Thread(target=lambda: (time.sleep(0.3), print('thread done'))).start(); run()"
-    )
-    assert r.returncode == 0 and r.stdout.rstrip().endswith("thread done"), r.stdout[-200:]
-    r = _run_in_python(prelude.replace("'kinematics'", "'audit', '--json', '-'") + "; run()")
-    assert r.returncode in (0, 1) and json.loads(r.stdout)  # the whole document reached the pipe
-    r = _run_in_python(prelude.replace("'kinematics'", "'kinematics', '--no-such-flag'") + "; run()")
-    assert r.returncode == 2 and r.stdout == ""
+def test_a_run_on_a_pipe_writes_its_whole_output_and_its_exit_code():
+    """``python -m wgcad`` writing to a pipe (block-buffered): the whole JSON document reaches the reader and the
+    exit code is the command's; a bad flag exits 2 with nothing on stdout."""
+    prelude = f"import sys; from wgcad.cli import run; sys.argv = ['wgcad', 'audit', {str(D4)!r}"
+    r = _run_in_python(prelude + ", '--json', '-']; run()")
+    assert r.returncode in (0, 1), r.stderr
+    assert json.loads(r.stdout)["worst"]  # the whole document reached the pipe
+    r = _run_in_python(prelude + ", '--no-such-flag']; run()")
+    assert r.returncode == 2 and r.stdout == "" and r.stderr.count("\n") == 1
 
 
 def test_both_to_stdout_is_refused(capsys):
@@ -197,12 +191,12 @@ def test_both_to_stdout_is_refused(capsys):
 
 
 def test_internal_error_exit_3_one_line_no_traceback(tmp_path, capsys, monkeypatch):
-    import wgcad.drive
+    import wgcad.cli.generate
 
     def broken(*args, **kwargs):
         return 1 / 0
 
-    monkeypatch.setattr(wgcad.drive, "build_drive", broken)
+    monkeypatch.setattr(wgcad.cli.generate, "build_drive", broken)
     monkeypatch.delenv("WGCAD_TRACEBACK", raising=False)
     code, out, err = run(["generate", D4, "--out", tmp_path / "o"], capsys)
     assert code == 3 and err.count("\n") == 1 and "Traceback" not in err
@@ -463,29 +457,3 @@ def test_every_flag_and_argument_has_help():
             if not action.help or not action.help.strip():
                 missing.append(f"{p.prog} {'/'.join(action.option_strings) or action.dest}")
     assert missing == []
-
-
-def _modules_after(argv):
-    code = (
-        "import sys; from wgcad.cli import main; rc = main(sys.argv[1:]);"
-        "heavy = ('matplotlib', 'trimesh', 'manifold3d', 'fcl', 'ezdxf', 'scipy.optimize', 'scipy.special', 'shapely');"
-        "print(' '.join(m for m in heavy if m in sys.modules)); sys.exit(rc)"
-    )
-    r = subprocess.run(
-        [sys.executable, "-c", code, *map(str, argv)],
-        capture_output=True,
-        text=True,
-        env={**os.environ, "PYTHONPATH": str(ROOT)},
-    )
-    assert r.returncode in (0, 1), r.stderr
-    return set(r.stdout.split())
-
-
-def test_each_command_imports_what_it_uses(tmp_path):
-    audit = _modules_after(["audit", D4, "--quiet", "--step-deg", "5"])
-    assert not audit & {"matplotlib", "trimesh", "manifold3d", "fcl", "ezdxf"}, audit
-    # the DXF is written without ezdxf (wgcad.export.dxf_tags), D4's rings are zipper-triangulated without manifold3d
-    generate = _modules_after(["generate", D4, "--out", tmp_path / "a", "--quiet"])
-    assert not generate & {"matplotlib", "trimesh", "manifold3d", "fcl", "ezdxf"}, generate
-    kin = _modules_after(["kinematics", D4])
-    assert not kin & {"matplotlib", "trimesh", "manifold3d", "fcl", "ezdxf", "shapely"}, kin

@@ -109,11 +109,11 @@ def test_no_budget_means_no_refusal_and_the_estimate_grows_with_the_work():
 
 def test_cli_refuses_over_budget_and_the_flag_raises_it(tmp_path, capsys):
     design = TEMPLATES / "d4_discrete.toml"
-    code = main(["audit", str(design), "--max-memory-mb", "100", "--json", str(tmp_path / "o" / "a.json")])
+    code = main(["audit", str(design), "--max-memory-mb", "50", "--json", str(tmp_path / "o" / "a.json")])
     err = capsys.readouterr().err
     assert code == 2 and err.count("\n") == 1 and "--max-memory-mb: this run needs about" in err
     assert not (tmp_path / "o").exists() or not any((tmp_path / "o").iterdir())
-    code = main(["generate", str(design), "--max-memory-mb", "100", "--out", str(tmp_path / "g")])
+    code = main(["generate", str(design), "--max-memory-mb", "50", "--out", str(tmp_path / "g")])
     assert code == 2 and "--max-memory-mb" in capsys.readouterr().err
     assert not (tmp_path / "g").exists() or not any((tmp_path / "g").iterdir())
     # the default budget admits the templates' default runs
@@ -164,3 +164,40 @@ def test_memory_estimate_is_above_the_measured_peak_and_not_far(argv, run, tmp_p
     est = estimate_run(d, tol, vertices_per_tooth=counts, **run).memory_mb
     # an estimate is for refusing runs: above the real peak, and within 4x of it (fitted on other runs)
     assert res["rss_mb"] <= est <= 4.0 * res["rss_mb"], (res["rss_mb"], est)
+
+
+def _peak_mb(args, cwd) -> tuple[int, float]:
+    """Exit code and peak RSS (VmHWM, MB) of ``wgcad ARGS`` in a fresh interpreter: the interpreter and imports count."""
+    p = subprocess.run([sys.executable, "-c", _CHILD, *args], capture_output=True, text=True, cwd=cwd, timeout=300)
+    res = json.loads(p.stdout.strip().splitlines()[-1])
+    return res["code"], res["rss_mb"] * 1.048576  # kB of /proc to MB (the budget's unit)
+
+
+TEMPLATE_FILES = sorted(p.stem for p in TEMPLATES.glob("*.toml"))
+
+
+@pytest.mark.skipif(not __import__("os").path.exists("/proc/self/status"), reason="needs Linux /proc for the peak RSS")
+@pytest.mark.parametrize("name", TEMPLATE_FILES)
+def test_generate_estimate_is_within_2x_of_the_peak_on_every_template(name, tmp_path):
+    """The figure ``generate --max-memory-mb`` is judged on (issue 43: 232 MB for a D1 run that peaked at 93 MiB,
+    so a budget of 150 MB refused it): above the measured peak and at most twice it, with and without STL."""
+    d = load_design(TEMPLATES / f"{name}.toml")
+    for extra, stl in (([], True), (["--no-stl"], False)):
+        args = ["generate", str(TEMPLATES / f"{name}.toml"), "--out", str(tmp_path / f"o{stl}"), "--quiet", *extra]
+        code, peak = _peak_mb(args, ROOT)
+        assert code == 0
+        est = estimate_run(d, 1e-3, exports=stl).memory_mb  # what build_drive checks for generate
+        assert peak <= est <= 2.0 * peak, (name, stl, peak, est)
+
+
+@pytest.mark.skipif(not __import__("os").path.exists("/proc/self/status"), reason="needs Linux /proc for the peak RSS")
+@pytest.mark.parametrize("name", TEMPLATE_FILES)
+def test_audit_estimate_is_within_2x_of_the_peak_on_every_template(name):
+    """A default audit (0.5 deg, 3 sections) against the estimate build_drive checks once the gears are built."""
+    code, peak = _peak_mb(["audit", str(TEMPLATES / f"{name}.toml"), "--quiet"], ROOT)
+    assert code in (0, 1)
+    d = load_design(TEMPLATES / f"{name}.toml")
+    drive = build_drive(d, tol=1e-3)
+    counts = {"flexspline": _per_tooth(drive.flex), "rigid": _per_tooth(drive.rigid)}
+    est = estimate_run(d, 1e-3, vertices_per_tooth=counts, angles=720, sections=3, exports=False).memory_mb
+    assert peak <= est <= 2.0 * peak, (name, peak, est)

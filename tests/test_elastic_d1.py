@@ -52,21 +52,19 @@ def test_every_body_in_equilibrium_and_contacts_complementary(sweep):
         assert c["force"].min() >= 0.0
 
 
-def test_reported_forces_balance_the_rim_exactly(sweep, offset_sweep):
+def test_reported_forces_balance_the_output_torque_exactly(sweep, offset_sweep):
     # every reported contact force (teeth from the rigid gear, balls from the cam) acts on the rim at its point
-    # along -normal; with the cup's torque and its support (the rim's translation against the cup's lateral
-    # stiffness) they balance to round-off (equilibrium of the rim; the rigid gear's and the cam's reactions are
-    # these forces reversed)
+    # along -normal; their moment about the axis balances the output torque to round-off (the flexspline's
+    # rotation is free; its translations and tilts stand on the cup and the output bearing, whose reactions are
+    # checked member by member in tests/test_elastic_supports.py)
     for st in sweep["states"] + offset_sweep["states"]:
         c = st.contacts
         F, n, p = c["force"], c["normal"], c["point"]
-        support = -st.model.lateral_stiffness * st.rigid[:2]
-        net = -(F[:, None] * n).sum(axis=0) + support
         moment = -(F * (p[:, 0] * n[:, 1] - p[:, 1] * n[:, 0])).sum() + st.model.torque_sign * 1e3 * st.torque_nm
         scale = float((F * np.hypot(p[:, 0], p[:, 1])).max())
-        assert np.abs(net).max() < 1e-9 * float(F.max())
         assert abs(moment) < 1e-9 * scale
-    assert np.abs(offset_sweep["states"][0].rigid[:2]).max() > 1e-4  # the offset moves the rim against its support
+    # the offset moves the members against their supports: the rim off the rigid gear's axis
+    assert np.abs(offset_sweep["states"][0].rigid[:2]).max() > 1e-4
 
 
 def test_generator_torque_is_output_over_ratio(sweep):

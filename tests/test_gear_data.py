@@ -137,3 +137,26 @@ def test_sensitivities_to_tooth_thickness_match_the_closed_forms(name):
         c = 1.0 if g.spec.z % 2 == 0 else math.cos(math.pi / (2 * g.spec.z))
         sign = -1.0 if g.spec.internal else 1.0  # a thicker internal tooth narrows the space: the pins sit further in
         assert p["dM_per_thickness"] == pytest.approx(sign * c * math.cos(g.spec.alpha) / math.sin(a_m), rel=1e-4)
+
+
+def test_a_conjugate_rigid_gear_states_its_envelope_residual():
+    """A conjugate rigid gear's gear data and the drive report give the envelope's residual: its exact points' distance
+    from the envelope condition (Newton's, below 1e-9 mm, docs/models.md 13.2) and its chords' (within the chord
+    tolerance); an involute gear states none."""
+    from wgcad.report.drive import gear_figures
+
+    drive = build_drive(load_design(TEMPLATES / "d1_conjugate.toml"))
+    g = drive.rigid
+    assert g.spec.form == "conjugate"
+    assert 0 <= g.envelope_residual_mm < 1e-9
+    assert 0 < g.envelope_sagitta_mm <= drive.tol
+    data = gear_data(g, drive.tol)
+    assert data["envelope_residual_mm"] == g.envelope_residual_mm
+    assert any(line.startswith("envelope residual = ") for line in data_lines("rigid", data))
+    fig = gear_figures(g, drive.rigid_rim_radius)
+    assert fig["envelope_residual_mm"] == pytest.approx(g.envelope_residual_mm, rel=1e-2)
+    # a finer sampling keeps the same envelope (the flank is not enveloped again)
+    assert g.sampled_at(1e-4).envelope_residual_mm == g.envelope_residual_mm
+    plain = build_drive(load_design(TEMPLATES / "d1_involute.toml")).rigid
+    assert plain.envelope_residual_mm is None and "envelope_residual_mm" not in gear_data(plain, 1e-3)
+    assert "envelope_residual_mm" not in gear_figures(plain, 90.0)

@@ -490,14 +490,13 @@ def test_a_forked_process_measures_with_threads_of_its_own(d2, monkeypatch):
     """A sweep's worker forked after the parent measured has none of the parent's helper thread: it starts its own
     (a helper inherited across a fork would take the work and never run it)."""
     import multiprocessing
-    import os
 
     from wgcad.clearance import threads
 
     monkeypatch.setattr(threads, "SPLIT", 2)
     monkeypatch.setattr(threads, "CORES", 2)
-    K.contact_table(d2, Imperfections(), 2, sections=[None])  # the parent's helper thread exists now
-    assert threads._HELPER is not None and threads._HELPER.pid == os.getpid()
+    K.contact_table(d2, Imperfections(), 2, sections=[None])
+    assert threads._POOL is not None  # the parent's pool thread exists now
     ctx = multiprocessing.get_context("fork")
     q = ctx.Queue()
     p = ctx.Process(target=_child_table, args=(d2, q))

@@ -32,7 +32,7 @@ BAD = [
     ("sectors", "heights", '"patent"', "sectors.heights", "must be one of closed_form, simulated, full, list"),
     ("sectors", "heights", '"list"', "sectors.heights_mm", "one height per coupling tooth (21)"),
     ("sectors", "heights_mm", "[0.3, 0.3]", "sectors.heights_mm", 'used only with heights = "list"'),
-    ("sectors", "assign", '"middle"', "sectors.assign", "must be one of register, boundary"),
+    ("sectors", "assign", '"middle"', "sectors.assign", "must be one of boundary, register"),
     ("sectors", "tip_clearance_um", "-5.0", "sectors.tip_clearance_um", "must be in [0, 1000)"),
     ("sectors", "teeth", '"21"', "sectors.teeth", "must be a non-empty list"),
     ("sectors", "teeth", "[21, 22.0, 21, 22]", "sectors.teeth[1]", "must be a whole number"),

@@ -33,7 +33,7 @@ from wgcad.clearance.engine import AuditSettings, Scene, audit
 from wgcad.design import TABLES, parse_design
 from wgcad.drive import build_drive, tooth_spec
 from wgcad.errors import DesignError
-from wgcad.laws import _FF_BETA_HI, _FF_BETA_LO
+from wgcad.laws import FF_BETA_HI, FF_BETA_LO
 from wgcad.placement import place_flex_teeth, tooth_angles, tooth_pose, transform
 from wgcad.profiles import cycloid as cy
 from wgcad.profiles.gear import _fillet_fits, largest_fillet_coef
@@ -165,7 +165,7 @@ def designs(draw):
 def must_fail(data) -> str | None:
     """Why a design may not build whatever else it holds, or None."""
     g = data["generator"]
-    if g["law"] == "four_force" and _FF_BETA_LO < math.radians(g["beta_deg"]) < _FF_BETA_HI:
+    if g["law"] == "four_force" and FF_BETA_LO < math.radians(g["beta_deg"]) < FF_BETA_HI:
         return "four_force beta in the rejected band (40.71, 49.29) deg"
     if data["tooth"]["form"] == "cycloidal" and any(data[w].get("shift", 0.0) != 0.0 for w in ("flexspline", "rigid")):
         return "profile shift on cycloidal teeth"

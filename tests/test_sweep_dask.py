@@ -61,6 +61,8 @@ def reference(tmp_path_factory):
     out = tmp_path_factory.mktemp("ref")
     info = run_sweep(_spec(), out, workers=0, batch=5)
     assert info.computed == 12 and not info.stopped_early
+    # in process: this process's resident memory after the first and the last task
+    assert list(info.worker_rss_mb) == [os.getpid()] and all(x > 0 for x in info.worker_rss_mb[os.getpid()])
     return _read(out, _spec())
 
 
@@ -82,6 +84,9 @@ def _same(a, b):
 def test_dask_run_is_bit_identical_to_in_process(client, reference, tmp_path):
     info = run_sweep(_spec(), tmp_path, client=client)  # grain measured: probe task, then planned batches
     assert info.computed == 12 and info.workers == 2 and info.sample_s > 0 and info.overhead_s > 0
+    # each worker process's resident memory after its first and its latest task (benchmarks/montecarlo.py)
+    assert 1 <= len(info.worker_rss_mb) <= 2 and os.getpid() not in info.worker_rss_mb
+    assert all(x > 0 for v in info.worker_rss_mb.values() for x in v)
     _same(_read(tmp_path, _spec()), reference)
     # a different grain and completion order: still the same bits
     out2 = tmp_path / "b"

@@ -246,22 +246,3 @@ def test_loaded_figures_are_the_elastic_models():
                 "parameters": {"load": {"cam_offset_um": {"grid": [30.0]}}},
             }
         )
-
-
-def test_spec_and_cli_do_not_import_dask_or_pyarrow():
-    # heavy libraries at the edge: a worker or `wgcad sweep --help` imports them only when it runs
-    import subprocess
-    import sys
-
-    code = (
-        "import sys, wgcad.cli, wgcad.sweep, wgcad.sweep.tasks, wgcad.sweep.store, wgcad.sweep.runner; "
-        "print(sorted(m for m in ('distributed', 'dask', 'pyarrow', 'matplotlib') if m in sys.modules))"
-    )
-    out = subprocess.run(
-        [sys.executable, "-c", code],
-        capture_output=True,
-        text=True,
-        check=True,
-        env={**__import__("os").environ, "PYTHONPATH": str(TEMPLATES.parent)},
-    )
-    assert out.stdout.strip() == "[]"

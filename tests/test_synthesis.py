@@ -32,6 +32,7 @@ def _req(tmp_path, body: str, name="req.toml") -> Path:
         ('trails = 4\n[free]\n"generator.w0_coef" = [0.9, 1.0]\n', "requirements.trails"),
         ("ratio = 100.0\n", "free"),
         ('cam_offset_um = -5.0\n[free]\n"generator.w0_coef" = [0.9, 1.0]\n', "requirements.cam_offset_um"),
+        ('min_efficiency = 1.2\n[free]\n"generator.w0_coef" = [0.9, 1.0]\n', "requirements.min_efficiency"),
     ],
 )
 def test_bad_requirements_name_the_key(tmp_path, body, field):
@@ -212,3 +213,18 @@ def test_length_and_lost_motion_limits(tmp_path, capsys):
     p = _req(tmp_path, "lost_motion_arcmin = [0.1, 1.0]\n" + body, name="lm2.toml")
     assert main(["design", str(p), "--out", str(tmp_path / "c"), "--no-plots"]) == 1
     assert "no candidate met: lost motion" in capsys.readouterr().out
+
+
+def test_an_efficiency_limit_and_objective(tmp_path, capsys):
+    """D1 (82.3 % at its rated 490 N m and 2000 rpm, docs/models.md 10.8): a limit of 80 % is met and the
+    efficiency ranks it; one of 90 % is not."""
+    body = 'ratio = 100.0\nobjective = "efficiency"\ntrials = 9\n[free]\n"drive.z_flex" = [196, 204]\n'
+    p = _req(tmp_path, "min_efficiency = 0.8\n" + body, name="eta.toml")
+    assert main(["design", str(p), "--out", str(tmp_path / "a"), "--no-plots"]) == 0
+    doc = json.loads((tmp_path / "a" / "eta_search.json").read_text())
+    assert doc["best"]["objectives"]["efficiency"] == pytest.approx(0.823, abs=0.002)
+    assert doc["best"]["margins"]["efficiency"] == pytest.approx(0.823 / 0.8 - 1, abs=0.003)
+    p = _req(tmp_path, "min_efficiency = 0.9\n" + body, name="eta2.toml")
+    assert main(["design", str(p), "--out", str(tmp_path / "b"), "--no-plots"]) == 1
+    out = capsys.readouterr().out
+    assert "NO FEASIBLE DESIGN" in out and "(stopped at rating: rating: efficiency)" in out

@@ -1,21 +1,38 @@
-"""Design file -> drive -> clearance audit, with the settings a run (or a baseline) names."""
+"""Design file -> drive -> clearance audit, with the settings a run (or a baseline) names.
+
+Called, the module is the library's audit: ``wgcad.audit(design, settings)`` is :func:`wgcad.api.audit`.
+"""
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import numpy as np
 
-from .arrays import unique_sorted
+from . import entry_module
 from .clearance.engine import AuditSettings, audit
+from .clearance.imperfect import audit_imperfect, chunk_angles
 from .design import load_design
 from .design.budget import DEFAULT_MAX_MEMORY_MB
 from .drive import build_drive
 from .errors import DesignError
-from .records import record
+from .numbers import Bound
+from .placement.imperfect import Imperfections, full_cycle_turns
 
-__all__ = ["RunSettings", "run_audit"]
+__all__ = ["BOUNDS", "RunSettings", "run_audit"]
 
 
-@record(frozen=True)
+#: the range of each numeric setting: RunSettings.check and the CLI's flags (wgcad.cli.bounds) state the same rule
+BOUNDS = {
+    "step_deg": Bound(1e-4, 90.0, "deg"),
+    "sections": Bound(1, 200, "sections", whole=True),
+    "chord_tol_um": Bound(0.0, 100.0, "um", lo_open=True),
+    "turns": Bound(1, 10_000, "generator turns", whole=True),  # or None: the whole cycle
+    "interference_tol_um": Bound(0.0, 1000.0, "um"),
+}
+
+
+@dataclass(frozen=True)
 class RunSettings:
     """Settings of an audit run as a user gives them (units in the names)."""
 
@@ -29,7 +46,7 @@ class RunSettings:
     cull: bool = True
     bound: bool = True
     max_memory_mb: float | None = DEFAULT_MAX_MEMORY_MB  # refuse runs estimated above this (None: no limit)
-    refine: bool = True  # figures on the exact tooth curves (issue 8)
+    refine: bool = True  # figures on the exact tooth curves
     #: generator turns swept for an imperfect drive (None: the whole cycle,
     #: placement.imperfect.full_cycle_turns); a perfect drive repeats every mesh period
     turns: int | None = 1
@@ -44,24 +61,19 @@ class RunSettings:
         def bad(field, rule):
             raise DesignError(names.get(field, field), rule)
 
-        if not 1e-4 <= self.step_deg <= 90.0:
-            bad("step_deg", f"must be in [1e-4, 90] degrees, got {self.step_deg:g}")
-        if not 1 <= self.sections <= 200:
-            bad("sections", f"must be 1..200, got {self.sections}")
-        if not 0.0 < self.chord_tol_um <= 100.0:
-            bad("chord_tol_um", f"must be in (0, 100] um, got {self.chord_tol_um:g}")
-        if self.turns is not None and not 1 <= self.turns <= 10_000:
-            bad("turns", f"must be 1..10000 generator turns or 'full', got {self.turns}")
-        if not 0.0 <= self.interference_tol_um <= 1000.0:
-            bad("interference_tol_um", f"must be in [0, 1000] um, got {self.interference_tol_um:g}")
+        for field, bound in BOUNDS.items():
+            value = getattr(self, field)
+            if value is not None and not bound.holds(value):
+                rule = f"must be {bound.rule()}" + (" or 'full'" if field == "turns" else "")
+                bad(field, f"{rule}, got {value:g}")
         return self
 
 
 def _sections(drive, k: int) -> np.ndarray:
-    """``k`` sections over the face width, and always both face ends (issue 13: ``--sections 1``
-    checked only mid-face, -14.6 um where the open end was at -58.8 um)."""
+    """``k`` sections over the face width, and always both face ends (on a coned drive the
+    worst section is usually an end, which a mid-face section alone misses)."""
     bw = drive.design.drive.face_width
-    return unique_sorted(np.concatenate([drive.sections(k), [0.0, bw]]))
+    return np.unique(np.concatenate([drive.sections(k), [0.0, bw]]))
 
 
 #: the CLI's flag of each RunSettings field, for its error lines
@@ -117,13 +129,9 @@ def run_audit(design_path, rs: RunSettings, progress=None):
     if imperfect:
         # imperfect parts: the sweep is held one chunk of generator angles at a time
         # (wgcad.clearance.imperfect), whatever its length
-        from .clearance.imperfect import chunk_angles
-
         run.update(angles=min(n, chunk_angles(design.drive.z_flex, rs.sections)), use_period=False)
     turns = 1
     if imperfect:
-        from .placement.imperfect import full_cycle_turns
-
         turns = full_cycle_turns(design.drive.z_flex, design.drive.z_rigid) if rs.turns is None else rs.turns
     elif rs.turns != 1:
         raise DesignError(
@@ -134,8 +142,8 @@ def run_audit(design_path, rs: RunSettings, progress=None):
     drive = build_drive(design, tol=rs.chord_tol_um * 1e-3, max_memory_mb=rs.max_memory_mb, run=run)
     settings = audit_settings(drive, rs, turns)
     if imperfect:
-        from .clearance.imperfect import audit_imperfect
-        from .placement.imperfect import Imperfections
-
         return drive, audit_imperfect(drive, settings, Imperfections.from_spec(design.imperfections), progress=progress)
     return drive, audit(drive, settings, progress=progress)
+
+
+entry_module(__name__)  # wgcad.audit(design, settings): wgcad.api.audit

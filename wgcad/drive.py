@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 from collections import OrderedDict
-from dataclasses import replace
+from dataclasses import dataclass, replace
 from math import pi
 
 import numpy as np
@@ -11,10 +11,11 @@ import numpy as np
 from . import constants
 from .design import Design
 from .design.budget import DEFAULT_MAX_MEMORY_MB, check_budget, estimate_run
+from .envelope.rigid import conjugate_rigid_gear
 from .errors import DesignError
 from .laws import Law, coned_w0, make_law
+from .profiles.double_arc import DEFAULTS
 from .profiles.gear import Gear, ToothSpec, make_gear, tooth_radii
-from .records import record
 
 __all__ = ["Drive", "build_drive", "tooth_spec"]
 
@@ -54,7 +55,6 @@ def _double_arc(d: Design) -> dict:
     """The double-arc parameters of a ToothSpec (docs/models.md 2.4), the form's defaults where the design gives none."""
     if d.tooth.form != "double_arc":
         return {}
-    from .profiles.double_arc import DEFAULTS
 
     t, m = d.tooth, d.drive.module
 
@@ -70,7 +70,7 @@ def _double_arc(d: Design) -> dict:
     }
 
 
-@record(frozen=True)
+@dataclass(frozen=True, slots=True)
 class Drive:
     """Geometry of a whole drive, undeformed, plus its deformation law.
 
@@ -288,8 +288,6 @@ def _conjugate(drive: Drive) -> Drive:
 
 
 def _build_conjugate(drive: Drive) -> Drive:
-    from .envelope.rigid import conjugate_rigid_gear
-
     d = drive.design
     z = d.rigid.conjugate_z
     if z is None:

@@ -1,5 +1,7 @@
 """The error hierarchy of wgcad: one base class, subclasses that also inherit the builtin they resemble."""
 
+import difflib
+
 __all__ = [
     "WgcadError",
     "DesignError",
@@ -8,6 +10,10 @@ __all__ = [
     "GeometryError",
     "ModelError",
     "EXIT_MODEL",
+    "DependencyError",
+    "EXIT_DEPENDENCY",
+    "FolderBusyError",
+    "EXIT_BUSY",
     "close_matches",
 ]
 
@@ -56,9 +62,28 @@ class ModelError(WgcadError, ArithmeticError):
     exit_code = EXIT_MODEL
 
 
+#: exit code of :class:`DependencyError`: an optional extra the command needs is not installed
+EXIT_DEPENDENCY = 5
+
+
+class DependencyError(WgcadError, ImportError):
+    """A command needs a package of an optional extra that is not installed; the message names the extra."""
+
+    exit_code = EXIT_DEPENDENCY
+
+
+#: exit code of :class:`FolderBusyError`: the output folder is another live run's
+EXIT_BUSY = 6
+
+
+class FolderBusyError(WgcadError, OSError):
+    """A results folder (a sweep's, a design study's) is held by another run still alive: two runs writing one
+    journal or one set of chunks would leave it mixed. Nothing is written; the message names the holder's pid."""
+
+    exit_code = EXIT_BUSY
+
+
 def close_matches(word: str, known) -> list[str]:
     """The entry of ``known`` closest to a mistyped ``word`` (difflib's ratio >= 0.6) as a list, empty if none: a
-    message's "did you mean". ``difflib`` loads here, when a message needs it (~1.5 ms of every start otherwise)."""
-    import difflib
-
+    message's "did you mean"."""
     return difflib.get_close_matches(word, known, n=1)

@@ -4,13 +4,12 @@ from __future__ import annotations
 
 import math
 import numbers
+from dataclasses import dataclass
 
 import numpy as np
 
 from wgcad.errors import DesignError
 from wgcad.laws import Law
-
-from .records import record
 
 __all__ = ["gear_ratios", "flex_rotation", "RingVelocities", "ring_generator_velocities"]
 
@@ -85,7 +84,7 @@ def flex_rotation(phi_h, z_flex: int, z_rigid: int) -> np.ndarray:
     return np.asarray(phi_h, dtype=np.float64) / u_hg
 
 
-@record(frozen=True)
+@dataclass(frozen=True, slots=True)
 class RingVelocities:
     """Velocities of the flexspline and washers of an external ring generator (docs/models.md 3.5).
 

@@ -3,13 +3,13 @@
 from __future__ import annotations
 
 import json
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
 from .errors import DesignError, InputFileError
 from .numbers import read_float, read_int
-from .records import record
 from .userfiles import read_user_text
 
 __all__ = ["FORMAT", "Drift", "baseline_figures", "make_baseline", "load_baseline", "compare", "format_drifts"]
@@ -29,7 +29,7 @@ CLEARANCE_TOL_UM = 1e-3
 BACKLASH_TOL_ARCMIN = 1e-4
 
 
-@record(frozen=True)
+@dataclass(frozen=True)
 class Drift:
     """A figure that moved beyond its tolerance (``None`` where a figure is missing or undefined)."""
 

@@ -1,12 +1,16 @@
 """A bracketed scalar root: Brent's method (inverse quadratic interpolation, secant and bisection).
 
-The audit's backlash and the tooth measurements need one root of a scalar
-function on a bracket. ``scipy.optimize.brentq`` does it, but importing
-scipy.optimize costs 0.2-0.7 s, more than a whole default audit's work
-(benchmarks/startup.py); this is the same algorithm (R. P. Brent,
-*Algorithms for Minimization without Derivatives*, 1973, ch. 4) in plain
-Python. tests/test_roots.py checks it against scipy's to the requested
-tolerance on smooth, flat, steep and kinked functions.
+The double-arc and cycloidal profiles, the tooth measurements and the
+backlash need one root of a scalar function on a bracket. This is
+``scipy.optimize.brentq``'s algorithm (R. P. Brent, *Algorithms for
+Minimization without Derivatives*, 1973, ch. 4) in plain Python, a copy kept
+by docs/architecture.md's rule: scipy's, imported where the root is taken,
+costs 12-28 % of the CPU of ``wgcad audit`` / ``generate`` on
+d1_double_arc and d1_cycloidal (benchmarks/copies.py, ``roots``), all of it
+the import of scipy.optimize, which no narrower scipy import avoids (every
+submodule runs the package's ``__init__``). tests/test_roots.py checks it
+against scipy's to the requested tolerance on smooth, flat, steep and kinked
+functions.
 """
 
 from __future__ import annotations

@@ -1,7 +1,7 @@
 """Unit factors at the edges: wgcad computes in mm and radians and converts only where a figure is shown or read.
 
-One definition of each factor (issue 20 found rad -> arcsec written four
-ways); names say what they convert, e.g. ``ke_rad * ARCSEC_PER_RAD``.
+One definition of each factor (rad -> arcsec had been written four ways);
+names say what they convert, e.g. ``ke_rad * ARCSEC_PER_RAD``.
 """
 
 from __future__ import annotations

@@ -30,13 +30,11 @@ from __future__ import annotations
 
 import math
 import numbers
-from dataclasses import fields
+from dataclasses import dataclass, fields
 
 import numpy as np
 
 from wgcad.errors import DesignError
-
-from ..records import record
 
 __all__ = [
     "ENGAGEMENTS",
@@ -62,7 +60,7 @@ def _real(value, name: str) -> float:
     return float(value)
 
 
-@record(frozen=True)
+@dataclass(frozen=True, slots=True)
 class Eccentricities:
     """Eccentricities of both gears and the phases of the kinematic ones. Lengths mm, angles rad.
 
@@ -97,7 +95,7 @@ class Eccentricities:
             object.__setattr__(self, f.name, val)
 
 
-@record(frozen=True)
+@dataclass(frozen=True, slots=True)
 class FlankErrors:
     """Radial and tangential mesh displacements, mm, read-only arrays of one shape.
 

@@ -33,10 +33,13 @@ What is exploited (tested against the direct computation in tests/test_ke.py):
   its lattice class by more than both error bounds can never be the first;
 * **harmonics**: every error is a first harmonic over the teeth or the
   generator angle, so each contact's error terms are ``Re(A_e . w(i))``
-  with three waves shared by every contact; the first contact of a block
-  of samples is sought only among the lanes whose chord over the block,
-  widened by the waves' bend, can come lowest (exact:
-  :func:`wgcad.accuracy.ke_lanes.lane_minimum`);
+  with three waves of modulus 1 shared by every contact; a contact that
+  stays above another of its class by more than their coefficients'
+  difference, ``g_e - g_d > sum |A_e - A_d|``, is never first, and the
+  handful left are evaluated at every sample
+  (:func:`wgcad.accuracy.ke_lanes.first_contacts`; ``reference=True``: the
+  older search, block by block among the lanes whose chord can come lowest,
+  :func:`wgcad.accuracy.ke_lanes.lane_minimum`; the same minimum);
 * **installation angles**: the coefficients depend on an installation
   angle ``gamma`` as ``A + X cos(gamma) + Y sin(gamma)``; ``X`` and ``Y``
   are computed once.
@@ -44,6 +47,7 @@ What is exploited (tested against the direct computation in tests/test_ke.py):
 
 from __future__ import annotations
 
+from dataclasses import dataclass
 from math import pi
 
 import numpy as np
@@ -54,8 +58,7 @@ from ..clearance.closing import closing_direct
 from ..errors import DesignError, ModelError
 from ..kinematics import gear_ratios
 from ..placement.imperfect import Imperfections
-from ..records import record
-from .ke_lanes import LanePlan, candidate_lanes, harmonics, lane_minimum
+from .ke_lanes import LanePlan, candidate_lanes, first_contacts, harmonics, lane_minimum
 from .ke_table import DEFAULT_N, ContactTable, contact_table
 
 #: generator angles per pass (a few MB of temporaries per lattice class)
@@ -101,11 +104,16 @@ DEEP_OVERLAP = 300.0 / ARCSEC_PER_RAD
 
 
 def _theta(tab, dw, dn):
+    """``theta = s_w (delta_w - min(LM, 0) / 2)`` and the lost motion ``LM`` (in place: no temporaries)."""
     lm = dw + dn
-    return tab.side_w * (dw - 0.5 * np.minimum(lm, 0.0)), lm
+    theta = np.minimum(lm, 0.0)
+    theta *= 0.5
+    np.subtract(dw, theta, out=theta)
+    theta *= tab.side_w
+    return theta, lm
 
 
-@record
+@dataclass(slots=True)
 class KEResult:
     """No-load KE over a flexspline revolution (radians; arrays over the generator angles)."""
 
@@ -140,7 +148,13 @@ def _record(tab: ContactTable) -> int:
 
 
 def kinematic_error(
-    drive, imp: Imperfections, n_per_mesh: int = DEFAULT_N, sections=None, table=None, samples: int | None = None
+    drive,
+    imp: Imperfections,
+    n_per_mesh: int = DEFAULT_N,
+    sections=None,
+    table=None,
+    samples: int | None = None,
+    reference: bool = False,
 ) -> KEResult:
     """No-load KE of an imperfect drive over one flexspline revolution (``|u_hg|`` generator turns).
 
@@ -150,12 +164,59 @@ def kinematic_error(
         Reused if given (it must have been built with the same cam-borne offset).
     samples : int, optional
         Only the first ``samples`` generator angles (tests); default the revolution.
+    reference : bool
+        The first contacts by the block-by-block search (module docstring; tests hold the default to it).
     """
     tab = table if table is not None else contact_table(drive, imp, n_per_mesh, sections)
     if tab.cam_cam != (imp.cam_cam, imp.cam_cam_phase):
         raise DesignError("imperfections.cam_offset_cam_um", "the contact table was built for another cam-borne offset")
     I = _record(tab) if samples is None else int(samples)
     _require_contacts(tab)
+    dw, dn, deep = (_first_contacts_blocks if reference else _first_contacts)(tab, imp, I)
+    if I and not (dw.max() < np.inf and dn.max() < np.inf):  # inf where no contact (NaN fails it too)
+        free = int(np.count_nonzero(~(np.isfinite(dw) & np.isfinite(dn))))
+        raise ModelError(
+            f"the flexspline turns freely at {free} of {I} generator angles (no tooth within reach of a rigid tooth "
+            "on one side): the output is not driven there and has no KE; check the tooth heights and W0 (wgcad audit)"
+        )
+    theta, lm = _theta(tab, dw, dn)
+    phi_h = np.arange(I) * (2 * tab.sigma) * pi  # sigma i 2 pi / (z_b N), the same products in fewer passes
+    phi_h /= tab.z_b * tab.N
+    eng = "single-flank (backlash)" if lm.min() >= 0 else "double-flank (interference)" if lm.max() < 0 else "mixed"
+    if I:
+        np.subtract(theta, theta[0], out=theta)
+    return KEResult(
+        phi_h,
+        dw,
+        dn,
+        lm,
+        np.negative(theta, out=theta),
+        tab.N,
+        I / (tab.N * tab.z_b),
+        eng,
+        abs(gear_ratios(tab.z_g, tab.z_b)["u_hg"]),
+        float(deep.mean()) if I else 0.0,
+    )
+
+
+def _first_contacts(tab: ContactTable, imp: Imperfections, I: int):
+    """``delta_w``, ``delta_n`` (inf where no contact) and where either first contact overlaps deeply, over samples
+    ``0 .. I - 1``: the undominated lanes at every sample (:func:`wgcad.accuracy.ke_lanes.first_contacts`)."""
+    sides = []
+    for side in (tab.side_w, -tab.side_w):
+        g = tab.sides[side]["g"]
+        lanes = candidate_lanes(tab, side, imp)
+        e = np.unique(lanes[lanes >= 0])
+        A = np.zeros((len(g), 3), dtype=complex)
+        A[e] = harmonics(tab, side, imp, contacts=e)  # the lanes' rows only
+        sides.append((lanes, g, A, g < -DEEP_OVERLAP))
+    (dw, fw), (dn, fn) = first_contacts(tab, sides, I)
+    return dw, dn, fw | fn
+
+
+def _first_contacts_blocks(tab: ContactTable, imp: Imperfections, I: int):
+    """What :func:`_first_contacts` computes, by :func:`wgcad.accuracy.ke_lanes.lane_minimum` in passes of
+    :data:`_SPAN` samples (the reference)."""
     lw, ln = candidate_lanes(tab, tab.side_w, imp), candidate_lanes(tab, -tab.side_w, imp)
     dw, dn = np.empty(I), np.empty(I)
     deep = np.zeros(I, dtype=bool)
@@ -166,27 +227,7 @@ def kinematic_error(
             g = tab.sides[side]["g"]
             out[a : a + len(i)], e = lane_minimum(tab, lanes, g, co[side], i)
             deep[a : a + len(i)] |= (e >= 0) & (g[np.maximum(e, 0)] < -DEEP_OVERLAP)
-    if not (np.all(np.isfinite(dw)) and np.all(np.isfinite(dn))):
-        free = int(np.count_nonzero(~(np.isfinite(dw) & np.isfinite(dn))))
-        raise ModelError(
-            f"the flexspline turns freely at {free} of {I} generator angles (no tooth within reach of a rigid tooth "
-            "on one side): the output is not driven there and has no KE; check the tooth heights and W0 (wgcad audit)"
-        )
-    theta, lm = _theta(tab, dw, dn)
-    phi_h = tab.sigma * np.arange(I) * 2 * pi / (tab.z_b * tab.N)
-    eng = "single-flank (backlash)" if lm.min() >= 0 else "double-flank (interference)" if lm.max() < 0 else "mixed"
-    return KEResult(
-        phi_h,
-        dw,
-        dn,
-        lm,
-        -(theta - theta[0]),
-        tab.N,
-        I / (tab.N * tab.z_b),
-        eng,
-        abs(gear_ratios(tab.z_g, tab.z_b)["u_hg"]),
-        float(deep.mean()) if I else 0.0,
-    )
+    return dw, dn, deep
 
 
 def _require_contacts(tab: ContactTable) -> None:

@@ -25,35 +25,68 @@ loaded KE is sampled, not followed within a mesh period.
 
 from __future__ import annotations
 
-from dataclasses import field
+from dataclasses import dataclass, field
 from math import pi
 
 import numpy as np
 
 from ..errors import DesignError
 from ..kinematics import gear_ratios
-from ..placement.imperfect import Imperfections, cam_offset, flex_deviations, rigid_translation
-from ..records import record
+from ..placement.imperfect import Imperfections
+from .load_errors import tooth_errors
+from .states import StateJob, solve_states
 
-__all__ = ["LoadedKE", "sample_periods", "tooth_errors", "loaded_ke", "LoadedLever", "install_lever", "SCAN_ANGLES"]
+__all__ = [
+    "LoadedKE",
+    "SINGLE_ZONE_SHARE",
+    "sample_periods",
+    "tooth_errors",
+    "loaded_ke",
+    "LoadedLever",
+    "install_lever",
+    "SCAN_ANGLES",
+]
 
 
-@record
+#: a load state is single-zone when the lesser engagement zone carries less than this share of the tooth torque
+#: ([S4]: single-zone engagement, which the errors cause, is what raises the KE; docs/models.md 6.3)
+SINGLE_ZONE_SHARE = 0.05
+
+
+@dataclass(slots=True)
 class LoadedKE:
     """Loaded KE at whole mesh periods (radians; arrays over the samples)."""
 
     torque_nm: float
     periods: np.ndarray  #: mesh periods n of each sample
     phi_h: np.ndarray  #: generator angle, rad
-    theta: np.ndarray  #: rim rotation against the rigid gear, rad (counter-clockwise)
+    theta: np.ndarray  #: output rotation against the rigid gear, rad (counter-clockwise)
     ke: np.ndarray  #: -(theta - theta[0])
     wind_up: float  #: mean rotation (mesh wind-up) over the samples, rad
     teeth_in_contact: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=int))
     seconds: float = 0.0
+    #: each sample's share of the tooth torque carried by each engagement zone, ``(n, waves)``
+    zone_share: np.ndarray = field(default_factory=lambda: np.zeros((0, 2)))
 
     @property
     def ke_pp(self) -> float:
         return float(self.ke.max() - self.ke.min())
+
+    @property
+    def single_zone(self) -> np.ndarray:
+        """Which samples are single-zone (the lesser zone below :data:`SINGLE_ZONE_SHARE` of the tooth torque)."""
+        if self.zone_share.size == 0:
+            return np.zeros(len(self.ke), dtype=bool)
+        return np.nanmin(self.zone_share, axis=1) < SINGLE_ZONE_SHARE
+
+    @property
+    def single_zone_fraction(self) -> float:
+        return float(self.single_zone.mean()) if len(self.ke) else 0.0
+
+    def ke_range(self, mask: np.ndarray) -> float:
+        """Peak to peak of the KE over the samples ``mask`` (0 for fewer than two), rad."""
+        k = self.ke[mask]
+        return float(k.max() - k.min()) if k.size >= 2 else 0.0
 
 
 def sample_periods(z_g: int, z_b: int, samples: int | None = None) -> np.ndarray:
@@ -73,45 +106,6 @@ def sample_periods(z_g: int, z_b: int, samples: int | None = None) -> np.ndarray
     return np.unique(np.round(np.linspace(0.0, total, samples, endpoint=False)).astype(int))
 
 
-def tooth_errors(model, imp: Imperfections, n: int):
-    """The errors of the drive at ``n`` mesh periods as the model's inputs: ``(turn, move)`` per tooth and the cam offset.
-
-    Returns
-    -------
-    (turn (S z_g,), move (S z_g, 2)), cam_offset_um, cam_offset_deg
-    """
-    drive = model.drive
-    d = drive.design.drive
-    z_g, z_b = d.z_flex, d.z_rigid
-    sigma = 1 if d.rotation == "ccw" else -1
-    phi_h = sigma * n * 2.0 * pi / z_b
-    phi_g = phi_h / gear_ratios(z_g, z_b)["u_hg"]
-    q = np.arange(z_g)
-    k = (q + sigma * n) % z_g  # the drive's tooth at the model's position q
-    dalpha, drho = flex_deviations(imp, k, z_g, drive.flex.r)
-    ang = model.tables.angles[:z_g]  # the model's tooth angles (generator frame)
-    # the rigid tooth facing each flexspline tooth: its run-out turn, read continuously along the gear
-    # (exact at tooth centres; adjacent teeth differ by F_b/(2 r_b) 2 pi/z_b, far below a micrometre)
-    a_rigid = ang + phi_h
-    dev = (0.5 * imp.rigid_runout / drive.rigid.r) * np.sin(a_rigid - imp.rigid_install + imp.rigid_runout_phase)
-    c, s = np.cos(-phi_h), np.sin(-phi_h)
-    T = rigid_translation(imp)
-    T = np.array([c * T[0] - s * T[1], s * T[0] + c * T[1]])  # the rigid gear's shift in the generator frame
-    turn = dalpha - dev
-    # the tooth's axis after the turn: drho along it (the rim's own rotation there is theta, ~1e-2 rad: its
-    # effect on a micrometre-sized drho is far below the figures)
-    axis = np.stack([np.cos(ang + turn), np.sin(ang + turn)], axis=-1)
-    move = drho[:, None] * axis - T[None, :]
-    S = len(model.zs)
-    E = cam_offset(imp, phi_h, phi_g)
-    Eg = np.array([c * E[0] - s * E[1], s * E[0] + c * E[1]])
-    return (
-        (np.tile(turn, S), np.tile(move, (S, 1))),
-        1e3 * float(np.hypot(*Eg)),
-        float(np.degrees(np.arctan2(Eg[1], Eg[0]))),
-    )
-
-
 def loaded_ke(
     drive,
     imp: Imperfections,
@@ -120,6 +114,7 @@ def loaded_ke(
     model=None,
     progress=None,
     tol: float | None = None,
+    workers: int | None = None,
 ) -> LoadedKE:
     """The KE of an imperfect drive under ``torque_nm`` from the elastic model at whole mesh periods (module docstring).
 
@@ -134,34 +129,35 @@ def loaded_ke(
     tol : float, optional
         The elastic solve's position tolerance, mm (default its own, 0.2 um: about 0.5'' of rotation at
         80 mm; the tests tighten it to compare two routes).
+    workers : int, optional
+        Processes to share the states among (:mod:`wgcad.accuracy.states`; default the cores available); the
+        figures do not depend on it.
     """
     import time
 
-    from ..elastic import build_model, solve_load
+    from ..elastic import build_model
 
     d = drive.design.drive
+    _check(d, torque_nm)
+    t0 = time.perf_counter()
+    model = build_model(drive) if model is None else model
+    periods = sample_periods(d.z_flex, d.z_rigid, samples)
+    run = solve_states(model, [StateJob(imp, float(torque_nm), periods, tol)], workers, progress)[0]
+    return _loaded(model, torque_nm, periods, run, time.perf_counter() - t0)
+
+
+def _check(d, torque_nm) -> None:
     if d.fixed != "rigid":
         raise DesignError("drive.fixed", f"the loaded KE models a fixed rigid gear, flexspline output; got '{d.fixed}'")
     if not (np.isfinite(torque_nm) and torque_nm > 0):
         raise DesignError("--torque-nm", f"must be > 0 N m for the loaded KE, got {torque_nm:g}")
-    t0 = time.perf_counter()
-    model = build_model(drive) if model is None else model
-    periods = sample_periods(d.z_flex, d.z_rigid, samples)
-    theta = np.empty(len(periods))
-    teeth = np.empty(len(periods), dtype=int)
-    warm = None
-    for i, n in enumerate(periods):
-        errs, e_um, e_deg = tooth_errors(model, imp, int(n))
-        kw = {} if tol is None else {"tol": tol}
-        st = solve_load(model, float(torque_nm), e_um, e_deg, warm=warm, tooth_errors=errs, **kw)
-        theta[i] = float(st.rigid[2])
-        c = st.contacts
-        teeth[i] = int(np.count_nonzero((c["kind"] == 1) & (c["force"] > 0)))
-        warm = st
-        if progress is not None:
-            progress(i + 1, len(periods))
+
+
+def _loaded(model, torque_nm, periods, run, seconds) -> LoadedKE:
+    d = model.drive.design.drive
     sigma = 1 if d.rotation == "ccw" else -1
     phi_h = sigma * periods * 2.0 * pi / d.z_rigid
+    theta = run.theta
     return LoadedKE(
         float(torque_nm),
         periods,
@@ -169,8 +165,9 @@ def loaded_ke(
         theta,
         -(theta - theta[0]),
         float(model.torque_sign * theta.mean()),
-        teeth,
-        time.perf_counter() - t0,
+        run.teeth,
+        seconds,
+        run.share,
     )
 
 
@@ -179,7 +176,7 @@ def loaded_ke(
 SCAN_ANGLES = 18
 
 
-@record
+@dataclass(slots=True)
 class LoadedLever:
     """The rigid gear's installation angle under load (radians inside).
 
@@ -226,6 +223,7 @@ def install_lever(
     n_grid: int = SCAN_ANGLES,
     progress=None,
     design: LoadedKE | None = None,
+    workers: int | None = None,
 ) -> LoadedLever:
     """The rigid gear's installation angle that lowers the largest KE under ``torque_nm`` most ([S4], docs/models.md 6.3).
 
@@ -246,32 +244,36 @@ def install_lever(
     t0 = time.perf_counter()
     model = build_model(drive) if model is None else model
     d = drive.design.drive
+    _check(d, torque_nm)
     u = abs(gear_ratios(d.z_flex, d.z_rigid)["u_hg"])
     scan_samples = int(np.ceil(u) + 4) if scan_samples is None else int(scan_samples)
-    n_scan = len(sample_periods(d.z_flex, d.z_rigid, scan_samples))
-    n_full = len(sample_periods(d.z_flex, d.z_rigid, samples))
-    total = (n_grid + 2) * n_scan + (1 if design is not None else 2) * n_full
+    scan_p = sample_periods(d.z_flex, d.z_rigid, scan_samples)
+    full_p = sample_periods(d.z_flex, d.z_rigid, samples)
+    total = (n_grid + 2) * len(scan_p) + (1 if design is not None else 2) * len(full_p)
     done = [0]
 
     def tick(i, n):
         if progress is not None:
             progress(done[0] + i, total)
 
-    def ke_at(angle, ns):
-        L = loaded_ke(drive, imp.replace(rigid_install=float(angle)), torque_nm, samples=ns, model=model, progress=tick)
-        done[0] += len(L.ke)
-        return L
+    def ke_at(angles, periods):
+        jobs = [StateJob(imp.replace(rigid_install=float(a)), float(torque_nm), periods) for a in angles]
+        runs = solve_states(model, jobs, workers, tick)
+        done[0] += len(jobs) * len(periods)
+        return [_loaded(model, torque_nm, periods, r, 0.0) for r in runs]
 
     grid = 2 * pi * np.arange(n_grid) / n_grid
-    pp = np.array([ke_at(a, scan_samples).ke_pp for a in grid])
+    pp = np.array([L.ke_pp for L in ke_at(grid, scan_p)])
     i = int(np.argmin(pp))
     step = 2 * pi / n_grid
     extra = [grid[i] - step / 2, grid[i] + step / 2]
-    pe = [ke_at(a, scan_samples).ke_pp for a in extra]
+    pe = [L.ke_pp for L in ke_at(extra, scan_p)]
     cands = [(pp[i], grid[i])] + list(zip(pe, extra))
     best_angle = float(min(cands)[1]) % (2 * pi)
-    best = ke_at(best_angle, samples)
-    design = ke_at(imp.rigid_install, samples) if design is None else design
+    if design is None:
+        best, design = ke_at([best_angle, imp.rigid_install], full_p)
+    else:
+        (best,) = ke_at([best_angle], full_p)
     if not best.ke_pp < design.ke_pp:
         # the scan ranks on fewer states: where its best does no better than the design's own angle on every
         # state, the design's angle is the answer (a flat curve: the lever does nothing)

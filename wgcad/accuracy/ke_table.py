@@ -9,7 +9,7 @@ the root fillet) that surface is tabulated too (``_second_features``).
 
 from __future__ import annotations
 
-from dataclasses import field
+from dataclasses import dataclass, field
 from math import pi
 
 import numpy as np
@@ -22,7 +22,6 @@ from ..errors import DesignError
 from ..kinematics import gear_ratios
 from ..placement import tooth_pose
 from ..placement.imperfect import Imperfections, cam_offset, coning_factor
-from ..records import record
 from .ke_lanes import candidate_lanes, fold_angle
 
 __all__ = ["ContactTable", "contact_table", "DEFAULT_N", "NT_MAX"]
@@ -37,7 +36,7 @@ _CHUNK = 8192
 NT_MAX = 2.0
 
 
-@record
+@dataclass
 class ContactTable:
     """Contacts of the perfect drive (plus the cam-borne offset) on the tooth-angle lattice, per side.
 
@@ -156,7 +155,7 @@ def contact_table(
     return tab
 
 
-@record
+@dataclass(slots=True)
 class _Lattice:
     """What every stage of the table shares: the drive, the teeth's outlines, the lattice of tooth angles."""
 
@@ -234,7 +233,7 @@ def _more_features(lat: _Lattice, tab: ContactTable, imp: Imperfections, side: i
     return out
 
 
-@record
+@dataclass(slots=True)
 class _Poses:
     """Tooth pairs of the lattice: ``idx`` the lattice points (into ``rot``, ``shift``: the lattice's poses), and per
     pair the pose's derivatives along the rim (``drot``, ``dshift``), the rigid tooth ``j``; the lattice indices
@@ -254,7 +253,7 @@ class _Poses:
         return _Poses(self.idx[k], self.rot, self.shift, self.drot[k], self.dshift[k], self.m_all, self.j[k], self.cz)
 
 
-@record
+@dataclass(slots=True)
 class _Solved:
     """One section's and side's first contacts: their table rows, which engaged pairs they are (``k``, into
     ``poses``), and the rigid teeth's angles ``rb`` of the engaged pairs."""
@@ -469,3 +468,5 @@ def _refine(tab: ContactTable, side: int, imp: Imperfections, flex, rigid, reach
     S["a_phi"][e] = np.einsum("ij,ij->i", S["dP"][e], nt)
     S["a_rho"][e] = np.cos(S["rr"][e]) * nt[:, 0] + np.sin(S["rr"][e]) * nt[:, 1]
     S["a_beta"][e] = -S["q"][e, 1] * nt[:, 0] + S["q"][e, 0] * nt[:, 1]
+    for key in ("_lane_factors", "_harmonic_factors"):  # of the sensitivities before
+        tab.__dict__.pop(key, None)

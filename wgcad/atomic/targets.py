@@ -9,7 +9,7 @@ from pathlib import Path
 
 from wgcad.errors import OutputError
 
-from .temps import _new_temp, _remove_quietly
+from .temps import new_temp, remove_quietly
 
 __all__ = ["check_target", "check_writable_dir", "ensure_writable_dir"]
 
@@ -36,7 +36,7 @@ _PSEUDO_FS = {
 }
 
 
-def _reason(exc: OSError) -> str:
+def os_reason(exc: OSError) -> str:
     """Short reason of an OS error, without the path (the caller names it)."""
     return exc.strerror or type(exc).__name__
 
@@ -57,7 +57,7 @@ def _kind(mode: int) -> str:
     return "not a regular file"  # pragma: no cover (doors, whiteouts)
 
 
-def _not_a_folder(path: Path) -> str:
+def not_a_folder(path: Path) -> str:
     """Why ``path`` cannot be reached: the first component of it that exists but is not a folder."""
     p = Path(os.path.abspath(path))
     for part in [*reversed(p.parents), p]:
@@ -99,9 +99,9 @@ def check_target(path: str | os.PathLike, hint: str = "") -> Path:
     except FileNotFoundError:
         return final
     except NotADirectoryError as exc:
-        raise OutputError(f"{final.parent}: output folder is not writable ({_not_a_folder(final.parent)})") from exc
+        raise OutputError(f"{final.parent}: output folder is not writable ({not_a_folder(final.parent)})") from exc
     except OSError as exc:
-        raise OutputError(f"{final}: cannot write file ({_reason(exc)})") from exc
+        raise OutputError(f"{final}: cannot write file ({os_reason(exc)})") from exc
     if stat.S_ISREG(mode):
         return final
     raise OutputError(f"{final}: is {_kind(mode)}; wgcad writes only new or regular files{hint}")
@@ -161,9 +161,9 @@ def check_writable_dir(path: str | os.PathLike) -> Path:
                 raise OutputError(f"{folder}: output folder is not writable (no existing parent folder)") from None
             probe_dir = probe_dir.parent
         except NotADirectoryError:
-            raise OutputError(f"{folder}: output folder is not writable ({_not_a_folder(folder)})") from None
+            raise OutputError(f"{folder}: output folder is not writable ({not_a_folder(folder)})") from None
         except OSError as exc:
-            raise OutputError(f"{folder}: output folder is not writable ({_reason(exc)})") from exc
+            raise OutputError(f"{folder}: output folder is not writable ({os_reason(exc)})") from exc
     if not stat.S_ISDIR(st.st_mode):
         which = "it" if probe_dir == Path(os.path.abspath(folder)) else str(probe_dir)
         raise OutputError(f"{folder}: output folder is not writable ({which} is {_kind(st.st_mode)}, not a folder)")
@@ -173,14 +173,14 @@ def check_writable_dir(path: str | os.PathLike) -> Path:
             f"{folder}: output folder is not writable (it is on a {fs} file system, which holds {_PSEUDO_FS[fs]}, not files)"
         )
     try:
-        probe = _new_temp(probe_dir / ".wgcad-write-probe")
+        probe = new_temp(probe_dir / ".wgcad-write-probe")
     except OSError as exc:
         if exc.errno == errno.ENOENT:  # the folder exists, yet "no such file": a special file system
-            reason = f"the file system refuses new files there ({_reason(exc)})"
+            reason = f"the file system refuses new files there ({os_reason(exc)})"
         else:
-            reason = _reason(exc)
+            reason = os_reason(exc)
         raise OutputError(f"{folder}: output folder is not writable ({reason})") from exc
-    _remove_quietly(probe)
+    remove_quietly(probe)
     return folder
 
 
@@ -199,5 +199,5 @@ def ensure_writable_dir(path: str | os.PathLike) -> Path:
     try:
         folder.mkdir(parents=True, exist_ok=True)
     except OSError as exc:
-        raise OutputError(f"{folder}: output folder is not writable ({_reason(exc)})") from exc
+        raise OutputError(f"{folder}: output folder is not writable ({os_reason(exc)})") from exc
     return folder

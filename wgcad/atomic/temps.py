@@ -5,11 +5,12 @@ from __future__ import annotations
 import contextlib
 import os
 import re
+import secrets
 import stat
 import time
 from pathlib import Path
 
-__all__ = ["TEMP_SUFFIX", "remove_stale_temps"]
+__all__ = ["TEMP_SUFFIX", "remove_stale_temps", "shown_name"]
 
 #: Temporary files are hidden (leading dot) and named
 #: ``.<final name>.<pid>-<12 hex digits>.tmp``: a run killed with SIGKILL
@@ -82,15 +83,26 @@ def remove_stale_temps(folder: str | os.PathLike) -> list[str]:
     return removed
 
 
-def _new_temp(final: Path) -> str:
+def shown_name(path: str | os.PathLike) -> Path:
+    """The file a user asked for behind ``path``: ``path`` itself, or, for one of wgcad's temporary files (an exporter
+    writing atomically onto a batch's temporary name), the final file it stands for. Error messages name that file:
+    ``.x.stl.123-0123456789ab.tmp: cannot write file`` tells a user nothing about ``x.stl``."""
+    p = Path(path)
+    name = p.name
+    while True:
+        m = _TEMP_RE.match(name) or _LEGACY_TEMP_RE.match(name)
+        if not m:
+            return p.with_name(name)
+        name = name[1 : name.rindex(".", 0, len(name) - len(TEMP_SUFFIX))]
+
+
+def new_temp(final: Path) -> str:
     """Create an empty temporary file beside ``final`` and return its path.
 
     ``os.open(..., 0o666)`` rather than ``tempfile.mkstemp`` so the file gets
     the usual permissions after the umask (``mkstemp`` makes it 0600, and that
     mode would survive the rename).
     """
-    import secrets  # here: its hashlib costs 4 ms of every command's start, and most write nothing
-
     for _ in range(100):
         temp = final.parent / f".{final.name}.{os.getpid()}-{secrets.token_hex(6)}{TEMP_SUFFIX}"
         try:
@@ -102,6 +114,8 @@ def _new_temp(final: Path) -> str:
     raise FileExistsError(f"{final.parent}: no free temporary file name")  # pragma: no cover
 
 
-def _remove_quietly(path: str | os.PathLike) -> None:
-    with contextlib.suppress(FileNotFoundError):
+def remove_quietly(path: str | os.PathLike) -> None:
+    """Remove a temporary file if it can be: one the file system will not let go (turned read-only under the run)
+    stays for the next run's :func:`remove_stale_temps`, and the error that stopped this run is the one reported."""
+    with contextlib.suppress(OSError):
         os.remove(path)

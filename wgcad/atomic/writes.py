@@ -11,8 +11,8 @@ from pathlib import Path
 
 from wgcad.errors import OutputError
 
-from .targets import _not_a_folder, _reason, check_target
-from .temps import _new_temp, _remove_quietly, remove_stale_temps
+from .targets import check_target, not_a_folder, os_reason
+from .temps import new_temp, remove_quietly, remove_stale_temps, shown_name
 
 __all__ = ["atomic_writer", "atomic_write", "commit_all", "discard_all", "Batch", "atomic_batch"]
 
@@ -40,14 +40,14 @@ def _prepare_temp(final: Path, created: list[Path] | None = None) -> str:
         made = _make_parents(final.parent)
         if created is not None:
             created.extend(made)
-        return _new_temp(final)
+        return new_temp(final)
     except OSError as exc:
         if isinstance(exc, NotADirectoryError):
-            reason = _not_a_folder(final.parent)
+            reason = not_a_folder(final.parent)
         elif exc.errno == errno.ENOENT and final.parent.is_dir():
-            reason = f"the file system refuses new files there ({_reason(exc)})"
+            reason = f"the file system refuses new files there ({os_reason(exc)})"
         else:
-            reason = _reason(exc)
+            reason = os_reason(exc)
         raise OutputError(f"{final.parent}: output folder is not writable ({reason})") from exc
 
 
@@ -128,15 +128,15 @@ def atomic_writer(path: str | os.PathLike) -> Iterator[str]:
         check_target(final)  # again: it may have become a link or FIFO while we computed
         os.replace(temp, final)
     except OutputError:
-        _remove_quietly(temp)
+        remove_quietly(temp)
         _remove_empty_dirs(created)
         raise
     except OSError as exc:
-        _remove_quietly(temp)
+        remove_quietly(temp)
         _remove_empty_dirs(created)
-        raise OutputError(f"{final}: cannot write file ({_reason(exc)})") from exc
+        raise OutputError(f"{shown_name(final)}: cannot write file ({os_reason(exc)})") from exc
     except BaseException:
-        _remove_quietly(temp)
+        remove_quietly(temp)
         _remove_empty_dirs(created)
         raise
 
@@ -170,7 +170,7 @@ def discard_all(temps: Iterable[str | os.PathLike]) -> None:
         Temporary files prepared for :func:`commit_all`.
     """
     for temp in temps:
-        _remove_quietly(temp)
+        remove_quietly(temp)
 
 
 def commit_all(
@@ -215,7 +215,7 @@ def commit_all(
         discard_all(temp for _, temp in pairs)
         if isinstance(exc, OutputError):
             raise
-        raise OutputError(f"{final}: cannot write file ({_reason(exc)})") from exc
+        raise OutputError(f"{final}: cannot write file ({os_reason(exc)})") from exc
     with _signals_deferred():
         for old in remove:
             with contextlib.suppress(FileNotFoundError):
@@ -226,7 +226,7 @@ def commit_all(
             except OSError as exc:
                 discard_all(t for _, t in pairs[k:])
                 raise OutputError(
-                    f"{final}: cannot write file ({_reason(exc)}); {k} of {len(pairs)} files were already written"
+                    f"{final}: cannot write file ({os_reason(exc)}); {k} of {len(pairs)} files were already written"
                 ) from exc
 
 

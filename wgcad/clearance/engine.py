@@ -32,14 +32,12 @@ Why it can skip work (each switchable, each tested against the full computation)
 from __future__ import annotations
 
 import time
-from dataclasses import field
+from dataclasses import dataclass, field
 from math import pi
 
 import numpy as np
 
-from ..arrays import unique_sorted
 from ..placement import tooth_pose
-from ..records import record
 from .backlash import backlash
 from .cascade import FINE, refine_candidates
 from .entry import (
@@ -54,8 +52,8 @@ from .entry import (
     smallest,
 )
 from .findings import AuditRun, Finding
-from .scene import Scene, _classify, clearance_at_poses, refine_min, tooth_clearance, tooth_clearance_sections
-from .search import AuditSettings, _evaluate, _fold, _sample_phi, _SectionSearch
+from .scene import Scene, classify, clearance_at_poses, refine_min, tooth_clearance, tooth_clearance_sections
+from .search import AuditSettings, SectionSearch, evaluate, fold, sample_phi
 
 __all__ = [
     "AuditSettings",
@@ -78,7 +76,7 @@ __all__ = [
 ]
 
 
-@record
+@dataclass(slots=True)
 class AuditResult:
     """Figures of an audit as :class:`~wgcad.clearance.findings.Finding` records (mm, rad inside).
 
@@ -164,12 +162,12 @@ def _canonical(scene: Scene, folded: np.ndarray, phi_w: float, z, exact: bool):
     Teeth and laws are symmetric: the tooth at ``-phi`` is the mirror image
     of the one at ``+phi`` with its flanks swapped, so both are named and
     the spot is reported at ``+|phi|`` whichever sample the search met
-    first (issue 13: the printed spot no longer depends on the shortcuts).
+    first (so the printed spot does not depend on the shortcuts).
     The sample is the first (generator angle, tooth) in order whose tooth
     angle folds to ``+|phi|`` (else ``-|phi|``); ``folded`` holds every
     sample's tooth angle folded to the nearest major axis, ``(A, z_g)``.
     """
-    a = abs(float(_fold(np.array([phi_w]), 2 * pi / scene.n_w)[0]))
+    a = abs(float(fold(np.array([phi_w]), 2 * pi / scene.n_w)[0]))
     folded = folded.ravel()
     hit = np.nonzero(np.abs(folded - a) <= 1e-9)[0]
     sgn = 1.0
@@ -184,7 +182,7 @@ def _canonical(scene: Scene, folded: np.ndarray, phi_w: float, z, exact: bool):
     for i, p in enumerate(both):
         side = min(("lower", "upper", "third"), key=lambda k: det[k][i])
         ridx = det["up"][i] if side == "upper" else det["lo"][i] if side == "lower" else det["th"][i]
-        locs.append(_classify(scene, placed[i], int(ridx), float(p), z))
+        locs.append(classify(scene, placed[i], int(ridx), float(p), z))
     return a, locs[0], locs[1], flat, sgn
 
 
@@ -203,16 +201,16 @@ def audit(drive, settings: AuditSettings, progress=None) -> AuditResult:
     scene = Scene(drive)
     angles = np.asarray(settings.angles, dtype=float)
     sections = [None] if not drive.coned else [float(z) for z in settings.sections]
-    phi_all = _sample_phi(scene, angles)  # (A, z_g)
+    phi_all = sample_phi(scene, angles)  # (A, z_g)
     period = 2 * pi / scene.n_w if settings.use_waves else 2 * pi
-    key = _fold(phi_all, period)
+    key = fold(phi_all, period)
     # every sample's tooth angle folded to the nearest major axis (where the worst spot is named)
-    folded = key if settings.use_waves else _fold(phi_all, 2 * pi / scene.n_w)
+    folded = key if settings.use_waves else fold(phi_all, 2 * pi / scene.n_w)
     if settings.use_mirror:
         key = np.abs(key)
     n_samples = phi_all.size * len(sections)
     if settings.use_period:
-        phi_u = unique_sorted(np.round(key, 12))
+        phi_u = np.unique(np.round(key, 12))
     else:
         phi_u = key.ravel()
     order = np.argsort(phi_u, kind="stable")
@@ -280,21 +278,21 @@ def audit(drive, settings: AuditSettings, progress=None) -> AuditResult:
 
 def _polygon_search(scene: Scene, phi_sorted: np.ndarray, sections: list, settings: AuditSettings, st):
     """Branch and bound on the polygons over every section: the sections' searches and the smallest figure."""
-    results = [_SectionSearch(scene, phi_sorted, z, settings) for z in sections]
+    results = [SectionSearch(scene, phi_sorted, z, settings) for z in sections]
     for r in results:
         r.prepare_bound()
     st(0.0)
     # coarse pass over every section first: the best of any prunes all; then finer strides
-    best = _evaluate(scene, results, [r.coarse() for r in results], sections, lambda f: st(0.3 * f))
+    best = evaluate(scene, results, [r.coarse() for r in results], sections, lambda f: st(0.3 * f))
     for step, stride in enumerate((64, 16, 4, 1)):
-        best = _evaluate(
+        best = evaluate(
             scene,
             results,
             [r.candidates(stride, best) for r in results],
             sections,
             lambda f, s=step: st(0.3 + 0.15 * (s + f)),
         )
-    best = _evaluate(scene, results, [r.culled_needed(best) for r in results], sections, lambda f: st(0.9 + 0.1 * f))
+    best = evaluate(scene, results, [r.culled_needed(best) for r in results], sections, lambda f: st(0.9 + 0.1 * f))
     return results, best
 
 
@@ -533,7 +531,7 @@ def clearance_vs_angle(scene: Scene, profile: dict, angles: np.ndarray) -> tuple
     angle (mesh period), linearly interpolated between profile points: a
     picture, not an exact figure (the audit's minimum is exact).
     """
-    phi = _fold(_sample_phi(scene, np.asarray(angles, dtype=float)), 2 * pi / scene.n_w)
+    phi = fold(sample_phi(scene, np.asarray(angles, dtype=float)), 2 * pi / scene.n_w)
     w = np.full(len(angles), np.inf)
     n = np.full(len(angles), np.inf)
     for sec in profile["sections"]:

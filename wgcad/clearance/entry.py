@@ -22,13 +22,13 @@ audit, the load audit and the imperfect audit share one definition.
 
 from __future__ import annotations
 
+from dataclasses import dataclass
 from math import pi
 
 import numpy as np
 
 from ..placement import transform
-from ..records import record
-from .scene import Scene, _classify
+from .scene import Scene, classify
 
 __all__ = [
     "EntryPassage",
@@ -61,7 +61,7 @@ TIP_BAND = 0.3
 _NEST, _NEST_PTS = 4, 17
 
 
-@record(frozen=True)
+@dataclass(frozen=True, slots=True)
 class EntryPassage:
     """The entry of one passage (mm, rad inside).
 
@@ -146,7 +146,7 @@ def crossings(scene: Scene, poses, K: int) -> np.ndarray:
     return out
 
 
-def _edge_idx(scene: Scene, rot, shift):
+def edge_index(scene: Scene, rot, shift):
     """Rigid tooth faced by the working and by the non-working edge of each placed tooth, ``(N,)`` each."""
     lo, up, _ = scene.neighbours(shift, rot)
     return (up, lo) if scene.working == "upper" else (lo, up)
@@ -160,7 +160,7 @@ def edge_gaps(scene: Scene, rot: np.ndarray, shift: np.ndarray, exact: bool = Tr
     """
     rot = np.atleast_1d(rot)
     shift = np.atleast_2d(shift)
-    jw, jn = _edge_idx(scene, rot, shift)
+    jw, jn = edge_index(scene, rot, shift)
     out = np.empty((len(rot), 2))
     if exact:
         val = scene.exact_to(np.concatenate([rot, rot]), np.concatenate([shift, shift]), np.concatenate([jw, jn]))[0]
@@ -363,10 +363,10 @@ def entry_pinch(scene: Scene, crossings_, tol: float | None = None, exact: bool 
 def location(scene: Scene, phi: float, z, edge: int) -> str:
     """Where on the flexspline tooth at ``phi`` (analytic law, section ``z``) its gap by ``edge`` is measured: tip, root or flank."""
     rot, shift = scene.pose(np.array([phi]), z)
-    jw, jn = _edge_idx(scene, rot, shift)
+    jw, jn = edge_index(scene, rot, shift)
     j = int((jw if edge == 0 else jn)[0])
     pts = transform(scene.flex_local, rot, shift)[0]
-    return _classify(scene, pts, j, phi, z)
+    return classify(scene, pts, j, phi, z)
 
 
 #: cells of :func:`lipschitz_min` split into this many per round

@@ -14,8 +14,6 @@ from __future__ import annotations
 import numpy as np
 import shapely
 
-from ..arrays import unique_sorted
-
 __all__ = ["ExactTooth", "point_signed_distance", "curv_h"]
 
 _SEED_GRID = 48  # samples per piece to seed the projection of a point
@@ -45,12 +43,22 @@ class ExactTooth:
         self.sense = np.array([1.0 if p.t1 >= p.t0 else -1.0 for p in pcs])
         # a spline (many cubic segments in one piece) gets four seeds per segment: one seed per 2.6 segments left
         # the projection in a neighbouring segment's basin (a -38 um figure at a contact on D1's conjugate flank)
-        self.seed_grid = max([_SEED_GRID] + [4 * (len(p.params) // 8) + 1 for p in pcs if p.kind == "spline"])
-        grid = [np.linspace(lo, hi, self.seed_grid) for lo, hi in zip(self.lo, self.hi)]
-        self.grid_t = np.array(grid)  # (n, G)
-        self.grid_p = np.stack([p.point(g) for p, g in zip(pcs, grid)])  # (n, G, 2)
+        self.grid_n = np.array(
+            [max(_SEED_GRID, 4 * (len(p.params) // 8) + 1) if p.kind == "spline" else _SEED_GRID for p in pcs]
+        )
+        grid = [np.linspace(lo, hi, g) for lo, hi, g in zip(self.lo, self.hi, self.grid_n)]
+        grid_p = [p.point(g) for p, g in zip(pcs, grid)]
+        # grid_t[j, :grid_n[j]]: piece j's seeds (padded with its last one)
+        self.grid_t = np.array([np.pad(g, (0, self.grid_n.max() - len(g)), mode="edge") for g in grid])
         # longest step between grid points of each piece: bounds how far the nearest grid point can be
-        self.grid_step = np.hypot(*np.diff(self.grid_p, axis=1).transpose(2, 0, 1)).max(axis=1)
+        self.grid_step = np.array([np.hypot(*np.diff(g, axis=0).T).max() for g in grid_p])
+        # the pieces of the usual grid are searched by one matrix product; a spline's thousands of seeds by a tree
+        self._dense = np.flatnonzero(self.grid_n == _SEED_GRID)
+        self._dense_g = _SEED_GRID
+        self._dense_p = np.array([grid_p[j] for j in self._dense]).reshape(-1, 2)
+        self._trees = [
+            (j, shapely.STRtree(shapely.points(grid_p[j]))) for j in np.flatnonzero(self.grid_n != _SEED_GRID)
+        ]
         # every vertex of the period part of the polygon: its piece and parameter. The polygon of an internal
         # gear's tooth runs the two body points first, then the period backwards (Gear.tooth_polygon)
         n_per = len(gear.period)
@@ -65,21 +73,37 @@ class ExactTooth:
         shapely.prepare(self.polygon)
         self.tol = float(gear.tol)
 
-    def grid_d2(self, pts: np.ndarray) -> np.ndarray:
-        """Squared distances ``(K, n, G)`` of points ``(K, 2)`` to every grid point of every piece.
+    def nearest_grid(self, pts: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Squared distance ``(K, n)`` of each of the points ``(K, 2)`` to the nearest grid point of every piece, and
+        that grid point's index (``grid_t[j, index]`` its parameter).
 
-        As ``|p|^2 + |g|^2 - 2 p.g`` about the grid's centre (one matrix
-        product, no (K, n, G, 2) temporary); it picks seeds and candidate
-        pieces, so the rounding (~1e-13 mm^2) does not matter.
+        The usual grids in one matrix product, as ``|p|^2 + |g|^2 - 2 p.g``
+        about their centre (no (K, n, G, 2) temporary); a spline's fine grid
+        (four seeds a segment) by a nearest-neighbour query of its own tree
+        (every piece seeded at a spline's count, one (K, n, G) array, was the
+        largest cost of a conjugate gear's audit). The distances pick seeds
+        and candidate pieces, so the rounding (~1e-13 mm^2) does not matter.
         """
-        if not hasattr(self, "_g_c"):
-            g = self.grid_p.reshape(-1, 2)
-            self._g_c = g.mean(axis=0)
-            self._g_rel = g - self._g_c
-            self._g_n2 = (self._g_rel**2).sum(-1)
-        p = pts - self._g_c
-        d2 = (p**2).sum(-1)[:, None] + self._g_n2[None, :] - 2.0 * (p @ self._g_rel.T)
-        return np.maximum(d2, 0.0).reshape(len(pts), self.n, -1)
+        K = len(pts)
+        d2 = np.full((K, self.n), np.nan)  # a point the tree cannot place (not finite) stays nan, as in the product
+        arg = np.zeros((K, self.n), dtype=np.intp)
+        if self._dense.size:
+            if not hasattr(self, "_g_c"):
+                self._g_c = self._dense_p.mean(axis=0)
+                self._g_rel = self._dense_p - self._g_c
+                self._g_n2 = (self._g_rel**2).sum(-1)
+            p = pts - self._g_c
+            dd = (p**2).sum(-1)[:, None] + self._g_n2[None, :] - 2.0 * (p @ self._g_rel.T)
+            dd = np.maximum(dd, 0.0).reshape(K, len(self._dense), self._dense_g)
+            g = dd.argmin(axis=2)
+            arg[:, self._dense] = g
+            d2[:, self._dense] = np.take_along_axis(dd, g[:, :, None], axis=2)[:, :, 0]
+        if self._trees:
+            geoms = shapely.points(pts)
+            for j, tree in self._trees:
+                (i, g), dist = tree.query_nearest(geoms, return_distance=True, all_matches=False)
+                d2[i, j], arg[i, j] = dist * dist, g
+        return d2, arg
 
     def _tables(self):
         """Per-piece parameters as arrays, so one call evaluates many pieces of one kind (by kind, not by piece)."""
@@ -99,15 +123,24 @@ class ExactTooth:
             elif p.kind == "cubic":
                 par[i] = p.params
             elif p.kind == "spline":
-                pass  # evaluated by the piece itself (its segments are not one row of parameters)
+                pass  # its segments: rows of the segment table below
             elif p.kind == "involute":
                 par[i, :2] = p.params
             else:
                 par[i, :3] = (p.params[0], p.params[1], 1.0 if p.kind == "epicycloid" else -1.0)
         self.par = par
+        # every spline's Bezier segments in one table: piece i's segment k is row seg0[i] + k (of nseg[i])
+        segs = [
+            np.asarray(p.params, dtype=float).reshape(-1, 8) if p.kind == "spline" else np.zeros((0, 8))
+            for p in self.pieces
+        ]
+        self.nseg = np.array([len(a) for a in segs])
+        self.seg0 = np.concatenate([[0], np.cumsum(self.nseg)[:-1]])
+        self.seg_par = np.ascontiguousarray(np.concatenate(segs).T)  # (8, segments)
         self.rot = np.array([p.rot for p in self.pieces])
         self.flip = np.array([p.flip for p in self.pieces])
-        self.kinds = unique_sorted(self.kind)
+        self.cos_rot, self.sin_rot = np.cos(self.rot), np.sin(self.rot)
+        self.kinds = np.unique(self.kind)
 
     def eval(self, idx: np.ndarray, t: np.ndarray, order: int = 2):
         """Point, first and second derivative ``(K, 2)`` each, for pieces ``idx`` at parameters ``t``."""
@@ -123,16 +156,8 @@ class ExactTooth:
             if not sel.any():
                 continue
             ii, tt = idx[sel], t[sel]
-            if kd == 5:  # spline: each piece evaluates itself (rot and flip included)
-                where = np.flatnonzero(sel)
-                for j in unique_sorted(ii):
-                    m = ii == j
-                    pcs = self.pieces[j]
-                    P[where[m]] = pcs.point(tt[m])
-                    D1[where[m]] = pcs.deriv(tt[m])
-                    D2[where[m]] = pcs.deriv2(tt[m])
-                continue
-            pr = self.par[ii]
+            if kd != 5:
+                pr = self.par[ii]
             if kd == 0:  # arc
                 c, s_ = np.cos(tt), np.sin(tt)
                 R = pr[:, 2]
@@ -159,6 +184,22 @@ class ExactTooth:
                 px, py = cu * ca, cu * sa
                 qx, qy = du * ca - dn * sa, du * sa + dn * ca
                 rx, ry = eu * ca - en * sa, eu * sa + en * ca
+            elif kd == 5:  # spline: segment floor(t), a cubic Bezier in t - floor(t) (pieces._eval, term by term)
+                seg = np.floor(tt).astype(np.intp)
+                np.clip(seg, 0, self.nseg[ii] - 1, out=seg)
+                x0, y0, x1, y1, x2, y2, x3, y3 = self.seg_par[:, self.seg0[ii] + seg]  # (8, K): one row a number
+                v = tt - seg
+                u = 1.0 - v
+                b0, b1, b2, b3 = u**3, 3 * u * u * v, 3 * u * v * v, v**3
+                px, py = b0 * x0 + b1 * x1 + b2 * x2 + b3 * x3, b0 * y0 + b1 * y1 + b2 * y2 + b3 * y3
+                b0, b1, b2 = 3 * u * u, 6 * u * v, 3 * v * v
+                qx = b0 * (x1 - x0) + b1 * (x2 - x1) + b2 * (x3 - x2)
+                qy = b0 * (y1 - y0) + b1 * (y2 - y1) + b2 * (y3 - y2)
+                b0, b1 = 6 * u, 6 * v
+                rx, ry = (
+                    b0 * (x2 - 2 * x1 + x0) + b1 * (x3 - 2 * x2 + x1),
+                    b0 * (y2 - 2 * y1 + y0) + b1 * (y3 - 2 * y2 + y1),
+                )
             elif kd == 4:  # cubic Bezier (pieces._cubic)
                 P0, P1, P2, P3 = pr[:, 0:2], pr[:, 2:4], pr[:, 4:6], pr[:, 6:8]
                 u = (1.0 - tt)[:, None]
@@ -183,8 +224,7 @@ class ExactTooth:
                 mu = (2.0 * k + sg) / np.maximum(np.sin(0.5 * phi), 1e-12)
                 rx, ry = -sp * mu * sm, sp * mu * cm
             fl = self.flip[ii]
-            ro = self.rot[ii]
-            c, s_ = np.cos(ro), np.sin(ro)
+            c, s_ = self.cos_rot[ii], self.sin_rot[ii]
             for out, x, y in ((P, px, py), (D1, qx, qy), (D2, rx, ry)):
                 y = fl * y
                 out[sel, 0], out[sel, 1] = c * x - s_ * y, s_ * x + c * y
@@ -198,10 +238,9 @@ class ExactTooth:
 
     def _locate(self, pts: np.ndarray):
         """Piece index and parameter of points that lie on the pieces (the polygon's vertices)."""
-        d2 = self.grid_d2(pts)  # (V, n, G)
-        flat = d2.reshape(len(pts), -1).argmin(axis=1)
-        idx, g = np.divmod(flat, self.seed_grid)
-        t = self.grid_t[idx, g]
+        d2, arg = self.nearest_grid(pts)  # (V, n)
+        idx = d2.argmin(axis=1)
+        t = self.grid_t[idx, arg[np.arange(len(pts)), idx]]
         t = self._project(pts, idx, t)
         return idx, t
 
@@ -233,9 +272,8 @@ def point_signed_distance(tooth: ExactTooth, pts: np.ndarray) -> np.ndarray:
     """
     K = len(pts)
     n = tooth.n
-    d2 = tooth.grid_d2(pts)  # (K, n, G)
-    g = d2.argmin(axis=2)  # (K, n)
-    gmin = np.sqrt(d2.min(axis=2))  # (K, n): nearest grid point of each piece
+    d2, g = tooth.nearest_grid(pts)  # (K, n) each
+    gmin = np.sqrt(d2)  # (K, n): nearest grid point of each piece
     # a piece can hold the nearest point only if its nearest grid point is within one grid step of the best
     cand = gmin <= gmin.min(axis=1, keepdims=True) + tooth.grid_step[None, :]
     kk, idx = np.nonzero(cand)

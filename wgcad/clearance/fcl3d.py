@@ -3,15 +3,16 @@
 from __future__ import annotations
 
 import time
-from dataclasses import field
+from dataclasses import dataclass, field
 
 import fcl
 import manifold3d
 import numpy as np
 
 from ..placement import transform
-from ..records import record
+from ..placement.imperfect import flex_poses, rigid_translation
 from .engine import Scene
+from .imperfect_scene import ImperfectScene
 from .scene import clearance_at_poses
 
 __all__ = [
@@ -35,7 +36,7 @@ __all__ = [
 FCL_TOL = 1e-6
 
 
-@record
+@dataclass(slots=True)
 class PairCheck:
     """One rigid tooth against the flexspline tooth: FCL's distance and the 2D engine's over the sections (mm).
 
@@ -53,7 +54,7 @@ class PairCheck:
     clearance_2d_at_witness: float | None = None
 
 
-@record
+@dataclass(slots=True)
 class ToothCheck:
     """The 3D check of one flexspline tooth (:func:`check_tooth`), mm and rad; times in seconds.
 
@@ -80,7 +81,7 @@ class ToothCheck:
     tooth: int | None = None
 
 
-@record
+@dataclass(slots=True)
 class Check3D:
     """The 3D check of the pairs the 2D audit singles out (:func:`verify_worst`): a :class:`ToothCheck` per pair,
     the loft's sections (``n_sections``: 2 for the prisms of a drive without coning), whether all agree."""
@@ -480,8 +481,6 @@ def imperfect_track(drive, imp, phi_h: float, tooth: int):
     gear's own centre as :class:`~wgcad.clearance.imperfect.ImperfectScene`
     holds the rigid teeth (:func:`wgcad.placement.imperfect.flex_poses`).
     """
-    from ..placement.imperfect import flex_poses, rigid_translation
-
     centre = rigid_translation(imp)
 
     def track(z):
@@ -519,8 +518,6 @@ def verify_worst(drive, result, n_sections: int = 9, imp=None) -> Check3D:
     """
     scene = Scene(drive)
     if imp is not None:
-        from .imperfect_scene import ImperfectScene
-
         scene = ImperfectScene.from_scene(scene, imp)
     bw = float(drive.design.drive.face_width)
     zs = np.linspace(0.0, bw, max(int(n_sections), 2))

@@ -8,11 +8,9 @@ and words them for people. Nothing here formats text.
 
 from __future__ import annotations
 
-from dataclasses import field
+from dataclasses import dataclass, field
 
 import numpy as np
-
-from ..records import record
 
 __all__ = ["Finding", "FIGURES", "METHODS", "AuditRun", "ImperfectRun"]
 
@@ -27,7 +25,7 @@ METHODS = {
 }
 
 
-@record(frozen=True)
+@dataclass(frozen=True, slots=True)
 class Finding:
     """One figure of an audit and where it lies.
 
@@ -80,7 +78,7 @@ class Finding:
             raise ValueError(f"unknown method {self.method!r}")
 
 
-@record(frozen=True)
+@dataclass(frozen=True, slots=True)
 class ImperfectRun:
     """How an imperfect drive's audit swept (:func:`wgcad.clearance.imperfect.audit_imperfect`): the generator turns
     swept and the whole error cycle's, which work-skipping facts still hold (and why), the generator angles per
@@ -93,7 +91,7 @@ class ImperfectRun:
     chunk: int
 
 
-@record(frozen=True)
+@dataclass(frozen=True, slots=True)
 class AuditRun:
     """What an audit ran with, in mm and rad (the report states it in the units of its keys, with its notes).
 

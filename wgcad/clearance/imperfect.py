@@ -24,7 +24,7 @@ What still saves work (docs/models.md 7, last paragraph):
 from __future__ import annotations
 
 import time
-from dataclasses import replace
+from dataclasses import dataclass, replace
 from math import pi
 
 import numpy as np
@@ -32,10 +32,13 @@ import shapely
 
 from ..placement import transform
 from ..placement.imperfect import Imperfections, flex_poses_batch, full_cycle_turns, rigid_translation, shortcuts
-from ..records import record
 from .cascade import FINE, refine_candidates
+from .closing import closing_direct
+from .engine import AuditResult, audit_run
+from .entry import EDGES, edge_gaps, edge_index, entry_crossings, entry_pinch
 from .findings import AuditRun, Finding, ImperfectRun
 from .imperfect_bounds import ErrorBound, PerfectBound, PerfectBounds, chunk_bounds
+from .imperfect_entry import imperfect_entry
 from .imperfect_scene import ImperfectScene
 from .scene import Scene, clearance_at_poses, refine_min
 
@@ -139,8 +142,6 @@ def audit_imperfect(drive, settings, imp: Imperfections, progress=None, chunk_sa
         (:mod:`wgcad.clearance.imperfect_entry`); the backlash is the
         imperfect drive's at the first generator angle.
     """
-    from .engine import AuditResult
-
     t0 = time.perf_counter()
     run = _Run.make(drive, settings, imp, chunk_samples)
     if progress is not None:
@@ -192,7 +193,7 @@ def audit_imperfect(drive, settings, imp: Imperfections, progress=None, chunk_sa
     return res
 
 
-@record
+@dataclass(slots=True)
 class _Run:
     """What every step of an imperfect audit shares: the drive and its errors, the scenes, the samples' axes."""
 
@@ -229,7 +230,7 @@ class _Run:
         return _poses_of(self.drive, self.imp, self.angles, a_, k_, s_, self.sections)
 
 
-@record
+@dataclass(slots=True)
 class _Found:
     """The polygon search's result: its best figure, the candidates within the margin of it, what it cost."""
 
@@ -409,9 +410,6 @@ def _entry(run: _Run):
     """Every passage of a tooth through the entry in the swept angles, each with its own crossing
     (wgcad.clearance.imperfect_entry), found from the perfect drive's (polygons suffice there: they only say
     where to look). Returns the perfect drive's crossings per section and the passages' figures."""
-    from .entry import entry_crossings, entry_pinch
-    from .imperfect_entry import imperfect_entry
-
     scene, sections, angles = run.scene, run.sections, run.angles
     gaps = list(zip(entry_crossings(scene, sections, exact=False), sections))
     crossed = any(np.isfinite(g[0]) for g, _ in gaps)
@@ -426,8 +424,6 @@ def _entry(run: _Run):
 
 def _audit_run(run: _Run) -> AuditRun:
     """What the audit ran with: no shortcut of the perfect drive, and how much of the error cycle it swept."""
-    from .engine import audit_run
-
     angles = run.angles
     A = len(angles)
     sc = shortcuts(run.imp)
@@ -528,11 +524,9 @@ def _entry_findings(run: _Run, gaps, ent: dict):
 def _entry_edge(drive, imp: Imperfections, isc: ImperfectScene, phi_h: float, k: int, z, exact: bool, rigid=None):
     """The edge (working / non-working) of the entry gap of tooth ``k`` at ``phi_h``, section ``z``, and where on
     the tooth it lies: the edge facing rigid tooth ``rigid`` or, without one, the edge with the smaller gap."""
-    from .entry import EDGES, _edge_idx, edge_gaps
-
     rot, shift = flex_poses_batch(drive, imp, np.array([phi_h]), np.array([k]), [z])[0]
     shift = isc.relative(shift)
-    idx = _edge_idx(isc, rot, shift)
+    idx = edge_index(isc, rot, shift)
     if rigid is None:
         e = int(np.argmin(edge_gaps(isc, rot, shift, exact=exact)[0]))
     else:
@@ -542,8 +536,6 @@ def _entry_edge(drive, imp: Imperfections, isc: ImperfectScene, phi_h: float, k:
 
 def _backlash(drive, imp: Imperfections, phi_h: float, z) -> float:
     """Dead travel (rad) of the imperfect drive at ``phi_h``: closing rotations either way; NaN if the teeth interfere."""
-    from .closing import closing_direct
-
     if drive.design.drive.fixed != "rigid":
         return float("nan")
     up = closing_direct(drive, imp, phi_h, 1, sections=[z])

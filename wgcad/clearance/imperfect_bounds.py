@@ -15,6 +15,7 @@ import numpy as np
 
 from ..placement.imperfect import Imperfections, cam_offset, coning_factor, flex_deviations, rigid_translation
 from .scene import Scene
+from .search import SectionSearch, evaluate
 
 __all__ = ["PerfectBound", "PerfectBounds", "ErrorBound", "GRID_LOSS", "chunk_bounds"]
 
@@ -31,14 +32,12 @@ class PerfectBound:
     """
 
     def __init__(self, scene: Scene, z, settings):
-        from .search import _SectionSearch
-
         half = pi / scene.n_w
         self.V = scene.speed_bound(np.linspace(-half, half, 4097), z)  # per rad of tooth angle, every phi
         n = int(np.ceil(half * self.V / (2.0 * GRID_LOSS))) + 1
         self.h = half / (n - 1)
         self.grid = np.linspace(0.0, half, n)
-        self.search = _SectionSearch(scene, self.grid, z, settings)
+        self.search = SectionSearch(scene, self.grid, z, settings)
         self.search.prepare_bound()
         self.z, self.half = z, half
 
@@ -64,20 +63,18 @@ class PerfectBounds:
     """The perfect drive's bounds of every section (:class:`PerfectBound`), searched together: the best of any prunes all."""
 
     def __init__(self, scene: Scene, sections: list, settings):
-        from .search import _evaluate
-
-        self._evaluate = _evaluate
+        self.evaluate = evaluate
         self.scene, self.sections = scene, sections
         self.pb = [PerfectBound(scene, z, settings) for z in sections]
         self.res = [p.search for p in self.pb]
-        self.best = _evaluate(scene, self.res, [r.coarse() for r in self.res], sections)
+        self.best = evaluate(scene, self.res, [r.coarse() for r in self.res], sections)
         self.band = -np.inf
 
     def extend(self, band: float) -> None:
         """Evaluate every grid point whose bound lies below ``best + band``; the others keep bounds at least that high."""
         if band <= self.band:
             return
-        ev, sc, res, zs = self._evaluate, self.scene, self.res, self.sections
+        ev, sc, res, zs = self.evaluate, self.scene, self.res, self.sections
         for stride in (64, 16, 4, 1):
             self.best = ev(sc, res, [r.candidates(stride, self.best + band) for r in res], zs)
         self.best = ev(sc, res, [r.culled_needed(self.best + band) for r in res], zs)

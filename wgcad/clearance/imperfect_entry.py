@@ -25,8 +25,11 @@ from math import pi
 
 import numpy as np
 
+from ..drive import build_drive
+from ..placement.imperfect import flex_poses_batch
 from .entry import PINCH_STEP, lipschitz_min
-from .scene import clearance_at_poses, refine_min
+from .imperfect_scene import ImperfectScene
+from .scene import Scene, clearance_at_poses, refine_min
 
 __all__ = ["passages", "imperfect_entry", "CROSS_WINDOW"]
 
@@ -79,8 +82,6 @@ def passages(scene, p_star: float, phi_lo: float, phi_hi: float):
 
 
 def _poses(drive, imp, isc, phi_h, k, z):
-    from ..placement.imperfect import flex_poses_batch
-
     rot, shift = flex_poses_batch(drive, imp, phi_h, k, [z])[0]
     return rot, isc.relative(shift)
 
@@ -185,10 +186,6 @@ def imperfect_entry(drive, imp, isc, scene, perfect_gaps, perfect_pinch, angles,
         if len(order) > _FINE_ABOVE:
             # many alike (the same cam phase every turn): sorted out first on polygons 8 times finer, as the
             # clearance audit does
-            from ..drive import build_drive
-            from .imperfect_scene import ImperfectScene
-            from .scene import Scene
-
             fine = ImperfectScene.from_scene(Scene(build_drive(drive.design, tol=drive.tol / 8)), imp)
             vf = np.empty(len(order))
             for s in np.unique(si[order]):

@@ -176,11 +176,11 @@ def _seeds(A: ExactTooth, B: ExactTooth, sd: np.ndarray, rot, shift, margin):
     s = np.concatenate(rows_sa)
     # the B pieces that can hold the nearest point to the seed (as in point_signed_distance)
     P0 = rotate(A.eval(ia, s, order=0)[0], rot[kk]) + shift[kk]
-    d2 = B.grid_d2(P0)  # (m, nB, G)
-    gmin = np.sqrt(d2.min(axis=2))
+    d2, g = B.nearest_grid(P0)  # (m, nB) each
+    gmin = np.sqrt(d2)
     cand = gmin <= gmin.min(axis=1, keepdims=True) + B.grid_step[None, :]
     row, ib = np.nonzero(cand)
-    t = B.grid_t[ib, d2[row, ib].argmin(axis=1)]
+    t = B.grid_t[ib, g[row, ib]]
     kk, ia, s = kk[row], ia[row], s[row]
 
     return kk, ia, s, ib, t

@@ -374,6 +374,3 @@ def classify(scene: Scene, pts: np.ndarray, rigid_idx: int, phi: float, z) -> st
         return "root"
     side = "upper" if loc[1] > 0 else "lower"
     return "working flank" if side == scene.working else "non-working flank"
-
-
-_classify = classify

@@ -2,18 +2,18 @@
 
 from __future__ import annotations
 
+from dataclasses import dataclass
 from math import pi
 
 import numpy as np
 
 from .. import constants
-from ..records import record
 from .scene import Scene, tooth_clearance_sections
 
 __all__ = ["AuditSettings", "SectionSearch", "evaluate", "sample_phi", "fold"]
 
 
-@record(frozen=True)
+@dataclass(frozen=True, slots=True)
 class AuditSettings:
     """What an audit computes.
 
@@ -43,18 +43,18 @@ class AuditSettings:
     refine: bool = True
 
 
-def _sample_phi(scene: Scene, angles: np.ndarray) -> np.ndarray:
+def sample_phi(scene: Scene, angles: np.ndarray) -> np.ndarray:
     """Tooth angles from the major axis for every (generator angle, tooth): ``(A, z_g)``, rad."""
     k = np.arange(scene.z_g)
     mat = 2 * pi * k[None, :] / scene.z_g + angles[:, None] / scene.ratios["u_hg"]
     return mat - angles[:, None]
 
 
-def _fold(phi: np.ndarray, period: float) -> np.ndarray:
+def fold(phi: np.ndarray, period: float) -> np.ndarray:
     return (phi + 0.5 * period) % period - 0.5 * period
 
 
-class _SectionSearch:
+class SectionSearch:
     """Branch and bound for the smallest sampled clearance of one section (module docstring)."""
 
     def __init__(self, scene: Scene, phi_u: np.ndarray, z, settings: AuditSettings):
@@ -122,7 +122,7 @@ class _SectionSearch:
 _CHUNK = 4096
 
 
-def _evaluate(scene: Scene, searches: list, picks: list, zs: list, done=None) -> float:
+def evaluate(scene: Scene, searches: list, picks: list, zs: list, done=None) -> float:
     """Evaluate the picked samples of every section in batches; return the best value so far."""
     phis = np.concatenate([r.phi[ix] for r, ix in zip(searches, picks)])
     if phis.size:
@@ -143,6 +143,3 @@ def _evaluate(scene: Scene, searches: list, picks: list, zs: list, done=None) ->
             r.evaluated[ix] = True
             at += n
     return min(r.best() for r in searches)
-
-
-SectionSearch, evaluate, sample_phi, fold = _SectionSearch, _evaluate, _sample_phi, _fold

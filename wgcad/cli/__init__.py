@@ -12,10 +12,13 @@ import sys
 for _var in ("OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
     os.environ.setdefault(_var, "1")
 
+import importlib
+import traceback
+
 from .. import __version__
 from ..errors import WgcadError
-from . import audit, design, generate, ke, kinematics, parts, rating, sector, sweep
 from .common import (  # noqa: F401
+    COMMAND_HELP,
     EPILOG,
     EXIT_INPUT,
     EXIT_INTERFERENCE,
@@ -32,14 +35,18 @@ from .common import circle as _circle  # noqa: F401  (tests/test_cli.py reaches 
 __all__ = ["main", "build_parser", "EXIT_OK", "EXIT_INTERFERENCE", "EXIT_INPUT", "EXIT_INTERNAL"]
 
 #: the subcommands, each the module of this package named as the command, in the order the help lists them
-COMMANDS = {
-    mod.__name__.rsplit(".", 1)[1]: mod
-    for mod in (generate, audit, kinematics, ke, rating, sector, parts, sweep, design)
-}
+COMMANDS = tuple(COMMAND_HELP)
 
 
-def build_parser(only: str | None = None) -> argparse.ArgumentParser:
-    """The whole command line's parser; with ``only``, one command's alone (what a line naming it needs)."""
+def build_parser(command: str | None = None) -> argparse.ArgumentParser:
+    """The command line's parser: every subcommand's flags, or with ``command`` only that one's.
+
+    A subcommand's module imports the pipeline it runs at its top, so registering all ten loads every model,
+    exporter and the synthesis (~500 modules); :func:`main` registers only the command named on its command
+    line (the others are listed, with their one line of help, for ``wgcad --help`` and for argparse's
+    messages). ``wgcad audit templates/d1_involute.toml`` then loads 385 modules instead of 519 and takes a
+    quarter less time (1.2-1.3 s against 1.7-1.8 s whole process on 2 cores at load ~2).
+    """
     p = Parser(
         prog="wgcad",
         description="Geometry, deformation and clearance of harmonic (strain-wave) drives.",
@@ -57,11 +64,13 @@ def build_parser(only: str | None = None) -> argparse.ArgumentParser:
         required=True,
         parser_class=Parser,
         metavar="COMMAND",
-        help="generate, audit, kinematics, ke, rating, sector, parts, sweep or design; wgcad COMMAND --help for its flags",
+        help="generate, audit, kinematics, ke, rating, sector, parts, sweep, design or templates; wgcad COMMAND --help for its flags",
     )
-    for name, mod in COMMANDS.items():
-        if only is None or name == only:
-            mod.register(sub)
+    for name in COMMANDS:
+        if command is None or name == command:
+            importlib.import_module(f"{__name__}.{name}").register(sub)
+        else:
+            sub.add_parser(name, help=COMMAND_HELP[name], add_help=False)
     # accepted after the subcommand too (wgcad audit D --traceback): users put it where the other flags are
     for sp in sub.choices.values():
         sp.add_argument(
@@ -71,18 +80,6 @@ def build_parser(only: str | None = None) -> argparse.ArgumentParser:
             help="on an internal error (exit 3) also print the Python traceback on stderr",
         )
     return p
-
-
-def _named_command(argv: list) -> str | None:
-    """The command a line names, if nothing before it needs every command's parser (help, the version, a name
-    that is no command); else None. Registering that command alone saves building eight parsers (~2.5 ms of every
-    start); the line parses the same (tests/test_cli.py)."""
-    for token in argv:
-        if token in ("-h", "--help", "--version", "--"):
-            return None
-        if not token.startswith("-"):
-            return token if token in COMMANDS else None
-    return None
 
 
 def _quiet_stdout() -> None:
@@ -98,16 +95,20 @@ def _quiet_stdout() -> None:
 def main(argv=None) -> int:
     """Entry point of the ``wgcad`` command; returns the exit code.
 
-    Exit codes: 0 success, 1 interference or baseline drift (audit), 2 bad
+    Exit codes: 0 success, 1 a verdict failed (audit: interference, drift, the entry gap closing; sector, rating,
+    design: each command's ``--help`` says what), 2 bad
     input (one line on stderr, nothing written), 3 internal error (one line
     asking for a report; the traceback with ``--traceback`` or
     ``WGCAD_TRACEBACK=1``), 4 the model could not answer (no convergence, or
-    the drive outside it: one line, nothing written), 128 + signal number when interrupted (SIGINT,
+    the drive outside it: one line, nothing written), 5 an optional extra the command needs is not installed (one
+    line naming it: ``pip install 'wgcad[EXTRA]'``), 6 the results folder of ``sweep`` or ``design`` held by
+    another live run, 128 + signal number when interrupted (SIGINT,
     SIGTERM, SIGHUP: temporary files are removed first).
     """
     argv = sys.argv[1:] if argv is None else list(argv)
-    parser = build_parser(only=_named_command(argv))
-    args = parser.parse_args(argv)
+    # the command is the first word that is not a flag (the global flags take no value)
+    named = next((a for a in argv if not a.startswith("-")), None)
+    args = build_parser(named if named in COMMANDS else None).parse_args(argv)
     show_tb = args.traceback or os.environ.get(TRACEBACK_ENV, "") not in ("", "0")
     try:
         with signals_raise():
@@ -127,8 +128,6 @@ def main(argv=None) -> int:
         return 141  # 128 + SIGPIPE, what a shell reports for a process killed by it
     except Exception as e:  # noqa: BLE001 (the one place that turns bugs into a clear exit)
         if show_tb:
-            import traceback
-
             traceback.print_exc()
         print(internal_error_line(e), file=sys.stderr)
         return EXIT_INTERNAL
@@ -137,28 +136,16 @@ def main(argv=None) -> int:
 def run() -> None:
     """The process entry point (``wgcad`` and ``python -m wgcad``): :func:`main`, then exit with its code.
 
-    A finished run leaves by ``os._exit`` once its streams are flushed and its ``atexit`` handlers have run:
-    CPython's finalisation, tearing down numpy, shapely and every module, does nothing a finished run needs and
-    costs ~20 ms of a 0.25 s audit (farm-bench, paired). Where a thread other than daemon helpers is still alive
-    (a dask cluster's), the interpreter's own exit joins it. An interrupted run leaves by ``os._exit`` too: the
-    clean-up has already run in :func:`main`, and a normal ``sys.exit`` would let CPython's finalisation turn the
-    exit into death by SIGINT (return code -2 instead of the documented 130) whenever the Ctrl-C landed inside
-    code that an extension ran through ``PyRun_*`` (measured: 2-5 of 40 interrupted ``python -m wgcad generate``
-    runs). A reader of stdout gone by the last flush gives 141, as one gone earlier.
+    The output is flushed first, so a reader of stdout gone by the last flush gives 141, as one gone earlier.
+    An interrupted run leaves by ``os._exit``: the clean-up has already run in :func:`main`, and a normal exit
+    would let CPython's finalisation turn the exit into death by SIGINT (return code -2 instead of the documented
+    130) whenever the Ctrl-C landed inside code that an extension ran through ``PyRun_*`` (measured: 2-5 of 40
+    interrupted ``python -m wgcad generate`` runs).
     """
-    code = main()
-    code = _flush(code)
+    code = _flush(main())
     if code > 128 and code != 141:  # 128 + SIGINT, SIGTERM or SIGHUP (141, SIGPIPE, closed its stdout)
         os._exit(code)
-    import atexit
-    import threading
-
-    others = [t for t in threading.enumerate() if t is not threading.main_thread() and not t.daemon]
-    run_exitfuncs = getattr(atexit, "_run_exitfuncs", None)
-    if others or run_exitfuncs is None:
-        sys.exit(code)
-    run_exitfuncs()
-    os._exit(_flush(code))
+    sys.exit(code)
 
 
 def _flush(code: int) -> int:

@@ -2,27 +2,45 @@
 
 from __future__ import annotations
 
+import argparse
 import os
 import sys
+import textwrap
 
-from ..errors import DesignError
+from ..audit import FLAGS, RunSettings
+from ..errors import DesignError, OutputError
+from ..export.audit_files import plot_paths, write_audit_files
 from ..export.json_text import json_text
-from .common import EXIT_INTERFERENCE, EXIT_OK, add_memory_flag, angle_count, epilog, positive_float, whole_number
+from ..regression import format_drifts, load_baseline
+from ..report.audit import audit_summary
+from ..report.audit_run import audit_document, baseline_document
+from ..report.sections import section_lines
+from .bounds import bounded
+from .common import (
+    COMMAND_HELP,
+    EXIT_INTERFERENCE,
+    EXIT_OK,
+    Progress,
+    add_memory_flag,
+    angle_count,
+    epilog,
+    require_picture_extras,
+    want_progress,
+    whole_number,
+)
+from .load import register_args, run_load
+from .outputs import STDOUT, check_output_file, write_stdout
 
 __all__ = ["register", "cmd_audit"]
 
 
 def _audit_summary(name: str, res: dict) -> str:
-    from ..report.audit import audit_summary  # shaped in the report layer (issue 8)
-
     return audit_summary(name, res)
 
 
 def _check_outputs(args) -> None:
     """Every output path is judged before the design is read: a refused run computes and writes nothing."""
-    from ..errors import OutputError
-    from .outputs import STDOUT, check_output_file
-
+    require_picture_extras(args)
     inputs = [args.design, args.baseline]
     if args.json == STDOUT and args.write_baseline == STDOUT:
         raise OutputError("--json - and --write-baseline -: only one of them can go to standard output")
@@ -31,7 +49,6 @@ def _check_outputs(args) -> None:
     if args.plot:
         if args.plot == STDOUT:
             raise OutputError("--plot: writes three PNG files, so it needs a path, not - (standard output)")
-        from ..export.audit_files import plot_paths
 
         targets += [("--plot", p) for _, p in plot_paths(args.plot)]
     if args.html:
@@ -50,8 +67,6 @@ def _check_outputs(args) -> None:
 
 def _run_settings(args, base: dict | None):
     """The run's settings: a baseline's (its figures are only comparable at its own), else the flags'."""
-    from ..audit import RunSettings
-
     if base is not None:
         st = base["settings"]
         return RunSettings(
@@ -81,34 +96,25 @@ def _run_settings(args, base: dict | None):
 
 def cmd_audit(args) -> int:
     if args.torque_nm is not None:  # under load: cli/load.py
-        from .load import run_load
-
         if args.by_section:
             raise DesignError("--by-section", "audits the unloaded drive; the load audit reports every section already")
 
         _check_outputs(args)
         return run_load(args)
-    from .common import Progress, want_progress
-    from .outputs import STDOUT, write_stdout
 
     bar = Progress(want_progress(args.progress) and (args.progress or not args.quiet))
     bar.start("loading modules")
     _check_outputs(args)
-    from ..audit import FLAGS
 
     bar.set(0.0, "reading the design")
 
     base = None
     if args.baseline:
-        from ..regression import load_baseline
-
         base = load_baseline(args.baseline)
     rs = _run_settings(args, base)
     rs.check(FLAGS)
     # the engine reports (done, total, stage); it fills the bar up to 90 % (95 % without pictures)
     work_end = 0.6 if args.plot else (0.9 if args.engine == "2d" else 0.8)
-    from ..export.audit_files import write_audit_files
-    from ..report.audit_run import audit_document, baseline_document
 
     try:
         run = audit_document(
@@ -148,15 +154,11 @@ def cmd_audit(args) -> int:
         stream = sys.stderr if STDOUT in (args.json, args.write_baseline) else sys.stdout
         lines = [_audit_summary(res["design"], res)]
         if "by_section" in res:
-            from ..report.sections import section_lines
-
             lines += section_lines(res["by_section"], res.get("balanced_taper"))
         lines += [f"  NOT CHECKED: {n}" for n in res["not_checked"]]
         if "fcl" in res:
             lines.append(f"  FCL 3D check of the pairs the 2D engine singled out: {res['fcl']['summary']}")
         if drifts is not None:
-            from ..regression import format_drifts
-
             lines.append(f"  baseline {args.baseline}: {format_drifts(drifts)}")
         if stream is sys.stdout:
             write_stdout("\n".join(lines) + "\n")
@@ -167,12 +169,9 @@ def cmd_audit(args) -> int:
 
 def register(sub) -> None:
     """Add the subcommand to the ``wgcad`` parser's subparsers."""
-    import argparse
-    import textwrap
-
     a = sub.add_parser(
         "audit",
-        help="clearance and interference over the generator cycle; exit 1 on interference or baseline drift",
+        help=COMMAND_HELP["audit"],
         description=textwrap.fill(
             "Signed clearance of every flexspline tooth against its rigid neighbours over a full generator "
             "revolution (and several sections when coned): the worst spot, entry gap and pinch, backlash. "
@@ -186,6 +185,7 @@ def register(sub) -> None:
         epilog=epilog(
             one="interference found, or drift from --baseline; with --torque-nm: the entry gap closes under the load",
             model="only with --torque-nm: the elastic model",
+            five="--plot needs wgcad[plots], --html wgcad[html]",
         ),
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
@@ -193,7 +193,7 @@ def register(sub) -> None:
     grp = a.add_mutually_exclusive_group()
     grp.add_argument("--angles", type=angle_count, metavar="N", help="N generator angles over a full revolution")
     grp.add_argument(
-        "--step-deg", type=positive_float(0.0, 90.0, "deg"), default=0.5, help="generator-angle step, deg (default 0.5)"
+        "--step-deg", type=bounded("audit", "--step-deg"), default=0.5, help="generator-angle step, deg (default 0.5)"
     )
     a.add_argument(
         "--turns",
@@ -205,7 +205,7 @@ def register(sub) -> None:
     )
     a.add_argument(
         "--sections",
-        type=int,
+        type=bounded("audit", "--sections"),
         default=3,
         metavar="N",
         help="cross-sections over the face width when the flexspline is coned, 1..200 (default 3)",
@@ -218,13 +218,13 @@ def register(sub) -> None:
     )
     a.add_argument(
         "--chord-tol-um",
-        type=positive_float(0.0, 100.0, "um"),
+        type=bounded("audit", "--chord-tol-um"),
         default=1.0,
         help="largest distance between outline and exact curve, um (default 1)",
     )
     a.add_argument(
         "--interference-tol-um",
-        type=float,
+        type=bounded("audit", "--interference-tol-um"),
         default=1.0,
         metavar="UM",
         help="penetration still reported as contact, not interference, um, 0..1000 (default 1)",
@@ -245,7 +245,6 @@ def register(sub) -> None:
     )
     a.add_argument("--quiet", action="store_true", help="print no summary")
     add_memory_flag(a)
-    from .load import register_args
 
     register_args(a)
     a.set_defaults(func=cmd_audit)

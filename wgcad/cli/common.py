@@ -6,11 +6,20 @@ import argparse
 import contextlib
 import math
 import os
+import re
 import signal
 import sys
+import traceback
+from dataclasses import fields
 from pathlib import Path
 
-from ..errors import WgcadError
+from ..design.budget import DEFAULT_MAX_MEMORY_MB
+from ..design.rules import key_meta
+from ..design.schema import TABLES
+from ..errors import EXIT_BUSY, WgcadError
+from ..extras import require
+from ..plane import circle_polygon
+from .bounds import bounded
 from .progress import Progress
 
 __all__ = [
@@ -19,11 +28,14 @@ __all__ = [
     "EXIT_INPUT",
     "EXIT_INTERNAL",
     "EXIT_MODEL",
+    "EXIT_DEPENDENCY",
+    "EXIT_BUSY",
     "EPILOG",
     "epilog",
     "TRACEBACK_ENV",
     "Parser",
     "angles_deg",
+    "flag_value",
     "positive_float",
     "angle_count",
     "out_dir",
@@ -33,14 +45,33 @@ __all__ = [
     "signals_raise",
     "internal_error_line",
     "want_progress",
+    "require_picture_extras",
     "add_memory_flag",
+    "scheduler_address",
 ]
 
+#: every subcommand in the order the help lists them, with its one line there (the commands' modules are
+#: imported only for the command that runs: wgcad.cli.build_parser)
+COMMAND_HELP = {
+    "generate": "write DXF, STL, <design>.report.json (and deformed-state DXF/PNG) for a design",
+    "audit": "clearance and interference over the generator cycle; exit 1 on interference or baseline drift",
+    "kinematics": "gear ratios; velocities of the external ring generator (CSV + PNG)",
+    "ke": "no-load kinematic error, lost motion and the installation-angle lever of an imperfect drive",
+    "rating": "datasheet: rated torque and the criterion that binds it, stresses, stiffness, ratcheting, bearing life",
+    "sector": "discrete-motion drive: sectored rigid gear, variable tooth heights, motion law, audit",
+    "parts": "write the parts a shop makes: cup flexspline, generator plug, rigid gear (DXF, SVG, STL, 3MF, STEP)",
+    "sweep": "tolerance Monte Carlo or design study over a sweep spec, on Dask; resumable",
+    "design": "search the free keys of a requirements file for drives that meet it; resumable, on Dask",
+    "templates": "list the bundled templates, or copy them into a folder (--copy DIR)",
+}
+
+
 EXIT_OK = 0
-EXIT_INTERFERENCE = 1  # reserved for `wgcad audit`: interference found or baseline drift
+EXIT_INTERFERENCE = 1  # a verdict failed (audit, sector, rating, design: each command's --help says which)
 EXIT_INPUT = 2  # bad design file, flag or output path; nothing written
 EXIT_INTERNAL = 3  # an unexpected error inside wgcad (a bug): one line, a request for a report
 EXIT_MODEL = 4  # valid input the model could not answer: it did not converge or the drive is outside it
+EXIT_DEPENDENCY = 5  # the command needs an optional extra that is not installed (the message names it)
 
 #: set to 1 to get the Python traceback of an internal error (same as --traceback)
 TRACEBACK_ENV = "WGCAD_TRACEBACK"
@@ -52,16 +83,24 @@ _CODES = {
     4: "the model could not answer: it did not converge, or the drive lies outside what it represents (one\n"
     "       line saying what to change; the input itself is valid; nothing written)",
 }
+_BUSY = "the results folder (--out) is held by another live run (one line naming its pid; nothing written)"
 _SIGNALS = (
     "  130  interrupted (Ctrl-C); 143 SIGTERM; 129 SIGHUP: temporary files removed, nothing half-written\n"
     "  141  standard output closed by its reader (e.g. | head)\n"
 )
 
 
-def epilog(one: str | None = None, model: str | None = None, four: str | None = None) -> str:
+def epilog(
+    one: str | None = None,
+    model: str | None = None,
+    four: str | None = None,
+    five: str | None = None,
+    busy: bool = False,
+) -> str:
     """The exit codes a command can return, for its ``--help``: 1 only where the command has a verdict (``one``
     says what it means), 4 only where a model can fail to answer (``model`` says when) or, ``four``, what 4
-    means for this command instead."""
+    means for this command instead; 5 where an optional extra is needed (``five`` says for what); 6 (``busy``)
+    where the command holds its results folder."""
     lines = ["exit codes:", f"  0    {_CODES[0]}"]
     if one:
         lines.append(f"  1    {one}")
@@ -70,43 +109,38 @@ def epilog(one: str | None = None, model: str | None = None, four: str | None = 
         lines.append(f"  4    {_CODES[4]} ({model})")
     elif four:
         lines.append(f"  4    {four}")
+    if five:
+        lines.append(f"  5    an optional extra is not installed ({five})")
+    if busy:
+        lines.append(f"  6    {_BUSY}")
     return "\n".join(lines) + "\n" + _SIGNALS
 
 
 #: every code of every command (the top-level help)
 EPILOG = epilog(
     one="a verdict failed: interference or drift from --baseline (audit), the entry gap closes (audit --torque-nm), "
-    "teeth meet tip to tip (sector)",
-    model="the elastic model (--torque-nm), a KE of teeth that never touch",
+    "teeth still meet with the built heights (sector), no rated torque: a criterion fails at no load (rating), no "
+    "candidate met every requirement (design)",
+    model="audit and ke with --torque-nm, rating: the elastic model; ke: teeth that never touch; sweep: the Dask "
+    "cluster failed, the chunks done are kept, run again to resume",
+    five="the command's optional extra: wgcad[plots] for pictures, [html] for --html, [sweep], [design], "
+    "[cad] for STEP; the line names it",
+    busy=True,
 )
 
 
-def terminal_columns() -> int:
-    """``shutil.get_terminal_size().columns`` without loading ``shutil`` (and with it ``zlib``, ``bz2`` and
-    ``lzma``, ~1.7 ms of every start): ``COLUMNS`` if a positive integer, else the width of the terminal on
-    standard output, else 80."""
-    try:
-        columns = int(os.environ["COLUMNS"])
-    except (KeyError, ValueError):
-        columns = 0
-    if columns <= 0:
-        try:
-            columns = os.get_terminal_size(sys.__stdout__.fileno()).columns
-        except (AttributeError, ValueError, OSError):
-            columns = 0
-    return columns or 80
-
-
 class Parser(argparse.ArgumentParser):
-    """argparse with one-line errors and exit code 2, no usage dump."""
+    """argparse with one-line errors and exit code 2, no usage dump, and negative numbers as values."""
+
+    def __init__(self, *args, **kwargs):
+        super().__init__(*args, **kwargs)
+        # a word that starts with a minus and a digit is a value (-3000:0:500, -30,-15, -1e-3), not an unknown
+        # option: argparse's own test takes only -N and -N.N (Python 3.13 widened it to this). No wgcad option
+        # looks like a number, so nothing else changes; the inf and nan spellings are values too (refused by rule)
+        self._negative_number_matcher = re.compile(r"^-(\.?\d|inf|nan)", re.IGNORECASE)
 
     def error(self, message):  # noqa: D401
         self.exit(EXIT_INPUT, f"wgcad: error: {message}\n")
-
-    def _get_formatter(self):
-        # argparse makes a formatter for every flag it adds (to check the flag's metavar); the width argparse
-        # itself would take (the terminal's less 2), from terminal_columns
-        return self.formatter_class(prog=self.prog, width=terminal_columns() - 2)
 
 
 class _UsageError(WgcadError, ValueError):
@@ -147,8 +181,6 @@ def signals_raise():
 
 def internal_error_line(exc: BaseException) -> str:
     """One line for an unexpected exception: what, where in wgcad, and what to do."""
-    import traceback
-
     what = " ".join(str(exc).split()) or "(no message)"
     if len(what) > 200:
         what = what[:197] + "..."
@@ -167,6 +199,22 @@ def internal_error_line(exc: BaseException) -> str:
     )
 
 
+def require_picture_extras(args) -> None:
+    """``--plot`` needs matplotlib (``[plots]``), ``--html`` plotly (``[html]``): refused in one line (exit 5) before
+    any work, rather than after minutes of it."""
+    if getattr(args, "plot", None):
+        require("plots", what="--plot")
+    if getattr(args, "html", None):
+        require("html", what="--html")
+
+
+def scheduler_address(text: str) -> str:
+    """The ``--scheduler`` flag of ``sweep`` and ``design``: a Dask scheduler's ``tcp://HOST:PORT`` (or ``tls://``)."""
+    if not (text.startswith("tcp://") or text.startswith("tls://")) or ":" not in text[6:]:
+        raise argparse.ArgumentTypeError(f"expected tcp://HOST:PORT (or tls://), got '{text}'")
+    return text
+
+
 def want_progress(flag: bool) -> bool:
     """The bar is drawn when asked for, or when stderr is a terminal."""
     if flag:
@@ -177,21 +225,29 @@ def want_progress(flag: bool) -> bool:
         return False
 
 
+def flag_value(parse, text: str):
+    """``parse(text)`` as an argparse type: its :class:`~wgcad.errors.DesignError` becomes argparse's one-line refusal
+    (``argument --FLAG: RULE``, exit 2), which argparse shows only for its own ArgumentTypeError."""
+    from ..errors import DesignError
+
+    try:
+        return parse(text)
+    except DesignError as e:
+        raise argparse.ArgumentTypeError(e.rule) from None
+
+
 def angles_deg(text: str) -> list[float]:
-    out = []
-    for part in text.split(","):
-        part = part.strip()
-        try:
-            val = float(part)
-        except ValueError:
-            raise argparse.ArgumentTypeError(f"'{part}' is not a number (degrees, comma separated)") from None
-        if not -3600.0 <= val <= 3600.0:
-            raise argparse.ArgumentTypeError(f"{val:g} deg is outside [-3600, 3600]")
-        if val == 0.0:
-            val = 0.0  # -0 is 0
-        if val not in out:
-            out.append(val)
-    return out
+    """``--generator-angle``: degrees as a value, a comma list or START:STOP:STEP (:func:`wgcad.numbers.read_values`,
+    at most :data:`~wgcad.constants.MAX_GENERATOR_ANGLES`), each in [-3600, 3600]; repeats dropped, -0 is 0."""
+    from ..constants import MAX_GENERATOR_ANGLES
+    from ..numbers import read_values
+
+    def parse(t: str) -> list[float]:
+        return read_values(
+            "--generator-angle", t, what="angles", unit="deg", max_count=MAX_GENERATOR_ANGLES, lo=-3600.0, hi=3600.0
+        )
+
+    return list(dict.fromkeys(v + 0.0 for v in flag_value(parse, text)))  # + 0.0: -0 is 0
 
 
 def positive_float(lo: float, hi: float, unit: str):
@@ -209,15 +265,9 @@ def positive_float(lo: float, hi: float, unit: str):
 
 def key_float(table: str, key: str):
     """An argparse type for a flag that sets design key ``[table] key``: the key's own bounds and unit
-    (:mod:`wgcad.design.rules`), so a flag and its key accept the same values. The schema is read only when the
-    flag is given (``wgcad --help`` stays light)."""
+    (:mod:`wgcad.design.rules`), so a flag and its key accept the same values."""
 
     def conv(text: str) -> float:
-        from dataclasses import fields
-
-        from ..design.rules import key_meta
-        from ..design.schema import TABLES
-
         meta = key_meta(next(f for f in fields(TABLES[table]) if f.name == key))
         lo, hi, unit = float(meta["lo"]), float(meta["hi"]), meta.get("unit") or ""
         try:
@@ -259,11 +309,9 @@ angle_count = whole_number(4, 3_600_000, "angles per revolution")
 
 def add_memory_flag(parser) -> None:
     """``--max-memory-mb``: the memory budget a run is judged against before it starts (wgcad.design.budget)."""
-    from ..design.budget import DEFAULT_MAX_MEMORY_MB
-
     parser.add_argument(
         "--max-memory-mb",
-        type=positive_float(0.0, 1e7, "MB"),
+        type=bounded("*", "--max-memory-mb"),
         default=DEFAULT_MAX_MEMORY_MB,
         help=f"refuse a run whose estimated memory exceeds this, MB (default {DEFAULT_MAX_MEMORY_MB:g})",
     )
@@ -275,6 +323,4 @@ def out_dir(args, design_path: str) -> Path:
 
 def circle(radius: float, tol: float):
     """The rim circle as a polygon within ``tol`` (mm): :func:`wgcad.plane.circle_polygon`."""
-    from ..plane import circle_polygon
-
     return circle_polygon(radius, tol)

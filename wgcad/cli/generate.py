@@ -2,31 +2,37 @@
 
 from __future__ import annotations
 
+import argparse
 import sys
+import textwrap
 import time
 
+from ..design import load_design
+from ..drive import build_drive
+from ..export.drive_files import write_drive_files
 from ..export.json_text import json_text
-from .common import EXIT_OK, add_memory_flag, angles_deg, epilog, out_dir, positive_float
+from ..extras import require
+from ..report import format_summary
+from .bounds import bounded
+from .common import COMMAND_HELP, EXIT_OK, Progress, add_memory_flag, angles_deg, epilog, out_dir, want_progress
+from .outputs import check_output_dir, write_stdout
 
 __all__ = ["register", "cmd_generate"]
 
 
 def cmd_generate(args) -> int:
-    from .common import Progress, want_progress
-    from .outputs import check_output_dir, write_stdout
-
+    if args.generator_angle:
+        require("plots", what="--generator-angle")  # the deformed assembly's picture
     t0 = time.perf_counter()
     bar = Progress(want_progress(args.progress) and (args.progress or not args.quiet))
     bar.start("loading modules")
-    from ..design import load_design
-    from ..drive import build_drive
-    from ..export.drive_files import write_drive_files
-    from ..report import format_summary
 
+    out = check_output_dir(out_dir(args, args.design))  # before any work
     bar.set(0.0, "reading the design")
     design = load_design(args.design)
-    drive = build_drive(design, tol=args.chord_tol_um * 1e-3, max_memory_mb=args.max_memory_mb, run={"exports": True})
-    out = check_output_dir(out_dir(args, args.design))
+    # the STL meshes dominate what the exports add (wgcad.design.budget)
+    run = {"exports": not args.no_stl}
+    drive = build_drive(design, tol=args.chord_tol_um * 1e-3, max_memory_mb=args.max_memory_mb, run=run)
     res = write_drive_files(
         drive,
         args.design,
@@ -57,12 +63,9 @@ def cmd_generate(args) -> int:
 
 def register(sub) -> None:
     """Add the subcommand to the ``wgcad`` parser's subparsers."""
-    import argparse
-    import textwrap
-
     g = sub.add_parser(
         "generate",
-        help="write DXF, STL, <design>.report.json (and deformed-state DXF/PNG) for a design",
+        help=COMMAND_HELP["generate"],
         description=textwrap.fill(
             "Write the manufacturing files of a design into one folder: <design>.dxf, "
             "<design>_flexspline.stl, <design>_rigid.stl, <design>.report.json and, per --generator-angle, "
@@ -72,7 +75,7 @@ def register(sub) -> None:
             "and the temporary files a killed run left (.<file>.<pid>-<hex>.tmp).",
             width=79,
         ),
-        epilog=epilog(),
+        epilog=epilog(five="the --generator-angle pictures need wgcad[plots]"),
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     g.add_argument("design", help="design file (TOML), e.g. templates/d1_involute.toml")
@@ -81,7 +84,7 @@ def register(sub) -> None:
     )
     g.add_argument(
         "--chord-tol-um",
-        type=positive_float(0.0, 100.0, "um"),
+        type=bounded("generate", "--chord-tol-um"),
         default=1.0,
         help="largest distance between outline and exact curve, um (default 1)",
     )

@@ -2,12 +2,34 @@
 
 from __future__ import annotations
 
+import argparse
 from pathlib import Path
 
 from wgcad.units import ARCSEC_PER_RAD
 
+from ..atomic import atomic_batch, check_writable_dir
+from ..design import load_design
+from ..design.load import require_bearing
+from ..drive import build_drive
+from ..errors import DesignError, OutputError
 from ..export.json_text import json_text
-from .common import EXIT_OK, epilog, positive_float, whole_number
+from ..export.ke_figures import ke_pngs
+from ..export.ke_html import ke_html
+from ..placement.imperfect import Imperfections
+from ..report.ke_run import add_install_scan, add_loaded, no_load
+from .bounds import bounded
+from .common import (
+    COMMAND_HELP,
+    EXIT_OK,
+    Progress,
+    epilog,
+    flag_value,
+    require_picture_extras,
+    want_progress,
+    whole_number,
+)
+from .load import torque_levels
+from .outputs import STDOUT, check_output_file
 
 __all__ = ["register", "cmd_ke"]
 
@@ -15,35 +37,22 @@ _AS = ARCSEC_PER_RAD
 
 
 def cmd_ke(args) -> int:
+    require_picture_extras(args)
 
-    from ..atomic import atomic_batch, check_writable_dir
-    from ..design import load_design
-    from ..drive import build_drive
-    from ..placement.imperfect import Imperfections
-
-    if args.torque_nm is not None:
-        _torques(args.torque_nm)  # bad torques are refused before any work
-    design = load_design(args.design)
-    drive = build_drive(design, tol=args.chord_tol_um * 1e-3)
-    imp = Imperfections.from_spec(design.imperfections)
-    if args.torque_nm is not None:
-        from ..design.load import require_bearing
-
-        require_bearing(design)  # ... and a design the elastic model cannot build
+    # the output paths are judged before any work (the gears are built next)
     if args.plot:
         check_writable_dir(Path(args.plot).parent if str(Path(args.plot).parent) else Path("."))
     if args.json:
         check_writable_dir(Path(args.json).parent if str(Path(args.json).parent) else Path("."))
     if args.html:
-        from .outputs import STDOUT, check_output_file
-
         if args.html == STDOUT:
-            from ..errors import OutputError
-
             raise OutputError("--html: writes a page, so it needs a path, not - (standard output)")
         check_output_file(args.html, flag="--html", inputs=[args.design])
-    from ..report.ke_run import add_install_scan, add_loaded, no_load
-    from .common import Progress, want_progress
+    design = load_design(args.design)
+    if args.torque_nm is not None:
+        require_bearing(design)  # a design the elastic model cannot build is refused before any work
+    drive = build_drive(design, tol=args.chord_tol_um * 1e-3)
+    imp = Imperfections.from_spec(design.imperfections)
 
     bar = Progress(want_progress(args.progress))
     bar.start("contact table")
@@ -53,7 +62,7 @@ def cmd_ke(args) -> int:
     if args.torque_nm is not None:
         lines = add_loaded(
             run,
-            _torques(args.torque_nm),
+            args.torque_nm,
             samples=args.load_samples,
             install=args.optimize_install_angle,
             bar=Progress(want_progress(False)),
@@ -65,12 +74,8 @@ def cmd_ke(args) -> int:
         if args.json:
             Path(batch.temp_path(Path(args.json))).write_text(json_text(run.doc))
         if args.html:
-            from ..export.ke_html import ke_html
-
             Path(batch.temp_path(Path(args.html))).write_text(ke_html(run), encoding="utf-8")
         if args.plot:
-            from ..export.ke_figures import ke_pngs
-
             stem = Path(args.plot)
             for suffix, png in ke_pngs(run).items():
                 Path(batch.temp_path(stem.with_name(stem.name + suffix + ".png"))).write_bytes(png)
@@ -78,23 +83,27 @@ def cmd_ke(args) -> int:
 
 
 def _torques(text: str) -> list:
-    from ..errors import DesignError
-    from .load import torque_levels
+    """The ``--torque-nm`` type of ``ke``: torque levels (:func:`wgcad.cli.load.torque_levels`), each > 0, judged
+    while the line is parsed."""
 
-    torques = torque_levels(text)
-    if any(t <= 0 for t in torques):
-        raise DesignError("--torque-nm", "the loaded KE needs torques > 0 N m (no load is the KE without the flag)")
-    return torques
+    def parse(t: str) -> list:
+        torques = torque_levels(t)
+        if any(v <= 0 for v in torques):
+            raise DesignError("--torque-nm", "the loaded KE needs torques > 0 N m (no load is the KE without the flag)")
+        return torques
+
+    return flag_value(parse, text)
 
 
 def register(sub) -> None:
     """Add the subcommand to the ``wgcad`` parser's subparsers."""
-    import argparse
-
     k = sub.add_parser(
         "ke",
-        help="no-load kinematic error, lost motion and the installation-angle lever of an imperfect drive",
-        epilog=epilog(model="teeth that never touch; with --torque-nm the elastic model"),
+        help=COMMAND_HELP["ke"],
+        epilog=epilog(
+            model="teeth that never touch; with --torque-nm the elastic model",
+            five="--plot needs wgcad[plots], --html wgcad[html]",
+        ),
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     k.add_argument(
@@ -116,7 +125,7 @@ def register(sub) -> None:
     )
     k.add_argument(
         "--chord-tol-um",
-        type=positive_float(0.0, 100.0, "um"),
+        type=bounded("ke", "--chord-tol-um"),
         default=1.0,
         help="largest distance between the teeth's outlines and their exact curves, um (default 1; D2's KE reads "
         "0.8 arcsec higher at 0.025: docs/models.md 6.2)",
@@ -124,6 +133,7 @@ def register(sub) -> None:
     k.add_argument(
         "--torque-nm",
         metavar="T",
+        type=_torques,
         help="also the KE under these output torques (a value, a list or START:STOP:STEP, "
         "N m > 0) from the elastic model (needs [bearing]); STEM_ke_load.png with --plot",
     )

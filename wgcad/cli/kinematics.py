@@ -2,26 +2,38 @@
 
 from __future__ import annotations
 
+import argparse
+import io
+import sys
 from pathlib import Path
 
-from .common import EXIT_OK, epilog, out_dir, positive_float
+import numpy as np
 
-__all__ = ["register", "cmd_kinematics"]
+from ..atomic import atomic_batch
+from ..design import load_design
+from ..drive import build_drive
+from ..errors import DesignError
+from ..export.figures import velocities_png
+from ..extras import require
+from ..kinematics import gear_ratios, ring_generator_velocities
+from .bounds import bounded
+from .common import COMMAND_HELP, EXIT_OK, epilog, out_dir
+from .outputs import check_output_dir
+
+__all__ = ["register", "cmd_kinematics", "DEFAULT_OMEGA_H"]
+
+#: --omega-h by default: velocities per rad/s of the generator
+DEFAULT_OMEGA_H = 1.0
 
 
 def cmd_kinematics(args) -> int:
-    import numpy as np
-
-    from ..design import load_design
-    from ..drive import build_drive
-    from ..kinematics import gear_ratios
-
+    require("plots", what="wgcad kinematics")  # its velocities picture
     design = load_design(args.design)
-    drive = build_drive(design)
-    if design.external:  # judge the output folder before printing anything
-        from .outputs import check_output_dir
-
+    if not design.external:
+        _refuse_velocity_flags(args, design)
+    else:  # judge the output folder before any work
         check_output_dir(out_dir(args, args.design))
+    drive = build_drive(design)
     d = design.drive
     r = gear_ratios(d.z_flex, d.z_rigid)
 
@@ -38,32 +50,29 @@ def cmd_kinematics(args) -> int:
     )
     if not design.external:
         return EXIT_OK
-    from ..atomic import atomic_batch
-    from ..kinematics import ring_generator_velocities
 
     out = out_dir(args, args.design)  # checked above; created with the files
     a_w = design.w0 if args.eccentricity is None else args.eccentricity
+    omega_h = DEFAULT_OMEGA_H if args.omega_h is None else args.omega_h
     phi = np.linspace(0.0, np.pi, 721)
-    vel = ring_generator_velocities(drive.law, phi, args.omega_h, design.flexspline.rim_thickness, a_w)
+    vel = ring_generator_velocities(drive.law, phi, omega_h, design.flexspline.rim_thickness, a_w)
     cols = ["V_w", "V_v", "dtheta_dt", "V_wK", "V_vK", "V_d", "V_dw", "V_dv", "V_sl"]
     units = {"dtheta_dt": "rad_s"}
     header = "phi_deg," + ",".join(f"{c}_{units.get(c, 'mm_s')}" for c in cols)
     rows = np.column_stack([np.rad2deg(phi)] + [getattr(vel, c) for c in cols])
-    import io
 
     buf = io.StringIO()
     np.savetxt(buf, rows, delimiter=",", header=header, comments="", fmt="%.9g")
-    from ..export.figures import velocities_png
 
     png = velocities_png(
-        vel, f"{d.name}: external ring generator velocities, omega_h = {args.omega_h:g} rad/s, a_w = {a_w:.3f} mm"
+        vel, f"{d.name}: external ring generator velocities, omega_h = {omega_h:g} rad/s, a_w = {a_w:.3f} mm"
     )
     stem = Path(args.design).stem
     with atomic_batch() as batch:
         Path(batch.temp_path(out / f"{stem}_velocities.csv")).write_text(buf.getvalue())
         Path(batch.temp_path(out / f"{stem}_velocities.png")).write_bytes(png)
     i = int(np.argmax(np.abs(vel.V_sl)))
-    print(f"  external ring generator, omega_h = {args.omega_h:g} rad/s, a_w = {a_w:.4f} mm:")
+    print(f"  external ring generator, omega_h = {omega_h:g} rad/s, a_w = {a_w:.4f} mm:")
     print(
         f"    washer speed V_d = {vel.V_d[0]:.4g} mm/s; largest sliding speed |V_sl| = {abs(vel.V_sl[i]):.4g} mm/s at phi = {np.rad2deg(phi[i]):.1f} deg"
     )
@@ -71,14 +80,26 @@ def cmd_kinematics(args) -> int:
     return EXIT_OK
 
 
+def _refuse_velocity_flags(args, design) -> None:
+    """A flag of the external ring generator's velocities given for another drive is refused, not ignored (a
+    silently ignored flag reads as if it had taken effect). ``--out`` only gets a warning: a script may pass
+    one folder to every command, and no figure depends on it."""
+    why = (
+        f"{design.drive.name} has [drive] deformation = '{design.drive.deformation}': kinematics gives its ratios only"
+    )
+    for flag, value in (("--omega-h", args.omega_h), ("--eccentricity", args.eccentricity)):
+        if value is not None:
+            raise DesignError(flag, f"sets the external ring generator's velocities, and {why}; drop the flag")
+    if args.out is not None:
+        print(f"wgcad: warning: --out: nothing written, {why}", file=sys.stderr)
+
+
 def register(sub) -> None:
     """Add the subcommand to the ``wgcad`` parser's subparsers."""
-    import argparse
-
     k = sub.add_parser(
         "kinematics",
-        help="gear ratios; velocities of the external ring generator (CSV + PNG)",
-        epilog=epilog(),
+        help=COMMAND_HELP["kinematics"],
+        epilog=epilog(five="the velocities picture needs wgcad[plots]"),
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     k.add_argument("design", help="design file (TOML), e.g. templates/d3_external.toml")
@@ -89,14 +110,14 @@ def register(sub) -> None:
     )
     k.add_argument(
         "--omega-h",
-        type=positive_float(0.0, 1e6, "rad/s"),
-        default=1.0,
-        help="generator speed, rad/s (default 1: velocities per rad/s; [S3] uses 210)",
+        type=bounded("kinematics", "--omega-h"),
+        default=None,
+        help="generator speed, rad/s (default 1: velocities per rad/s; [S3] uses 210); external deformation only",
     )
     k.add_argument(
         "--eccentricity",
-        type=positive_float(0.0, 100.0, "mm"),
+        type=bounded("kinematics", "--eccentricity"),
         default=None,
-        help="washer crank eccentricity a_w, mm (default W0)",
+        help="washer crank eccentricity a_w, mm (default W0); external deformation only",
     )
     k.set_defaults(func=cmd_kinematics)

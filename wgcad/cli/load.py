@@ -5,11 +5,19 @@ from __future__ import annotations
 import sys
 from pathlib import Path
 
+from ..atomic import atomic_batch, check_writable_dir
+from ..constants import MAX_LOAD_LEVELS
+from ..design import load_design
+from ..design.budget import check_load_budget
 from ..errors import DesignError
 from ..export.json_text import json_text
-from .common import EXIT_INTERFERENCE, EXIT_OK, Progress, key_float
+from ..export.load_figures import entry_gap_png, force_distribution_png
+from ..export.load_html import load_html
+from ..numbers import read_values
+from .bounds import REVERSE
+from .common import EXIT_INTERFERENCE, EXIT_OK, Progress, flag_value, key_float
 
-__all__ = ["register_args", "run_load", "torque_levels", "RATED", "RATED_STEPS"]
+__all__ = ["register_args", "run_load", "torque_levels", "torque_flag", "RATED", "RATED_STEPS"]
 
 #: ``--torque-nm`` without a value: the design's rated torque, from zero in RATED_STEPS steps
 RATED = "rated"
@@ -17,26 +25,21 @@ RATED_STEPS = 12
 
 
 def torque_levels(text: str) -> list[float]:
-    """``"0:3000:250"`` (start:stop:step, stop included), ``"500"`` or ``"0,500,1000"`` -> torques in N m (>= 0)."""
-    import math
+    """``"0:3000:250"`` (start:stop:step, stop included), ``"500"`` or ``"0,500,1000"`` -> torques in N m (>= 0), at
+    most :data:`~wgcad.constants.MAX_LOAD_LEVELS` of them (:func:`wgcad.numbers.read_values`)."""
+    values = read_values("--torque-nm", text, what="torques", unit="N m", max_count=MAX_LOAD_LEVELS)
+    for v in values:
+        if v < 0:  # judged here, not by read_values' bound, to say why a sign is refused
+            raise DesignError("--torque-nm", f"torques must be >= 0 N m, got {v:g}: {REVERSE}")
+    return values
 
-    try:
-        if ":" in text:
-            a, b, c = (float(x) for x in text.split(":"))
-            if not (c > 0 and b >= a):
-                raise ValueError
-            n = int(math.floor((b - a) / c + 1e-9))
-            out = [a + i * c for i in range(n + 1)]
-        else:
-            out = [float(x) for x in text.split(",")]
-    except ValueError:
-        raise DesignError(
-            "--torque-nm", f"expected START:STOP:STEP, a value or a comma list of torques in N m, got '{text}'"
-        ) from None
-    for t in out:
-        if not (math.isfinite(t) and t >= 0):
-            raise DesignError("--torque-nm", f"torques must be >= 0 N m, got {t:g}")
-    return out
+
+def torque_flag(text: str):
+    """The ``--torque-nm`` type (``audit`` and ``ke``): :func:`torque_levels`, judged while the line is parsed (before
+    the design is read); the flag alone (its ``const``) stays :data:`RATED`."""
+    if text == RATED:
+        return RATED
+    return flag_value(torque_levels, text)
 
 
 def register_args(a) -> None:
@@ -47,6 +50,7 @@ def register_args(a) -> None:
         metavar="SPEC",
         nargs="?",
         const=RATED,
+        type=torque_flag,
         help="output torques: START:STOP:STEP (e.g. 0:3000:250), a value or a list; without SPEC, 0 to the "
         "design's [load] rated_torque_nm in 12 steps; exit 1 when the entry gap Delta closes at a requested load",
     )
@@ -73,8 +77,7 @@ def register_args(a) -> None:
 def _levels(args) -> list[float]:
     """The torque levels of ``--torque-nm``: as given, or 0 to ``[load] rated_torque_nm`` in :data:`RATED_STEPS` steps."""
     if args.torque_nm != RATED:
-        return torque_levels(args.torque_nm)
-    from ..design import load_design
+        return args.torque_nm
 
     rated = load_design(args.design).load.rated_torque_nm
     if rated is None or not rated > 0:
@@ -88,10 +91,12 @@ def _levels(args) -> list[float]:
 
 def run_load(args) -> int:
     """The load audit: sweep, print, write JSON and PNGs atomically; exit 1 when the entry gap closes."""
-    from ..atomic import atomic_batch, check_writable_dir
     from ..report.load import load_lines, load_run
 
     torques = _levels(args)
+    # every level's solved state is held to the end: judged against the budget before the first is solved
+    z_flex = load_design(args.design).drive.z_flex
+    check_load_budget(len(torques), z_flex, args.sections, args.max_memory_mb, sweeps=2 if args.compare else 1)
     for path in (args.json, args.plot, args.html):
         if path:
             check_writable_dir(Path(path).parent if str(Path(path).parent) else Path("."))
@@ -116,12 +121,8 @@ def run_load(args) -> int:
         if args.json:
             Path(batch.temp_path(args.json)).write_text(json_text(res) + "\n")
         if args.html:
-            from ..export.load_html import load_html
-
             Path(batch.temp_path(args.html)).write_text(load_html(res), encoding="utf-8")
         if args.plot:
-            from ..export.load_figures import entry_gap_png, force_distribution_png
-
             p = Path(args.plot)
             name = res["design"]
             series = [

@@ -6,6 +6,7 @@ import os
 import sys
 from pathlib import Path
 
+from ..atomic import check_target, check_writable_dir
 from ..errors import OutputError
 
 __all__ = ["STDOUT", "check_output_file", "check_output_dir", "write_stdout"]
@@ -43,8 +44,6 @@ def check_output_file(path, *, flag: str, inputs=(), stdout_ok: bool = False) ->
     ------
     OutputError
     """
-    from ..atomic import check_target, check_writable_dir
-
     p = Path(path)
     hint = f" (give {flag} - to write to standard output)" if stdout_ok else ""
     try:
@@ -60,8 +59,6 @@ def check_output_file(path, *, flag: str, inputs=(), stdout_ok: bool = False) ->
 
 def check_output_dir(path) -> Path:
     """Check an output folder (``--out``) before anything is computed; nothing is created."""
-    from ..atomic import check_writable_dir
-
     return check_writable_dir(path)
 
 

@@ -5,9 +5,16 @@ from __future__ import annotations
 import argparse
 import time
 
+from ..design import load_design
+from ..design.bolting import RULE
+from ..design.parts import load_parts
+from ..drive import build_drive
 from ..export.json_text import json_text
-from ..export.part_files import FORMATS
-from .common import EXIT_OK, angles_deg, epilog, out_dir, positive_float
+from ..export.part_files import FORMATS, write_part_files
+from ..rating.plate_sizing import sized_parts
+from .bounds import bounded
+from .common import COMMAND_HELP, EXIT_OK, Progress, angles_deg, epilog, out_dir, want_progress
+from .outputs import check_output_dir
 
 __all__ = ["register", "cmd_parts", "FORMATS"]
 
@@ -25,19 +32,15 @@ def formats(text: str) -> list[str]:
 
 def cmd_parts(args) -> int:
     t0 = time.perf_counter()
-    from ..design import load_design
-    from ..design.parts import load_parts, part_sizes
-    from ..drive import build_drive
-    from ..export.part_files import write_part_files
-    from .common import Progress, want_progress
 
+    # the folder is judged before any work, not after the parts are built
+    out = check_output_dir(out_dir(args, args.design))
     bar = Progress(want_progress(args.progress) and (args.progress or not args.quiet))
     bar.start("reading the design")
     design = load_design(args.design)
     spec = load_parts(args.design)
     drive = build_drive(design, tol=args.chord_tol_um * 1e-3)
-    sizes = part_sizes(spec, drive)  # every fit rule is checked here or while building: before anything is written
-    out = out_dir(args, args.design)
+    sizes = sized_parts(spec, drive)  # every fit rule is checked here or while building: before anything is written
     res = write_part_files(
         drive,
         sizes,
@@ -61,12 +64,13 @@ def cmd_parts(args) -> int:
             print("    " + ", ".join(f"{k} = {sizes.values[k]:g}" for k in sizes.derived))
         by_rule = {}
         for k, rule in sizes.rules.items():
-            by_rule.setdefault(rule, []).append(k.split("_")[0])
+            if k != "diaphragm_thickness":
+                by_rule.setdefault(rule, []).append(k.split("_")[0])
+            else:
+                print(f"  {k}: {rule}")
         for rule, keys in by_rule.items():
             print(f"  {' and '.join(dict.fromkeys(keys))} bolts: {rule}")
         if any(r[:1].isdigit() for r in sizes.rules.values()):
-            from ..design.bolting import RULE
-
             print(f"    ({RULE})")
         for n in sizes.notes:
             print(f"  WARNING: {n}")
@@ -78,8 +82,8 @@ def register(sub) -> None:
     """Add the subcommand to the ``wgcad`` parser's subparsers."""
     g = sub.add_parser(
         "parts",
-        help="write the parts a shop makes: cup flexspline, generator plug, rigid gear (DXF, SVG, STL, 3MF, STEP)",
-        epilog=epilog(),
+        help=COMMAND_HELP["parts"],
+        epilog=epilog(five="STEP needs build123d: pip install 'wgcad[cad]'"),
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     g.add_argument("design", help="design file (TOML); sizes of the parts from its optional [parts] table")
@@ -99,7 +103,7 @@ def register(sub) -> None:
     )
     g.add_argument(
         "--chord-tol-um",
-        type=positive_float(0.0, 100.0, "um"),
+        type=bounded("parts", "--chord-tol-um"),
         default=1.0,
         help="largest distance between written geometry and exact curve, um (default 1)",
     )

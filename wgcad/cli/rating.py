@@ -2,23 +2,36 @@
 
 from __future__ import annotations
 
+import argparse
 from pathlib import Path
 
+from ..atomic import atomic_batch
+from ..design import load_design
+from ..drive import build_drive
+from ..errors import OutputError
 from ..export.json_text import json_text
-from .common import EXIT_INTERFERENCE, EXIT_OK, epilog, key_float, positive_float, whole_number
+from ..export.rating_figures import rating_png
+from ..export.rating_html import rating_html
+from .bounds import bounded
+from .common import (
+    COMMAND_HELP,
+    EXIT_INTERFERENCE,
+    EXIT_OK,
+    Progress,
+    epilog,
+    key_float,
+    require_picture_extras,
+    want_progress,
+)
+from .outputs import STDOUT, check_output_file
 
 __all__ = ["register", "cmd_rating"]
 
 
 def cmd_rating(args) -> int:
-    from ..atomic import atomic_batch
-    from ..design import load_design
-    from ..drive import build_drive
-    from ..errors import OutputError
+    require_picture_extras(args)
     from ..rating.datasheet import rate_drive
     from ..report.rating import rating_document, rating_lines
-    from .common import Progress, want_progress
-    from .outputs import STDOUT, check_output_file
 
     for flag, path in (("--json", args.json), ("--plot", args.plot), ("--html", args.html)):
         if path == STDOUT:
@@ -42,26 +55,21 @@ def cmd_rating(args) -> int:
             doc = rating_document(ds, str(args.design))
             Path(batch.temp_path(Path(args.json))).write_text(json_text(doc))
         if args.plot:
-            from ..export.rating_figures import rating_png
-
             Path(batch.temp_path(Path(args.plot))).write_bytes(rating_png(ds))
         if args.html:
-            from ..export.rating_html import rating_html
-
             Path(batch.temp_path(Path(args.html))).write_text(rating_html(ds), encoding="utf-8")
     return EXIT_OK if ds.rated_torque_nm > 0 else EXIT_INTERFERENCE
 
 
 def register(sub) -> None:
     """Add the subcommand to the ``wgcad`` parser's subparsers."""
-    import argparse
-
     r = sub.add_parser(
         "rating",
-        help="datasheet: rated torque and the criterion that binds it, stresses, stiffness, ratcheting, bearing life",
+        help=COMMAND_HELP["rating"],
         epilog=epilog(
             one="no rated torque: a criterion fails at no load (the datasheet says which)",
             model="the elastic model cannot solve the unloaded drive",
+            five="--plot needs wgcad[plots], --html wgcad[html]",
         ),
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
@@ -71,7 +79,7 @@ def register(sub) -> None:
     )
     r.add_argument(
         "--speed-rpm",
-        type=positive_float(0.0, 1e5, "rpm"),
+        type=bounded("rating", "--speed-rpm"),
         default=None,
         help="input speed the bearing life is rated at (default [load] input_speed_rpm, 2000)",
     )
@@ -90,7 +98,7 @@ def register(sub) -> None:
     )
     r.add_argument(
         "--sections",
-        type=whole_number(1, 9, "sections"),
+        type=bounded("rating", "--sections"),
         default=3,
         help="cross-sections of the elastic model over the face width (default 3)",
     )

@@ -10,8 +10,9 @@ The rule wgcad applies, every factor stated so a designer can change it:
   table of metric coarse threads);
 * friction ``mu = 0.12`` between dry machined steel faces (a low value of
   the usual 0.1-0.2: the joint should not rely on more);
-* a safety factor of 2 on slip: ``T_cap >= 2 T`` with ``T`` the rated
-  output torque (``[load] rated_torque_nm``); the cup's bolts and the rigid
+* a safety factor of 2 on slip: ``T_cap >= 2 T`` with ``T`` the design
+  torque (``[load] rated_torque_nm``, the torque the parts are sized for;
+  not the datasheet's rated torque, docs/glossary.md); the cup's bolts and the rigid
   gear's carry the whole output torque (the generator's input torque is
   the output over the ratio: within 1 % of it on these drives);
 * clearance holes of ISO 273 "medium"; every ligament (hole to the inner
@@ -27,9 +28,9 @@ is refused, naming the key to change.
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
 
 from ..errors import DesignError
-from ..records import record
 
 __all__ = ["METRIC", "BoltChoice", "carry", "choose_bolts", "RULE"]
 
@@ -55,11 +56,11 @@ COUNTS = (6, 8, 10, 12, 16, 20, 24, 32)
 #: the rule in one line, for the summaries
 RULE = (
     f"friction grip: class 12.9 bolts preloaded to {PRELOAD_FRACTION:g} R_p0.2, mu {MU:g}, slip safety {SLIP_SAFETY:g} "
-    "on the rated torque; ISO 273 medium holes, ligaments >= half a hole"
+    "on the design torque ([load] rated_torque_nm); ISO 273 medium holes, ligaments >= half a hole"
 )
 
 
-@record(frozen=True)
+@dataclass(frozen=True, slots=True)
 class BoltChoice:
     """A bolt circle: ``count`` bolts of ``size`` in ``hole_mm`` holes at ``radius_mm``, and the torque it carries."""
 
@@ -72,7 +73,7 @@ class BoltChoice:
     def text(self, torque_nm: float) -> str:
         return (
             f"{self.count} x {self.size} (12.9) in {self.hole_mm:g} mm holes on {2 * self.radius_mm:.1f} mm: "
-            f"slip at {self.capacity_nm:.0f} N m = {self.capacity_nm / torque_nm:.1f} x the rated {torque_nm:g} N m"
+            f"slip at {self.capacity_nm:.0f} N m = {self.capacity_nm / torque_nm:.1f} x the design torque {torque_nm:g} N m"
         )
 
 

@@ -12,11 +12,11 @@ err on the high side.
 
 from __future__ import annotations
 
+from dataclasses import dataclass
 from math import ceil, sqrt
 
 from .. import constants
 from ..errors import DesignError
-from ..records import record
 
 __all__ = [
     "DEFAULT_MAX_MEMORY_MB",
@@ -26,6 +26,8 @@ __all__ = [
     "check_budget",
     "estimate_sector_mb",
     "check_sector_budget",
+    "estimate_load_mb",
+    "check_load_budget",
 ]
 
 #: Memory a run may use by default, MB. The bundled templates need 0.1-0.2 GB
@@ -45,11 +47,15 @@ _VERTS_B = {"involute": 2.2, "cycloidal": 2.6, "double_arc": 2.2}
 # triangles); per audit sample (generator angle x tooth: angle arrays, folding,
 # sorting); per distinct tooth angle and section (search state); per vertex of a
 # tooth evaluated in one batch (placed copies, polygons, distances)
-# re-measured after the exporters and the CLI grew (progress bar, manifests, parts):
-# `generate` of D4 with STL peaks at 130 MB at 1 um chords (60 MB with --no-stl) and
-# at 153-165 MB at 0.1 um across fresh environments (/usr/bin/time -f %M)
-_BASE_B = 140e6
-_PER_EXPORT_VERTEX_B = 2.8e3
+# fitted to the peak RSS (VmHWM) of
+# `generate` on every template at 1 and 0.1 um, with and without STL, and of a default `audit`: 76-94 MB without
+# STL, 86-145 MB with it, 51-72 MB for the audits (each command loading only its own modules). The base is the interpreter and
+# the imports (~75 MB); the STL meshes' cost is taken per estimated outline vertex (an upper count, ~3x the
+# built one), so the estimate stays above the peak and within 2x of it (tests/test_design_budget.py)
+_BASE_B = 82e6
+_PER_EXPORT_VERTEX_B = 500.0
+# a conjugate gear's envelope of the mating tooth's motion (docs/models.md 13): D1's peaks 8-25 MB higher with it
+_CONJUGATE_B = 20e6
 _PER_SAMPLE_B = 64.0
 _PER_UNIQUE_SECTION_B = 40.0
 _PER_BATCH_VERTEX_B = 100.0
@@ -58,7 +64,7 @@ _PER_BATCH_VERTEX_B = 100.0
 _BOUND_BATCH_DIVISOR = 256
 
 
-@record(frozen=True)
+@dataclass(frozen=True, slots=True)
 class RunEstimate:
     """What a run is expected to need.
 
@@ -121,7 +127,7 @@ def estimate_run(
         The audit's shortcuts (:class:`wgcad.clearance.engine.AuditSettings`):
         without them far more samples are kept and evaluated at once.
     exports : bool
-        Whether DXF/STL files of the outlines are written (``generate``).
+        Whether the STL solids of the outlines are written (``generate``; its DXF alone fits in the base).
     vertices_per_tooth : dict, optional
         Measured vertices of one pitch (``{"flexspline": n, "rigid": n}``) of
         gears already built, instead of the upper estimate.
@@ -136,6 +142,7 @@ def estimate_run(
     mem = _BASE_B + n_out * 16.0 * 6  # outline arrays and their intermediates (angles, radii, polar)
     if exports:
         mem += n_out * _PER_EXPORT_VERTEX_B
+    mem += _CONJUGATE_B * sum(getattr(design, g).flanks == "conjugate" for g in ("flexspline", "rigid"))
     samples = 0
     if angles > 0:
         secs = sections if design.generator.cone_length is not None else 1
@@ -151,7 +158,7 @@ def estimate_run(
         mem += (
             n_s * _PER_SAMPLE_B
             + n_u * secs * _PER_UNIQUE_SECTION_B
-            + n_u * 0.5 * p * 16.0  # radial bound: the tip half of every distinct tooth angle, placed
+            + n_u * 0.5 * p * 32.0  # radial bound: the tip half of every distinct tooth angle, placed, and temporaries
             + batch * p * _PER_BATCH_VERTEX_B
         )
     return RunEstimate(verts, int(n_out), int(samples), mem / 1e6)
@@ -167,8 +174,14 @@ _SECTOR_PER_PAIR_B = 1.2 * 2.78e3
 
 def estimate_sector_mb(z_flex: int, step_deg: float) -> float:
     """Memory (MB) of ``wgcad sector`` at generator-angle step ``step_deg`` for ``z_flex`` flexspline teeth."""
-    angles = round(180.0 / step_deg)
-    return _SECTOR_BASE_MB + _SECTOR_PER_PAIR_B * angles * z_flex / 1e6
+    return _SECTOR_BASE_MB + _SECTOR_PER_PAIR_B * _sector_angles(step_deg) * z_flex / 1e6
+
+
+def _sector_angles(step_deg: float) -> float:
+    """The sweeps' generator angles over half a turn; a step so fine that they overflow a float (a subnormal step)
+    counts 1e300, still far beyond any budget."""
+    angles = 180.0 / step_deg
+    return float(round(angles)) if angles < 1e300 else 1e300
 
 
 def check_sector_budget(z_flex: int, step_deg: float, max_memory_mb: float | None = DEFAULT_MAX_MEMORY_MB) -> float:
@@ -177,9 +190,43 @@ def check_sector_budget(z_flex: int, step_deg: float, max_memory_mb: float | Non
     if max_memory_mb is not None and mb > max_memory_mb:
         raise DesignError(
             "--step-deg",
-            f"a step of {step_deg:g} deg needs about {mb:.0f} MB ({round(180.0 / step_deg)} generator angles x "
+            f"a step of {step_deg:g} deg needs about {mb:.4g} MB ({_sector_angles(step_deg):.6g} generator angles x "
             f"{z_flex} teeth held at once), more than the budget of {max_memory_mb:g} MB; coarsen --step-deg or "
             "raise --max-memory-mb",
+        )
+    return mb
+
+
+# `wgcad audit --torque-nm`: every level's solved state is kept until the entry gaps of all levels are refined in
+# one engine call. Measured peak RSS (/usr/bin/time -f %M) at 2 and 51 levels of D1 (200 teeth): 0.36 MB more per
+# level at 1 section, 1.29 MB at 3, 2.46 MB at 6 (D2 at 3 sections: 1.24 MB), i.e. ~2.1 kB per level, tooth and
+# section; the estimate takes 2.5 kB. 74-94 MB at 1-2 levels: the base is taken as 100 MB.
+_LOAD_BASE_MB = 100.0
+_LOAD_PER_LEVEL_TOOTH_SECTION_B = 2.5e3
+
+
+def estimate_load_mb(levels: int, z_flex: int, sections: int, sweeps: int = 1) -> float:
+    """Memory (MB) of a load audit of ``levels`` torque levels at ``sections`` sections; ``sweeps`` of them held at
+    once (``--compare`` holds the audit's while it runs the others)."""
+    return _LOAD_BASE_MB + _LOAD_PER_LEVEL_TOOTH_SECTION_B * sweeps * levels * z_flex * sections / 1e6
+
+
+def check_load_budget(
+    levels: int,
+    z_flex: int,
+    sections: int,
+    max_memory_mb: float | None = DEFAULT_MAX_MEMORY_MB,
+    sweeps: int = 1,
+) -> float:
+    """Refuse a load audit whose estimated memory exceeds ``max_memory_mb`` (one line naming --torque-nm)."""
+    mb = estimate_load_mb(levels, z_flex, sections, sweeps)
+    if max_memory_mb is not None and mb > max_memory_mb:
+        held = f"{levels} levels x {z_flex} teeth x {sections} sections" + (f" x {sweeps} sweeps" if sweeps > 1 else "")
+        raise DesignError(
+            "--torque-nm",
+            f"{levels} torque levels need about {mb:.0f} MB of solved states ({held} held at once), more than the "
+            f"budget of {max_memory_mb:g} MB; fewer levels (a coarser STEP), fewer --sections, or raise "
+            "--max-memory-mb",
         )
     return mb
 

@@ -40,6 +40,8 @@ def load_design(path) -> Design:
     DesignError
         A field rule is broken.
     """
+    if isinstance(path, Design):  # already read (a library caller's object): taken as it is
+        return path
     p = Path(path)
     return parse_design(parse_toml(read_design_text(p), p, "a design"), source=str(p))
 

@@ -2,15 +2,14 @@
 
 from __future__ import annotations
 
-from dataclasses import fields
+from dataclasses import dataclass, fields
 
-from ..records import record
 from .rules import Rel, key
 
 __all__ = ["ImperfectionsSpec"]
 
 
-@record(frozen=True)
+@dataclass(frozen=True)
 class ImperfectionsSpec:
     """``[imperfections]``: manufacturing and mounting errors of a drive (all optional, default a perfect drive).
 

@@ -2,14 +2,15 @@
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 from ..errors import DesignError
-from ..records import record
 from .rules import key as _key
 
 __all__ = ["MaterialSpec", "BearingSpec", "LoadSpec", "require_bearing"]
 
 
-@record(frozen=True)
+@dataclass(frozen=True, slots=True)
 class MaterialSpec:
     """``[material]``: the flexspline and bearing material and the rim's bending section."""
 
@@ -102,7 +103,7 @@ class MaterialSpec:
     )
 
 
-@record(frozen=True)
+@dataclass(frozen=True, slots=True)
 class BearingSpec:
     """``[bearing]``: the flexible bearing between cam and flexspline."""
 
@@ -169,14 +170,45 @@ class BearingSpec:
         why="above 0.5 or the ball jams in its groove; below 1 for a groove at all",
         default=0.52,
     )
+    # ---- friction (wgcad rating; docs/models.md 10.8) ----
+    lubricant_viscosity_cst: float = _key(
+        "kinematic viscosity of the bearing's lubricant (base oil) at the operating temperature, for Palmgren's "
+        "viscous friction term",
+        unit="mm^2/s",
+        lo=0.0,
+        lo_open=True,
+        hi=10000.0,
+        why="positive; above 10000 mm^2/s no rolling bearing runs",
+        default=30.0,
+        default_doc="30 (an ISO VG 32 oil near 40 C; assumed)",
+    )
+    viscous_friction_factor: float = _key(
+        "Palmgren's lubrication factor f0 of the viscous friction term",
+        lo=0.0,
+        hi=20.0,
+        why="not negative; Palmgren's table ends below 20",
+        default=2.0,
+        default_doc="2 (deep-groove ball bearing, oil bath or grease; Palmgren, as tabulated by Harris & Kotzalas)",
+    )
+    seal_torque_nmm: float = _key(
+        "drag torque of the bearing's seals between its rings, as the seal's maker gives it",
+        unit="N mm",
+        lo=0.0,
+        hi=1e5,
+        why="not negative; 100 N m of seal drag is beyond any flexible bearing",
+        default=0.0,
+        default_doc="0 (no seals)",
+    )
 
 
-@record(frozen=True)
+@dataclass(frozen=True, slots=True)
 class LoadSpec:
     """``[load]``: the operating load of the drive."""
 
     rated_torque_nm: float | None = _key(
-        "output torque the load audit sweeps to by default",
+        "the design torque: the output torque the parts are sized for (bolts) and the load audit sweeps to by "
+        "default; outputs call it design torque (design_torque_nm), not the rated torque of wgcad rating "
+        "(docs/glossary.md)",
         unit="N m",
         lo=0.0,
         hi=1e7,
@@ -207,10 +239,6 @@ class LoadSpec:
         why="one turn either way",
         default=0.0,
     )
-    #: radial stiffness with which the flexspline's supports hold the toothed rim centred, N/mm: a cup's wall
-    #: bending and shearing as a thin tube from the diaphragm (docs/models.md 4.1); 0 lets the rim float
-    #: radial stiffness of the cam's support (input shaft and its bearings), N/mm: the balls' imbalance moves the
-    #: cam against it (docs/models.md 4.1); 0 for a floating (self-centring) generator, e.g. on an Oldham coupling
     input_speed_rpm: float = _key(
         "input (wave generator) speed the bearing life is rated at",
         unit="rpm",
@@ -253,23 +281,20 @@ class LoadSpec:
         default=None,
         default_doc="none: the frequency is not computed",
     )
-    cam_support_stiffness_n_per_mm: float | None = _key(
-        "radial stiffness holding the cam on the drive axis (0: floating generator)",
-        unit="N/mm",
+    tooth_friction: float = _key(
+        "Coulomb coefficient of friction of the tooth flanks (sliding and at rest)",
         lo=0.0,
-        hi=1e9,
-        why="not negative; 1e9 N/mm is a rigid support",
-        default=None,
-        default_doc="rigid (the cam held where its offset puts it)",
+        hi=0.5,
+        why="not negative; above 0.5 the flanks are dry and galling, outside any lubricated gear",
+        default=0.07,
+        default_doc="0.07 (lubricated steel flanks in mixed lubrication, 0.05-0.1)",
     )
-    rim_lateral_stiffness_n_per_mm: float | None = _key(
-        "radial stiffness holding the toothed rim on the drive axis (0: floating)",
-        unit="N/mm",
-        lo=0.0,
-        hi=1e9,
-        why="not negative; 1e9 N/mm is a rigid support",
-        default=None,
-        default_doc="the cup wall as a thin tube from the diaphragm to the generator centre line; 0 without [generator] cone_length",
+    tooth_compliance: str = _key(
+        "what a tooth pair's compliance holds besides the flanks' Hertz approach",
+        choices=("hertz_bending", "hertz"),
+        why="[S1] writes the pair's approach lambda(Q) by Hertz alone; with both teeth's bending and shear it is "
+        "the reading of docs/models.md 4.1",
+        default="hertz_bending",
     )
 
 

@@ -4,17 +4,27 @@ from __future__ import annotations
 
 import math
 import tomllib
-from dataclasses import fields
+from dataclasses import dataclass, fields
 from pathlib import Path
 
 from ..errors import DesignError, InputFileError, close_matches
-from ..numbers import read_float
-from ..records import record
+from ..numbers import read_float, show_value
+from .bolting import METRIC, RULE, SLIP_SAFETY, carry, choose_bolts
 
-__all__ = ["PartsSpec", "PartSizes", "parse_parts", "load_parts", "part_sizes", "MAX_PART_MM", "MAX_BOLTS", "PARTS_DOC"]
+__all__ = [
+    "PartsSpec",
+    "PartSizes",
+    "parse_parts",
+    "load_parts",
+    "part_sizes",
+    "diaphragm_geometry",
+    "MAX_PART_MM",
+    "MAX_BOLTS",
+    "PARTS_DOC",
+]
 
 
-@record(frozen=True)
+@dataclass(frozen=True, slots=True)
 class PartsSpec:
     """``[parts]``: every key optional (mm, counts); ``None`` means "derive from the gear size" (:func:`part_sizes`)."""
 
@@ -61,7 +71,7 @@ PARTS_DOC = {
 }
 
 
-@record(frozen=True)
+@dataclass(frozen=True)
 class PartSizes:
     """The resolved sizes (mm): every field of :class:`PartsSpec` with a value, which were derived, the rule each
     derived size follows, the keys the drive's parts use, and warnings on given sizes that break a rule."""
@@ -95,7 +105,7 @@ def parse_parts(data) -> PartsSpec:
         where = f"parts.{key}"
         if key.endswith("_count"):
             if isinstance(value, bool) or not isinstance(value, int) or not 1 <= value <= MAX_BOLTS:
-                raise DesignError(where, f"must be a whole number 1..{MAX_BOLTS}, got {value!r}")
+                raise DesignError(where, f"must be a whole number 1..{MAX_BOLTS}, got {show_value(value)}")
         else:
             value = read_float(where, value)
             if not 0 < value <= MAX_PART_MM:
@@ -123,8 +133,12 @@ def part_sizes(spec: PartsSpec, drive) -> PartSizes:
 
     Defaults (``d`` the flexspline pitch diameter, ``r_in`` its bore radius,
     ``h1`` the rim under its teeth, ``R_rim`` the rigid gear's outer radius):
-    cup length = ``generator.cone_length`` or ``0.8 d``; shell = ``0.7 h1``;
-    diaphragm = ``1.5 x`` shell; hub bore = ``0.5 r_in``; cup bolt circle in
+    cup length = ``generator.cone_length`` or ``0.8 d``; shell =
+    ``[material] cup_wall_thickness_mm`` (the wall the models rate) or ``h1``,
+    at most ``h1 - 0.05`` (the roots);
+    diaphragm = ``1.5 x 0.7 h1`` (rounded to 0.05 mm each), then sized for
+    fatigue with the cup's bolt circle by ``wgcad parts`` and ``wgcad rating``
+    (wgcad.rating.plate_sizing); hub bore = ``0.5 r_in``; cup bolt circle in
     the middle of the diaphragm's annulus, 8 holes of a third of its width;
     bearing radial thickness ``0.06 x 2 r_in``, width ``0.8 x`` face width;
     plug bore ``0.4 x`` the plug's smallest diameter; flange holes
@@ -167,10 +181,13 @@ def _derive(spec: PartsSpec, drive) -> tuple[dict, list, dict]:
     d_pitch = 2.0 * drive.flex.r
     r_in = drive.flex_rim_radius  # flexspline bore (internal deformation) / outer surface (external)
     default("cup_length", d.generator.cone_length if d.generator.cone_length is not None else _r(0.8 * d_pitch))
-    default("shell_thickness", _r(0.7 * h1, 0.05))
-    default("diaphragm_thickness", _r(1.5 * v["shell_thickness"], 0.05))
+    # the wall the elastic model and the rating take (docs/design-keys.md: cup_wall_thickness_mm), so the cup exported
+    # is the cup rated; a step thinner than the rim at most, which a wall as thick as the rim would reach the roots of
+    default("shell_thickness", _r(min(d.material.cup_wall_thickness_mm or h1, h1 - 0.05), 0.05))
+    # the plate's starting thickness: 1.5 x the 0.7 h1 of a thin shell (the loaded model's tilting stiffness, 4.2,
+    # keeps it), which the fatigue sizing (wgcad.rating.plate_sizing) then checks with the bolt circle
+    default("diaphragm_thickness", _r(1.5 * _r(0.7 * h1, 0.05), 0.05))
     default("hub_bore_diameter", _r(0.5 * r_in))
-    from .bolting import choose_bolts
 
     torque = d.load.rated_torque_nm
     rules = {}
@@ -310,17 +327,13 @@ def _check_fits(v: dict, drive) -> None:
 
 
 def _bolt_notes(v: dict, drive, rules: dict) -> list[str]:
-    """Warnings on bolt circles the user gave: a ligament under half a hole, bolts that slip under the rated torque."""
-    from .bolting import RULE, carry
-
+    """Warnings on bolt circles the user gave: a ligament under half a hole, bolts that slip under the design torque."""
     ext = drive.external
     r_in = drive.flex_rim_radius
     R_rim = drive.rigid_rim_radius
     torque = drive.design.load.rated_torque_nm
     notes = []
-    # given bolt circles: whether they carry the rated torque, and their ligaments (warnings: the user chose them)
-    from .bolting import METRIC, SLIP_SAFETY
-
+    # given bolt circles: whether they carry the design torque, and their ligaments (warnings: the user chose them)
     for prefix, lo, hi in (
         ("cup", 0.5 * v["hub_bore_diameter"], r_in),
         ("flange", R_rim, (0.5 * v["flange_outer_diameter"]) if not ext else min(drive.rigid.r_f, drive.rigid.r_a)),
@@ -341,7 +354,7 @@ def _bolt_notes(v: dict, drive, rules: dict) -> list[str]:
             if cap < SLIP_SAFETY * torque:
                 notes.append(
                     f"{prefix} bolts ({n} of the largest metric bolt a {hole:g} mm hole takes) slip at "
-                    f"{cap:.0f} N m, less than {SLIP_SAFETY:g} x the rated {torque:g} N m ({RULE})"
+                    f"{cap:.0f} N m, less than {SLIP_SAFETY:g} x the design torque {torque:g} N m ({RULE})"
                 )
     return notes
 
@@ -375,3 +388,19 @@ def _bolts(prefix, bc_d, hole_d, count, r_lo, r_hi, inner, outer):
         raise DesignError(
             f"parts.{prefix}_bolt_count", f"{count} holes of {hole_d:g} mm overlap on a {bc_d:g} mm bolt circle"
         )
+
+
+def diaphragm_geometry(drive, t_cup: float) -> tuple[float, float, float, bool]:
+    """The cup's diaphragm as a plate: ``(r_i, r_o, h, given)``, mm.
+
+    Clamped at the cup's bolt circle (inside it the output flange holds the plate), joined to the cup wall's
+    mid-surface at ``r_o``, ``h`` thick; sizes from the design file's ``[parts]`` (its derived defaults when the
+    file has none or the design is in memory). ``given``: the file states the thickness and the bolt circle.
+    """
+    d = drive.design
+    spec = load_parts(d.source) if Path(d.source).is_file() else PartsSpec()
+    v = part_sizes(spec, drive)
+    r_o = drive.flex_rim_radius + 0.5 * t_cup
+    r_i = 0.5 * v.cup_bolt_circle_diameter
+    given = spec.diaphragm_thickness is not None and spec.cup_bolt_circle_diameter is not None
+    return float(r_i), float(r_o), float(v.diaphragm_thickness), bool(given)

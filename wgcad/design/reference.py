@@ -12,6 +12,7 @@ import typing
 from dataclasses import MISSING, fields
 
 from .files import MAX_DESIGN_BYTES
+from .parts import MAX_BOLTS, MAX_PART_MM, PARTS_DOC, PartsSpec, part_sizes
 from .rules import bound_text, key_meta
 from .schema import OPTIONAL_TABLES, TABLES
 
@@ -101,8 +102,6 @@ def design_keys_markdown() -> str:
 
 def _parts_section() -> str:
     """``[parts]`` (read by ``wgcad parts`` only): every key optional, derived from the gear size when absent."""
-    from .parts import MAX_BOLTS, MAX_PART_MM, PARTS_DOC, PartsSpec, part_sizes
-
     lines = [
         "\n## [parts] (optional table, read by `wgcad parts`)\n",
         "Sizes of the flexspline cup, the wave-generator plug and the rigid gear's body. Every key is optional; "

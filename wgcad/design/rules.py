@@ -15,10 +15,9 @@ from __future__ import annotations
 import math
 import reprlib
 from collections.abc import Callable
-from dataclasses import MISSING, field, fields
+from dataclasses import MISSING, dataclass, field, fields
 
 from ..errors import DesignError
-from ..records import record
 
 __all__ = ["Rel", "key", "key_meta", "check_bounds", "show", "context", "WHEN_BUILT"]
 
@@ -26,7 +25,7 @@ __all__ = ["Rel", "key", "key_meta", "check_bounds", "show", "context", "WHEN_BU
 WHEN_BUILT = " (checked when the gears are built)"
 
 
-@record(frozen=True)
+@dataclass(frozen=True, slots=True)
 class Rel:
     """A bound relative to the design's own sizes: ``text`` for people, ``fn(ctx)`` for the check (mm)."""
 
@@ -50,6 +49,7 @@ def key(
     why: str = "",
     default=MISSING,
     default_doc: str | None = None,
+    inf_ok: bool = False,
 ):
     """A dataclass field of a design table with its documented rule.
 
@@ -70,6 +70,8 @@ def key(
         Why the bounds are what they are.
     default_doc : str, optional
         How the default reads in the reference when it is not a plain value.
+    inf_ok : bool
+        ``inf`` is a meaningful value (a support stiffness: held), not refused as non-finite.
     """
     meta = {
         "doc": doc,
@@ -82,6 +84,7 @@ def key(
         "rule": rule,
         "why": why,
         "default_doc": default_doc,
+        "inf_ok": inf_ok,
     }
     return field(default=default, metadata={"wgcad": meta})
 
@@ -204,6 +207,8 @@ def check_bounds(design, tables: dict, passes: tuple = (0, 1)) -> None:
                     continue
                 if isinstance(value, str) and meta.get("choices") is None:
                     continue
+                if meta.get("inf_ok") and value == math.inf:
+                    continue  # inf is a value of its own here (a held support), beyond the finite bounds
                 if isinstance(value, float) and not math.isfinite(value):
                     raise DesignError(f"{name}.{f.name}", f"must be finite, got {_fmt(value)}")
                 _check_one(f"{name}.{f.name}", meta, value, tctx)

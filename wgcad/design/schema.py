@@ -4,16 +4,17 @@ from __future__ import annotations
 
 import math
 import typing
-from dataclasses import MISSING, fields, replace
+from dataclasses import MISSING, dataclass, fields, replace
 
 from ..errors import DesignError, close_matches
 from ..numbers import read_float, read_int
-from ..records import record
 from .imperfections import ImperfectionsSpec
 from .load import BearingSpec, LoadSpec, MaterialSpec
+from .parts import parse_parts
 from .rules import WHEN_BUILT, Rel, check_bounds, show
 from .rules import key as _key
 from .sectors import SectorsSpec, validate_sectors
+from .supports import SupportsSpec
 from .teeth import GearSpec, ToothFormSpec
 
 __all__ = [
@@ -34,7 +35,7 @@ LAW_NAMES = ("harmonic", "disc", "four_force", "ellipse", "external_ring")
 _BETA_LAWS = ("disc", "four_force", "external_ring")
 
 
-@record(frozen=True)
+@dataclass(frozen=True, slots=True)
 class DriveSpec:
     """``[drive]``: the pair of gears and how the drive is used."""
 
@@ -99,7 +100,7 @@ class DriveSpec:
     rotation: str = _key("generator direction seen from the open end", choices=("ccw", "cw"), default="ccw")
 
 
-@record(frozen=True)
+@dataclass(frozen=True, slots=True)
 class GeneratorSpec:
     """``[generator]``: the wave generator and its deformation law (docs/models.md 3)."""
 
@@ -164,7 +165,7 @@ class GeneratorSpec:
     )
 
 
-@record(frozen=True)
+@dataclass(frozen=True, slots=True)
 class Design:
     """A whole design file."""
 
@@ -178,6 +179,7 @@ class Design:
     material: MaterialSpec = MaterialSpec()  # [material], [bearing], [load]: design/load.py
     bearing: BearingSpec = BearingSpec()
     load: LoadSpec = LoadSpec()
+    supports: SupportsSpec = SupportsSpec()  # [supports]: design/supports.py
     imperfections: ImperfectionsSpec = ImperfectionsSpec()  # optional table, docs/models.md 6.2
 
     @property
@@ -212,9 +214,10 @@ TABLES: dict[str, type] = {
     "material": MaterialSpec,
     "bearing": BearingSpec,
     "load": LoadSpec,
+    "supports": SupportsSpec,
     "imperfections": ImperfectionsSpec,
 }
-OPTIONAL_TABLES = ("tooth", "sectors", "material", "bearing", "load", "imperfections")
+OPTIONAL_TABLES = ("tooth", "sectors", "material", "bearing", "load", "supports", "imperfections")
 #: tables validated by other modules (``[parts]``: wgcad.design.parts), passed over here
 _OTHER_TABLES = ("parts",)
 
@@ -406,6 +409,9 @@ def parse_design(data: dict, source: str = "<memory>") -> Design:
                 continue
             raise DesignError(name, f"table [{name}] is required")
         parts[name] = _build(name, cls, data[name])
+    # [parts] is read by the part set and, for the diaphragm the flexspline tilts on, by the loaded model: a bad
+    # key is refused with the design, not when one of them first reads it
+    parse_parts(data.get("parts"))
     return validate(Design(source=source, **parts))
 
 

@@ -2,11 +2,10 @@
 
 from __future__ import annotations
 
-from dataclasses import fields
+from dataclasses import dataclass, fields
 
 from ..errors import DesignError, close_matches
 from ..numbers import read_float, read_int
-from ..records import record
 from .rules import key as _key
 
 __all__ = ["SectorsSpec", "KINDS", "HEIGHT_MODES", "validate_sectors", "sector_pitch_z"]
@@ -23,7 +22,7 @@ HEIGHT_MODES = ("closed_form", "simulated", "full", "list")
 _FILL_TOL = 1e-9
 
 
-@record(frozen=True)
+@dataclass(frozen=True, slots=True)
 class SectorsSpec:
     """``[sectors]``: the rigid gear built from sectors (docs/models.md 2.3), listed counter-clockwise.
 
@@ -55,9 +54,10 @@ class SectorsSpec:
         Smallest tip clearance the simulated heights keep, um.
     assign : str
         How the closed form assigns a generator angle to a tooth:
-        ``"register"`` (where a flexspline tip first faces the tooth's tip,
-        out of register, closest to the major axis) or ``"boundary"`` (the
-        major axis on the nearest sector boundary).
+        ``"boundary"`` (the major axis on the nearest sector boundary, as
+        [S5]'s fig. 3 places the wave: the default) or ``"register"`` (where a
+        flexspline tip first faces the tooth's tip, out of register, closest
+        to the major axis).
     """
 
     kinds: tuple = _key(
@@ -104,7 +104,7 @@ class SectorsSpec:
         default=10.0,
     )
     assign: str = _key(
-        "how the closed form assigns a generator angle to a tooth", rule="register | boundary", default="register"
+        "how the closed form assigns a generator angle to a tooth", rule="boundary | register", default="boundary"
     )
 
     @property
@@ -233,7 +233,7 @@ def validate_sectors(spec: SectorsSpec, z_flex: int, z_rigid: int, waves: int) -
         detail = " + ".join(f"{z} x 360/{p:g}" for z, p in zip(spec.teeth, pz))
         raise DesignError(f"{t}.teeth", f"sectors must fill the circle: {detail} = {360.0 * cover:.4f} deg, not 360")
     _choice(f"{t}.heights", spec.heights, HEIGHT_MODES)
-    _choice(f"{t}.assign", spec.assign, ("register", "boundary"))
+    _choice(f"{t}.assign", spec.assign, ("boundary", "register"))
     if spec.heights == "list":
         zc = [z for k, z in zip(spec.kinds, spec.teeth) if k == "coupling"][0]
         if spec.heights_mm is None or len(spec.heights_mm) != zc:

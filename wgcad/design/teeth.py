@@ -3,14 +3,15 @@
 
 from __future__ import annotations
 
-from ..records import record
+from dataclasses import dataclass
+
 from .rules import WHEN_BUILT, Rel
 from .rules import key as _key
 
 __all__ = ["ToothFormSpec", "GearSpec"]
 
 
-@record(frozen=True)
+@dataclass(frozen=True, slots=True)
 class ToothFormSpec:
     """``[tooth]``: tooth form shared by both gears (docs/models.md 2)."""
 
@@ -82,7 +83,7 @@ class ToothFormSpec:
     )
 
 
-@record(frozen=True)
+@dataclass(frozen=True, slots=True)
 class GearSpec:
     """``[flexspline]`` / ``[rigid]``: one gear's teeth and body."""
 

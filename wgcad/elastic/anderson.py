@@ -13,41 +13,43 @@ _KREF = 1e5  # N/mm, a contact stiffness: weighs rim motions against forces ther
 
 
 class Anderson:
-    """Anderson acceleration of the re-linearisation (type II, Walker & Ni 2011) on the ring loads and rim motion.
+    """Anderson acceleration of the re-linearisation (type II, Walker & Ni 2011) on the ring loads and the members'
+    motion.
 
     The next linearisation point is the affine combination of the last
     solutions that best cancels their residuals (solution minus
     linearisation point), so it balances the torque as each of them does.
     Forces weigh in N, couples per ``_LEVER`` mm, motions times ``_KREF``
-    N/mm (a contact stiffness): the least-squares metric only. The history is
-    dropped when a step does not lower the residual (a change of contact set).
+    N/mm (a contact stiffness; rotations at the rim's radius): the
+    least-squares metric only. The history is dropped when a step does not
+    lower the residual (a change of contact set).
     """
 
-    def __init__(self, r_m: float, depth: int):
-        self.r_m, self.depth = r_m, depth
+    def __init__(self, r_m: float, depth: int, planes: int = 1):
+        self.r_m, self.depth, self.planes = r_m, depth, planes
+        w_rim = np.tile([_KREF, _KREF, _KREF * r_m], planes)
+        self._w = np.concatenate([w_rim, np.full(2 * planes + 2, _KREF)])
         self.reset()
 
     def reset(self):
         self.X, self.G, self.last = [], [], np.inf
 
-    def _vec(self, loads, rigid):
-        return np.concatenate(
-            [loads[:, :2].ravel(), loads[:, 2] / _LEVER, _KREF * np.array([rigid[0], rigid[1], rigid[2] * self.r_m])]
-        )
+    def _vec(self, loads, motion):
+        return np.concatenate([loads[:, :2].ravel(), loads[:, 2] / _LEVER, self._w * motion.vector()])
 
-    def step(self, loads, rigid, loads_new, rigid_new, change):
+    def step(self, loads, motion, loads_new, motion_new, change):
         if self.depth == 0:
-            return loads_new, np.array(rigid_new, dtype=float)
+            return loads_new, motion_new
         if change > self.last or change > ANDERSON_START:
             self.reset()
             if change > ANDERSON_START:
-                return loads_new, np.array(rigid_new, dtype=float)
+                return loads_new, motion_new
         self.last = change
-        self.X.append(self._vec(loads, rigid))
-        self.G.append(self._vec(loads_new, rigid_new))
+        self.X.append(self._vec(loads, motion))
+        self.G.append(self._vec(loads_new, motion_new))
         self.X, self.G = self.X[-(self.depth + 1) :], self.G[-(self.depth + 1) :]
         if len(self.X) < 2:
-            return loads_new, np.array(rigid_new, dtype=float)
+            return loads_new, motion_new
         R = [g - x for g, x in zip(self.G, self.X)]
         dR = np.stack([R[i + 1] - R[i] for i in range(len(R) - 1)], axis=1)
         dG = np.stack([self.G[i + 1] - self.G[i] for i in range(len(R) - 1)], axis=1)
@@ -57,5 +59,4 @@ class Anderson:
         out = np.empty_like(loads)
         out[:, 0], out[:, 1] = y[: 2 * n].reshape(n, 2).T
         out[:, 2] = y[2 * n : 3 * n] * _LEVER
-        r = y[3 * n :] / _KREF
-        return out, np.array([r[0], r[1], r[2] / self.r_m])
+        return out, type(motion).from_vector(y[3 * n :] / self._w, self.planes)

@@ -2,13 +2,12 @@
 
 from __future__ import annotations
 
+from dataclasses import dataclass
 from math import pi
 
 import numpy as np
 
 from wgcad.errors import DesignError
-
-from ..records import record
 
 __all__ = ["HertzPoint", "ball_contact", "FlexibleBearing", "STATIC_PRESSURE_LIMIT_MPA"]
 
@@ -17,7 +16,7 @@ __all__ = ["HertzPoint", "ball_contact", "FlexibleBearing", "STATIC_PRESSURE_LIM
 STATIC_PRESSURE_LIMIT_MPA = 4200.0
 
 
-@record(frozen=True)
+@dataclass(frozen=True, slots=True)
 class HertzPoint:
     """One elliptical Hertz contact, Hamrock & Brewe (1983) approximations (docs/models.md 4.1).
 
@@ -71,7 +70,7 @@ def ball_contact(
     return inner, outer
 
 
-@record(frozen=True)
+@dataclass(frozen=True, slots=True)
 class FlexibleBearing:
     """Balls between the cam and the (merged) outer ring: angles, gap and load-approach law.
 

@@ -2,13 +2,23 @@
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import numpy as np
 
-from ..records import record
 from .solve import ContactSolveError, solve_supported
 from .tables import Compliance
 
-__all__ = ["BallRows", "ball_rows", "MountedState", "mounted", "cam_excess", "generator_torque"]
+__all__ = [
+    "BallRows",
+    "ball_rows",
+    "ball_problem",
+    "field_displacement",
+    "MountedState",
+    "mounted",
+    "cam_excess",
+    "generator_torque",
+]
 
 #: The cam's size is found when the mounted rim's W0 is within this of the design's, mm (1 nm).
 _W0_TOL = 1e-6
@@ -18,7 +28,7 @@ _HERTZ_PASSES = 12
 _FLOOR = 1e-2
 
 
-@record(frozen=True)
+@dataclass(frozen=True, slots=True)
 class BallRows:
     """The balls' rows of the linearised contact problem (docs/models.md 4.1).
 
@@ -73,7 +83,7 @@ def ball_rows(model, excess: float, e=(0.0, 0.0)) -> BallRows:
     return BallRows(b, A, q, normal)
 
 
-@record(frozen=True)
+@dataclass(frozen=True, slots=True)
 class MountedState:
     """The rim pressed onto the cam by the balls alone (no teeth, no torque): the drive at no load before the mesh.
 
@@ -81,10 +91,8 @@ class MountedState:
     ----------
     loads : (n, 3) float
         Generalized loads on the ring at the table's angles (the balls' forces).
-    rigid : (3,) float
-        Rim motion ``dx, dy, rot``.
-    cam : (2,) float
-        The cam's motion against its support, mm (zero when it is held).
+    motion : Motion
+        Where the members stand (the rim against its supports, the cam against its own).
     force : (Z,) float
         Ball forces, N.
     w0 : float
@@ -92,10 +100,35 @@ class MountedState:
     """
 
     loads: np.ndarray
-    rigid: np.ndarray
+    motion: object
     force: np.ndarray
     w0: float
-    cam: np.ndarray
+
+    @property
+    def rigid(self) -> np.ndarray:
+        """The rim against the rigid gear at the generator's centre plane, ``dx, dy, rot``."""
+        return self.motion.centre
+
+    @property
+    def cam(self) -> np.ndarray:
+        return self.motion.cam
+
+
+def ball_problem(model, rows: BallRows):
+    """The balls' freedom columns ``(Z, r)`` and the cup's field ``(U, W)`` (or None) at the ball plane."""
+    sup = model.supports
+    Z = len(rows.q)
+    plane = np.full(Z, sup.ball_plane)
+    A3 = rows.A[:, :3]
+    return sup.columns(A3, rows.A[:, 3:5], plane, np.zeros(Z, dtype=bool)), sup.field(A3, plane)
+
+
+def field_displacement(field, F: np.ndarray):
+    """The cup's field displacements ``-W U' F`` under contact forces ``F`` (None without a field)."""
+    if field is None:
+        return None
+    U, W = field
+    return -(W @ (U.T @ F))
 
 
 def _solve_mount(model, rows: BallRows) -> MountedState:
@@ -106,14 +139,15 @@ def _solve_mount(model, rows: BallRows) -> MountedState:
     idx = tab.z_g + np.arange(Z)
     F = np.zeros(Z)
     active = rows.q < 0.0
+    A, fld = ball_problem(model, rows)
+    # the rim's rotation held: without teeth nothing but the balls' slight tilt sets it (a ring turns freely
+    # on its cam); the mesh sets it once the teeth are in (docs/models.md 4.1)
+    k = model.support_stiffness.copy()
+    k[0] = np.inf
     for _ in range(_HERTZ_PASSES):
         off, slope = br.tangent(F, _FLOOR)
         M = Compliance(tab, idx, rows.b, slope)
-        # the rim's rotation held: without teeth nothing but the balls' slight tilt sets it (a ring turns freely
-        # on its cam); the mesh sets it once the teeth are in (docs/models.md 4.1)
-        k = model.support_stiffness.copy()
-        k[2] = np.inf
-        sol = solve_supported(M, rows.q + off, rows.A, np.zeros(5), k, active=active)
+        sol = solve_supported(M, rows.q + off, A, np.zeros(A.shape[1]), k, active=active, field=fld)
         done = np.abs(sol.F - F).max() <= 1e-9 * max(float(sol.F.max()), 1.0)
         F, active = sol.F, sol.F > 0
         if done:
@@ -126,8 +160,9 @@ def _solve_mount(model, rows: BallRows) -> MountedState:
     loads = np.zeros((len(tab.angles), 3))
     np.add.at(loads, idx, -F[:, None] * rows.b)
     el = tab.tooth_field(loads)
-    w0 = float(el[0, 0] + sol.a[0])  # tooth 0 sits at angle 0: w = elastic + dx
-    return MountedState(loads, sol.a[:3].copy(), F, w0, sol.a[3:].copy())
+    motion = model.supports.plane_motion(sol.a, field_displacement(fld, F))
+    w0 = float(el[0, 0] + motion.centre[0])  # tooth 0 sits at angle 0: w = elastic + dx
+    return MountedState(loads, motion, F, w0)
 
 
 def cam_excess(model) -> float:

@@ -2,19 +2,18 @@
 
 from __future__ import annotations
 
-from dataclasses import field, replace
+from dataclasses import dataclass, field, replace
 from typing import ClassVar
 
 import numpy as np
 
 from ..laws import Law, RimState
-from ..records import record
 from .ring import Ring
 
 __all__ = ["LoadedLaw", "displacements_many"]
 
 
-@record(frozen=True)
+@dataclass(frozen=True, slots=True)
 class LoadedLaw(Law):
     """Neutral line of the loaded flexspline, usable wherever a :class:`~wgcad.laws.Law` is.
 

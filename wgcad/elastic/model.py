@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from dataclasses import field
+from dataclasses import dataclass, field
 from math import pi
 
 import numpy as np
@@ -11,16 +11,16 @@ from wgcad.clearance.engine import Scene
 from wgcad.design.load import require_bearing
 from wgcad.errors import DesignError
 
-from ..records import record
 from .bearing import FlexibleBearing, ball_contact
 from .ring import Ring
+from .supports import Supports, build_supports
 from .tables import RingTables, ring_tables
 from .teeth import ToothCompliance
 
 __all__ = ["ElasticModel", "build_model"]
 
 
-@record(frozen=True)
+@dataclass(frozen=True, slots=True)
 class ElasticModel:
     """Everything the contact solver needs that does not depend on the load.
 
@@ -40,18 +40,16 @@ class ElasticModel:
     scales : (S,) float
         Coning factor ``W0(z)/W0`` of each section.
     cup_stiffness : float
-        Torsional stiffness of the cup wall between rim and diaphragm, N mm/rad (inf without coning data).
+        Torsional stiffness of the cup between the generator's centre plane and the diaphragm, N mm/rad (inf
+        without coning data): what the planar model adds to the wind-up in series.
     torque_sign : float
         +1 when the load torque on the flexspline is counter-clockwise (working flank ``upper``).
     ei_parts : dict
         The bending-stiffness contributions, N mm^2 (reported).
-    lateral_stiffness : float
-        Radial stiffness of the rim's support (the cup), N/mm; 0: the rim floats (its translation is set by the
-        contacts alone).
-    cam_stiffness : float
-        Radial stiffness of the cam's support, N/mm; inf: held where its offset puts it; 0: floating.
     tables : RingTables
         The ring's influence and the nominal rim at the tooth and ball angles (what every solver pass reads).
+    supports : Supports
+        The members' freedoms and what holds them, the cup's fields (docs/models.md 4.2).
     """
 
     drive: object
@@ -66,14 +64,12 @@ class ElasticModel:
     torque_sign: float
     ei_parts: dict
     tables: RingTables
-    lateral_stiffness: float = 0.0
-    cam_stiffness: float = float("inf")
+    supports: Supports
 
     @property
     def support_stiffness(self) -> np.ndarray:
-        """Stiffness of each rigid-body freedom of the contact problem: rim ``dx, dy`` (its support), rim rotation
-        (free: the torque balances it), cam ``dx, dy`` (its support; inf: held), N/mm and N mm/rad."""
-        return np.array([self.lateral_stiffness, self.lateral_stiffness, 0.0, self.cam_stiffness, self.cam_stiffness])
+        """Stiffness of each freedom of the contact problem (:attr:`Supports.names`): 0 free, inf held."""
+        return self.supports.stiffness
 
     #: results reused between load states of this model (the tooth pairs measured at the nominal state)
     cache: dict = field(default_factory=dict, repr=False, compare=False)
@@ -102,7 +98,7 @@ def _int_f2(f, a: float, b: float) -> float:
     return float((b - a) / 6.0 * (f(a) ** 2 + 4.0 * f(m) ** 2 + f(b) ** 2))
 
 
-def build_model(drive, sections: int = 3) -> ElasticModel:
+def build_model(drive, sections: int = 3, rim: str | None = None, plate=None) -> ElasticModel:
     """The elastic model of ``drive`` from its ``[material]`` and ``[bearing]`` tables (docs/models.md 4.1).
 
     Ring stiffness by a Ritz reduction of the cup: the rim's displacement at
@@ -114,6 +110,10 @@ def build_model(drive, sections: int = 3) -> ElasticModel:
     the toothed rim (equivalent thickness ``h_eq``), the plain cup wall up to
     the diaphragm, and the bearing's outer ring bending with it (merged with
     the flexspline: in contact where it carries load).
+
+    ``plate``: the cup's diaphragm ``(r_i, r_o, h)`` (mm) its tilting
+    stiffness is derived from, in place of ``[parts]``' geometric defaults
+    (the rating passes the part set's sized one, wgcad.rating.plate_sizing).
 
     Raises
     ------
@@ -139,15 +139,14 @@ def build_model(drive, sections: int = 3) -> ElasticModel:
     bw = d.drive.face_width
     f = _coning(drive)
     if f is None:
-        rim, cup, cup_len = bw, 0.0, 0.0
+        rim_w, cup = bw, 0.0
         f_of = lambda z: np.ones_like(np.asarray(z, dtype=float))  # noqa: E731
     else:
-        rim = _int_f2(f, 0.0, bw)
-        cup_len = d.generator.cone_length - bw
+        rim_w = _int_f2(f, 0.0, bw)
         cup = _int_f2(f, bw, d.generator.cone_length)
         f_of = f
     parts = {
-        "toothed_rim": E * h_eq**3 / 12.0 * rim,
+        "toothed_rim": E * h_eq**3 / 12.0 * rim_w,
         "cup_wall": E * t_cup**3 / 12.0 * cup,
         "bearing_outer_ring": E * br.width_mm * br.outer_ring_thickness_mm**3 / 12.0,
     }
@@ -167,19 +166,15 @@ def build_model(drive, sections: int = 3) -> ElasticModel:
     zs = drive.sections(sections)
     widths = np.full(1, bw) if sections == 1 else bw * np.diff(np.concatenate([[0.0], 0.5 * (zs[1:] + zs[:-1]), [bw]]))
     scene = Scene(drive)
-    teeth = ToothCompliance(E, mat.poisson, 0.5 * pi * d.drive.module, flex.r_f, drive.rigid.r_f)
-    r_c = drive.flex_rim_radius + 0.5 * t_cup
-    k_cup = G * 2.0 * pi * r_c**3 * t_cup / cup_len if cup_len > 0 else float("inf")
+    bending = d.load.tooth_compliance == "hertz_bending"
+    teeth = ToothCompliance(E, mat.poisson, 0.5 * pi * d.drive.module, flex.r_f, drive.rigid.r_f, with_bending=bending)
     laws = [drive.law_at(float(z)) if drive.coned else drive.law for z in zs]
     tables = ring_tables(ring, d.drive.z_flex, psi, laws, drive.law)
-    k_lat = d.load.rim_lateral_stiffness_n_per_mm
-    if k_lat is None:
-        k_lat = (
-            cup_lateral_stiffness(E, G, r_c, t_cup, d.generator.cone_length - d.generator.generator_z)
-            if f is not None
-            else 0.0
-        )
-    k_cam = d.load.cam_support_stiffness_n_per_mm
+    if rim is not None and rim not in ("spatial", "planar"):
+        raise DesignError("supports.rim", f"must be 'spatial' or 'planar', got {rim!r}")
+    spatial = None if rim is None else rim == "spatial"
+    supports = build_supports(drive, zs, E, G, t_cup, d.supports, spatial, plate)
+    k_cup = 1.0 / supports.cup_twist if supports.cup_twist > 0 else float("inf")
     return ElasticModel(
         drive,
         scene,
@@ -193,15 +188,5 @@ def build_model(drive, sections: int = 3) -> ElasticModel:
         1.0 if scene.working == "upper" else -1.0,
         parts,
         tables,
-        float(k_lat),
-        float("inf") if k_cam is None else float(k_cam),
+        supports,
     )
-
-
-def cup_lateral_stiffness(E: float, G: float, r: float, t: float, length: float) -> float:
-    """Radial stiffness (N/mm) of a thin tube of radius ``r``, wall ``t`` and ``length``, clamped at the diaphragm,
-    loaded at its free end: bending ``L^3 / (3 E pi r^3 t)`` plus shear ``L / (k G 2 pi r t)`` with the thin tube's
-    shear coefficient ``k = 1/2`` (docs/models.md 4.1). The diaphragm's own tilt is left out: an upper bound."""
-    I = pi * r**3 * t
-    A = 2.0 * pi * r * t
-    return 1.0 / (length**3 / (3.0 * E * I) + length / (0.5 * G * A))

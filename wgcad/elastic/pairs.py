@@ -61,16 +61,22 @@ class MeasuredPairs:
         new.__dict__.update({k: (v.copy() if isinstance(v, np.ndarray) else v) for k, v in self.__dict__.items()})
         return new
 
-    def linear_gap(self, keys, fU, rigid):
-        """Linearised gap of pairs ``keys`` at the current state (``fU``: scaled elastic ``w, v, theta`` at each pair's tooth)."""
-        return self.q_geo[keys] - (self.b[keys] * fU).sum(axis=1) - self.A[keys] @ rigid
+    def _sec_motion(self, keys, motion):
+        """Each pair's section motion ``(k, 3)`` from the rim's motion per section ``motion`` ``(S, 3)``."""
+        return np.asarray(motion, dtype=float).reshape(-1, 3)[(keys // 2) // self.model.tables.z_g]
+
+    def linear_gap(self, keys, fU, motion):
+        """Linearised gap of pairs ``keys`` at the current state (``fU``: scaled elastic ``w, v, theta`` at each pair's
+        tooth; ``motion``: the rim's motion against the rigid gear per section, ``(S, 3)``)."""
+        sec = self._sec_motion(keys, motion)
+        return self.q_geo[keys] - (self.b[keys] * fU).sum(axis=1) - (self.A[keys] * sec).sum(axis=1)
 
     def _move(self, keys, rot, origin):
         """Largest motion of any point of each pair's tooth since the pair was measured, mm."""
         t = keys // 2
         return np.hypot(*(origin[t] - self.at_origin[keys]).T) + np.abs(rot[t] - self.at_rot[keys]) * self.lever
 
-    def update(self, rot, shift, origin, el, cand, rigid, full: bool = False):
+    def update(self, rot, shift, origin, el, cand, motion, full: bool = False):
         """Measure again the pairs of teeth ``cand`` (flat tooth indices) that need it; return the keys within GAP_MARGIN."""
         m = self.model
         sec, tooth = np.divmod(cand, m.tables.z_g)
@@ -83,14 +89,14 @@ class MeasuredPairs:
             need = ~seen
             k0 = keys[seen]
             move = self._move(k0, rot, origin)
-            lin = self.linear_gap(k0, fU[seen], rigid)
+            lin = self.linear_gap(k0, fU[seen], motion)
             # a tooth that has not moved (a warm start's first pass) keeps its exact measurement
             need[seen] = (lin < 2.0 * move + REFRESH_MARGIN) & (move > 1e-9)
-        self._measure(np.nonzero(need)[0], keys, fU, rot, shift, origin, rigid)
-        lin = self.linear_gap(keys, fU, rigid)
+        self._measure(np.nonzero(need)[0], keys, fU, rot, shift, origin, motion)
+        lin = self.linear_gap(keys, fU, motion)
         return keys[lin < GAP_MARGIN]
 
-    def _measure(self, idx, keys, fU, rot, shift, origin, rigid):
+    def _measure(self, idx, keys, fU, rot, shift, origin, motion):
         """Measure pairs ``keys[idx]`` on the exact geometry at the current poses."""
         if idx.size == 0:
             return
@@ -113,11 +119,11 @@ class MeasuredPairs:
         self.gap[k] = g.gap
         self.b[k], self.A[k], self.point[k], self.normal[k] = b, A, p, n
         self.rigid_tooth[k] = g.rigid
-        self.q_geo[k] = g.gap + (b * fU[idx]).sum(axis=1) + A @ rigid
+        self.q_geo[k] = g.gap + (b * fU[idx]).sum(axis=1) + (A * self._sec_motion(k, motion)).sum(axis=1)
         self.at_origin[k] = origin[t]
         self.at_rot[k] = rot[t]
 
-    def report(self, rot, shift, origin, el, cand, rigid):
+    def report(self, rot, shift, origin, el, cand, motion):
         """The pairs within GAP_MARGIN at a solved state and their gaps, exact wherever it can matter.
 
         Measured on the exact geometry: every pair that could be closing (as
@@ -132,13 +138,13 @@ class MeasuredPairs:
         gap : (k,) float, mm
         exact : (k,) bool
         """
-        self.update(rot, shift, origin, el, cand, rigid)
+        self.update(rot, shift, origin, el, cand, motion)
         m = self.model
         sec, tooth = np.divmod(cand, m.tables.z_g)
         flat = np.stack([2 * cand, 2 * cand + 1], axis=1).ravel()
         fU = np.repeat(m.scales[sec][:, None] * el[:, tooth].T, 2, axis=0)
         while True:
-            lin = self.linear_gap(flat, fU, rigid)
+            lin = self.linear_gap(flat, fU, motion)
             move = self._move(flat, rot, origin)
             exact = move <= 1e-9
             op = exact & (lin > 0.0)
@@ -154,6 +160,6 @@ class MeasuredPairs:
                 need[first[np.isfinite(lb[first])]] = True
             if not need.any():
                 break
-            self._measure(np.nonzero(need)[0], flat, fU, rot, shift, origin, rigid)
+            self._measure(np.nonzero(need)[0], flat, fU, rot, shift, origin, motion)
         band = lin < GAP_MARGIN
         return flat[band], np.where(exact, self.gap[flat], lin)[band], exact[band]

@@ -26,18 +26,19 @@ __all__ = [
 RADIAL_MARGIN = 0.2
 
 
-def rim_displacements(model: ElasticModel, loads: np.ndarray, rigid) -> tuple:
+def rim_displacements(model: ElasticModel, loads: np.ndarray, motion) -> tuple:
     """``w, v, theta`` ``(S, z_g)`` of every section at the tooth angles, and the elastic field ``(3, z_g)`` (centre scale).
 
-    The formula of :class:`LoadedLaw` (nominal law + scaled ring field +
-    rigid-body motion) on the model's tables: the same numbers, without the
-    kernel evaluations.
+    ``motion``: the rim's rigid-body motion against the rigid gear, ``(dx, dy, rot)`` (3,) for every section or
+    ``(S, 3)`` one per section (docs/models.md 4.2). The formula of :class:`LoadedLaw` (nominal law + scaled ring
+    field + rigid-body motion) on the model's tables: the same numbers, without the kernel evaluations.
     """
     tab = model.tables
     el = tab.tooth_field(loads)
     phi = tab.angles[: tab.z_g]
     c, sn = np.cos(phi), np.sin(phi)
-    dx, dy, rot = (float(x) for x in rigid)
+    m = np.asarray(motion, dtype=float).reshape(-1, 3)
+    dx, dy, rot = m[:, 0:1], m[:, 1:2], m[:, 2:3]
     nom = tab.nominal
     f = model.scales[:, None]
     # the rim is round when unloaded: the cam's balls bend it (their forces are among the loads), so the
@@ -49,7 +50,7 @@ def rim_displacements(model: ElasticModel, loads: np.ndarray, rigid) -> tuple:
     return w, v, th, el
 
 
-def tooth_poses(model: ElasticModel, loads: np.ndarray, rigid, tooth_errors=None):
+def tooth_poses(model: ElasticModel, loads: np.ndarray, motion, tooth_errors=None):
     """Poses of every tooth of every section (flattened ``section * z_g + tooth``), their neutral-line origins and
     the elastic field, plus the indices of the teeth whose tips reach within RADIAL_MARGIN of the rigid tips.
 
@@ -58,7 +59,7 @@ def tooth_poses(model: ElasticModel, loads: np.ndarray, rigid, tooth_errors=None
     d = model.drive
     z_g = model.tables.z_g
     S = len(model.zs)
-    w, v, th, el = rim_displacements(model, loads, rigid)
+    w, v, th, el = rim_displacements(model, loads, motion)
     phi = np.broadcast_to(model.tables.angles[:z_g], (S, z_g))
     off = np.array([model.section_law(i).tooth_offset for i in range(S)])[:, None]
     rot, shift = pose_from_displacements(phi, w, v, th, d.r_m, 0.0, off)
@@ -102,9 +103,9 @@ def displaced(points: np.ndarray, tooth_errors) -> np.ndarray:
     return np.stack([ct * points[:, 0] - st * points[:, 1], st * points[:, 0] + ct * points[:, 1]], axis=-1) + move
 
 
-def tooth_origins(model: ElasticModel, loads: np.ndarray, rigid, tooth_errors=None) -> np.ndarray:
+def tooth_origins(model: ElasticModel, loads: np.ndarray, motion, tooth_errors=None) -> np.ndarray:
     """Neutral-line origins ``(S z_g, 2)`` of every tooth of every section (flattened as in :func:`tooth_poses`)."""
-    w, v, _, _ = rim_displacements(model, loads, rigid)
+    w, v, _, _ = rim_displacements(model, loads, motion)
     phi = model.tables.angles[: model.tables.z_g]
     c, sn = np.cos(phi), np.sin(phi)
     r = model.drive.r_m + w

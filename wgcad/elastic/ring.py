@@ -2,13 +2,12 @@
 
 from __future__ import annotations
 
+from dataclasses import dataclass
 from math import pi
 
 import numpy as np
 
 from wgcad.errors import DesignError
-
-from ..records import record
 
 __all__ = ["Ring", "ring_kernels", "series_kernels"]
 
@@ -131,7 +130,7 @@ def series_kernels(x, n_max: int = 20000):
     return c @ (1.0 / (n2 * (n2 - 1.0) ** 2)), c @ (1.0 / (n2 * (n2 - 1.0)))
 
 
-@record(frozen=True)
+@dataclass(frozen=True, slots=True)
 class Ring:
     """A thin inextensible elastic ring: radius ``r`` (mm), bending stiffness ``EI`` (N mm^2).
 

@@ -3,16 +3,15 @@
 from __future__ import annotations
 
 import time
-from dataclasses import field, replace
+from dataclasses import dataclass, field
 from typing import NamedTuple
 
 import numpy as np
 
 from wgcad.errors import DesignError
 
-from ..records import record
 from .anderson import Anderson
-from .cam import ball_rows, cam_excess, generator_torque, mounted
+from .cam import ball_rows, cam_excess, field_displacement, generator_torque, mounted
 from .loaded import LoadedLaw
 from .model import ElasticModel
 from .pairs import GAP_MARGIN, MeasuredPairs
@@ -25,9 +24,10 @@ from .rim import (
     tooth_poses,
 )
 from .solve import ContactSolveError, solve_supported
+from .supports import Motion
 from .tables import Compliance
 
-__all__ = ["LoadState", "solve_load", "POSITION_TOL", "RADIAL_MARGIN", "GAP_MARGIN"]
+__all__ = ["LoadState", "solve_load", "POSITION_TOL", "RADIAL_MARGIN", "GAP_MARGIN", "STEP_LIMIT"]
 
 #: Re-linearisation stops when no tooth moves by more than this between two
 #: solutions, mm (0.2 um: a fifth of the 1 um chord tolerance of the outlines.
@@ -38,8 +38,11 @@ POSITION_TOL = 2e-4
 #: (the approach error it leaves is below 1e-5 mm for the balls and teeth of D1).
 FORCE_FLOOR = 1e-2
 _MAX_LINEARISATIONS = 100
+#: Largest move of a tooth one pass may take, mm: a longer step is shortened to it (the radial margin within which
+#: teeth are considered, RADIAL_MARGIN: beyond it the linearisation knows nothing).
+STEP_LIMIT = 0.2
 #: Smallest relaxation of a cycling re-linearisation: its steps shrink to this share of the plain step.
-_OMEGA_MIN = 1.0 / 64.0
+_OMEGA_MIN = 1.0 / 256.0
 #: Solutions the re-linearisation's Anderson acceleration combines (0: plain fixed-point iteration).
 ANDERSON_DEPTH = 3
 #: Every state's first pass solves the contact problem up to this many times, the Hertz contacts linearised
@@ -51,10 +54,12 @@ _HERTZ_START = 8
 #: ... until the forces change by less than this share of the largest (a starting point, not the answer:
 #: the passes that follow converge to the same fixed point).
 _HERTZ_TOL = 0.1
+#: the shares of the torque a cold start passes through before the full torque (each warm-starting the next)
+_RAMP = (0.25, 0.5)
 _TRACE = None  # a list to record (pass, change, relaxation, pairs, loaded contacts) while debugging
 
 
-@record(frozen=True)
+@dataclass(frozen=True, slots=True)
 class LoadState:
     """A solved load state (lengths mm, angles rad, forces N inside).
 
@@ -66,7 +71,8 @@ class LoadState:
     laws : list of LoadedLaw
         The loaded neutral line of each section (``model.zs``).
     rigid : (3,) float
-        Rim translation ``dx, dy`` (mm) and rotation (rad, counter-clockwise) relative to the rigid gear.
+        Rim translation ``dx, dy`` (mm) and rotation (rad, counter-clockwise) relative to the rigid gear at the
+        generator's centre plane (the ball plane).
     contacts : dict of arrays
         ``kind`` (0 ball, 1 tooth), ``section``, ``tooth``, ``flank`` (0 lower, 1 upper, -1 ball),
         ``phi`` (rad), ``force`` (N), ``gap`` (geometric gap at the solution, mm: exact, from the
@@ -93,21 +99,57 @@ class LoadState:
     #: torque the balls put on the cam, N mm (counter-clockwise positive; frictionless: on average over a mesh
     #: period the output torque over the ratio, docs/models.md 4.1)
     generator_torque: float = 0.0
-    #: the cam's motion against its support, mm (generator frame; zero when it is held)
-    cam_shift: np.ndarray = field(default_factory=lambda: np.zeros(2))
+    #: where every member stands (:class:`~wgcad.elastic.supports.Motion`: the rim and rigid gear at each plane,
+    #: the cam against its support)
+    motion: object = None
+    #: the freedoms of the contact problem (``model.supports.names``), mm and rad
+    freedoms: np.ndarray = field(default_factory=lambda: np.zeros(0))
+
+    @property
+    def cam_shift(self) -> np.ndarray:
+        """The cam's motion against its support, mm (generator frame; zero when it is held)."""
+        return self.motion.cam if self.motion is not None else np.zeros(2)
 
     @property
     def mesh_wind_up(self) -> float:
-        """Rotation of the toothed rim against the rigid gear, rad (signed so that it grows with torque)."""
+        """Rotation of the toothed rim against the rigid gear at the generator's centre plane, rad (signed so that
+        it grows with torque)."""
         return float(self.model.torque_sign * self.rigid[2])
 
     @property
+    def output_rotation(self) -> float:
+        """The output's rotation against the rigid gear, rad (counter-clockwise): the diaphragm's (spatial rim) or
+        the rim's plus the cup's twist in series (planar), docs/models.md 4.2."""
+        sup = self.model.supports
+        return sup.output_rotation(self.freedoms, self.model.torque_sign * 1e3 * self.torque_nm)
+
+    @property
     def wind_up(self) -> float:
-        """Output wind-up: rim rotation plus the cup's twist ``M / K_cup``, rad."""
-        return self.mesh_wind_up + 1e3 * self.torque_nm / self.model.cup_stiffness
+        """Output wind-up, rad (signed so that it grows with torque)."""
+        return float(self.model.torque_sign * self.output_rotation)
 
     def law(self, section: int = 0) -> LoadedLaw:
         return self.laws[section]
+
+    def zone_torque(self) -> np.ndarray:
+        """The torque each engagement zone carries, N mm ``(waves,)``: the tooth forces' moments about the axis by
+        the wave their tooth belongs to (docs/models.md 4.2), signed like the output torque."""
+        c = self.contacts
+        t = c["kind"] == 1
+        n_w = self.model.drive.design.drive.waves
+        # the wave a tooth belongs to: the nearest major axis (at 2 pi k / n_w from the generator's)
+        wave = np.mod(np.round(c["phi"][t] * n_w / (2.0 * np.pi)), n_w).astype(int)
+        p, n = c["point"][t], c["normal"][t]
+        moment = -c["force"][t] * (p[:, 0] * n[:, 1] - p[:, 1] * n[:, 0])
+        out = np.zeros(n_w)
+        np.add.at(out, wave, moment)
+        return -out * self.model.torque_sign
+
+    def zone_share(self) -> np.ndarray:
+        """Each zone's share of the tooth torque ``(waves,)`` (sums to 1; NaN without tooth load)."""
+        z = self.zone_torque()
+        tot = float(z.sum())
+        return z / tot if tot > 0 else np.full(len(z), np.nan)
 
 
 def _cam_offset(e_um: float, e_deg: float) -> np.ndarray:
@@ -116,40 +158,62 @@ def _cam_offset(e_um: float, e_deg: float) -> np.ndarray:
     return np.array([e * np.cos(a), e * np.sin(a)])
 
 
-def _geometry(model: ElasticModel, loads: np.ndarray, rigid):
-    """Every tooth pair within GAP_MARGIN measured on the exact geometry at the state ``(loads, rigid)``: keys, gaps, pairs."""
-    rot, shift, origin, el, cand = tooth_poses(model, loads, rigid)
+def _geometry(model: ElasticModel, loads: np.ndarray, motion: Motion):
+    """Every tooth pair within GAP_MARGIN measured on the exact geometry at the state ``(loads, motion)``: keys, gaps, pairs."""
+    rot, shift, origin, el, cand = tooth_poses(model, loads, motion.sections)
     pairs = MeasuredPairs(model)
-    keys = pairs.update(rot, shift, origin, el, cand, rigid, full=True) if cand.size else np.zeros(0, dtype=int)
+    sec = motion.sections
+    keys = pairs.update(rot, shift, origin, el, cand, sec, full=True) if cand.size else np.zeros(0, dtype=int)
     return keys, pairs.gap[keys], pairs
 
 
-def _assemble(model: ElasticModel, pairs: MeasuredPairs, keys, el, rigid, e, F_prev_ball, F_prev_teeth):
-    """Vectors of the linearised contact problem (balls first, then the tooth pairs ``keys``): angle index, b, f, A, q, s."""
+class _Problem(NamedTuple):
+    """The linearised contact problem of a pass (balls first, then the tooth pairs ``keys``)."""
+
+    idx: np.ndarray  # angle index of each contact in the ring's tables
+    b: np.ndarray  # (m, 3) how a unit force loads the ring
+    f: np.ndarray  # (m,) coning weight
+    A: np.ndarray  # (m, r) freedom columns
+    q: np.ndarray  # (m,) gap at zero force and zero motion (Hertz offsets included)
+    s: np.ndarray  # (m,) contact compliances
+    field: object  # (U, W) of the cup, or None
+
+
+def _assemble(model: ElasticModel, pairs: MeasuredPairs, keys, e, F_prev_ball, F_prev_teeth) -> _Problem:
+    """The linearised contact problem: balls along the cam's normals, the rim round when unloaded (cam.ball_rows,
+    docs/models.md 4.1), then the tooth pairs ``keys`` as measured; every contact's freedom columns and the cup's
+    field from its plane (docs/models.md 4.2)."""
     br = model.bearing
     tab = model.tables
+    sup = model.supports
     Z = len(br.psi)
-    # balls: along the cam's normals, the rim round when unloaded (cam.ball_rows, docs/models.md 4.1)
     rows = ball_rows(model, cam_excess(model), e)
     idx_b = tab.z_g + np.arange(Z)
-    b_b, A_b = rows.b, rows.A
     o_b, s_b = br.tangent(F_prev_ball, FORCE_FLOOR)
     q_b = rows.q + o_b
-    if len(keys) == 0:
-        return idx_b, b_b, np.ones(Z), A_b, q_b, s_b
     sec, tooth = np.divmod(keys // 2, tab.z_g)
+    n_t = len(keys)
+    A3 = np.concatenate([rows.A[:, :3], pairs.A[keys]])
+    cam = np.concatenate([rows.A[:, 3:5], np.zeros((n_t, 2))])
+    plane = np.concatenate([np.full(Z, sup.ball_plane), sec])
+    is_tooth = np.concatenate([np.zeros(Z, dtype=bool), np.ones(n_t, dtype=bool)])
+    A = sup.columns(A3, cam, plane, is_tooth)
+    fld = sup.field(A3, plane)
+    if n_t == 0:
+        return _Problem(idx_b, rows.b, np.ones(Z), A, q_b, s_b, fld)
     f_t = model.scales[sec]
     width = model.widths[sec]
     o_t, s_t = model.teeth.tangent(F_prev_teeth, width, FORCE_FLOOR)
     s_t = s_t + model.teeth.bending(pairs.point[keys], pairs.normal[keys], width)
     q_t = pairs.q_geo[keys] + o_t
-    return (
+    return _Problem(
         np.concatenate([idx_b, tooth]),
-        np.concatenate([b_b, pairs.b[keys]]),
+        np.concatenate([rows.b, pairs.b[keys]]),
         np.concatenate([np.ones(Z), f_t]),
-        np.concatenate([A_b, np.pad(pairs.A[keys], ((0, 0), (0, 2)))]),
+        A,
         np.concatenate([q_b, q_t]),
         np.concatenate([s_b, s_t]),
+        fld,
     )
 
 
@@ -172,17 +236,18 @@ def solve_load(
     tol: float = POSITION_TOL,
     warm: LoadState | None = None,
     tooth_errors=None,
+    ramp: bool = True,
+    exact_report: bool = True,
 ) -> LoadState:
     """Solve the drive under output torque ``torque_nm`` with the cam axis offset by ``cam_offset_um`` at ``cam_offset_deg``.
 
-    Generator at angle 0 (major axis on +x, tooth 0 on it, rigid gear fixed).
+    Generator at angle 0 (major axis on +x, tooth 0 on it, rigid gear's teeth as the design places them).
     Each pass: exact contact geometry of every tooth near engagement from the
     clearance engine at the current loaded poses; the linearised problem
-    ``gap = q + (D + diag(s)) F - A a >= 0, F >= 0, F gap = 0, A'F = (0, 0, M)``
-    with ``D`` the ring compliance, ``s`` the ball and tooth secant
-    compliances, ``A`` the rim's rigid-body freedoms (docs/models.md 4.1);
-    then the poses are updated and the pass repeated until no tooth moves by
-    more than ``tol`` (mm).
+    ``gap = q + (D + diag(s) + U W U') F - A a >= 0, F >= 0, F gap = 0`` with the
+    freedoms ``a`` of every member free, held or sprung (``D`` the ring compliance, ``s`` the ball and tooth
+    secant compliances, ``U W U'`` the cup's bending and twist between planes; docs/models.md 4.1, 4.2); then the
+    poses are updated and the pass repeated until no tooth moves by more than ``tol`` (mm).
 
     Raises
     ------
@@ -196,58 +261,43 @@ def solve_load(
     relative to the rigid teeth: ``(turn, move)`` per tooth of every section
     (flattened ``section * z_g + tooth``), rad and mm
     (:mod:`wgcad.accuracy.ke_load` builds them from the run-out and
-    eccentricities); the cam offset stays the physical input above.
+    eccentricities); the cam offset stays the physical input above. A cold start (no ``warm``) brings the
+    torque up in steps (``ramp``). ``exact_report`` False leaves the final measurement of the open pairs out
+    (their gaps the last linearisation's): a run that needs only the motions and forces (the loaded KE).
     """
     _check_load_inputs(torque_nm, cam_offset_um, tol)
+    if warm is None and torque_nm > 0 and ramp:
+        warm = _ramp(model, torque_nm, cam_offset_um, cam_offset_deg, tol, tooth_errors)
     e = _cam_offset(cam_offset_um, cam_offset_deg)
-    f_ext = np.array([0.0, 0.0, model.torque_sign * 1e3 * torque_nm, 0.0, 0.0])
+    sup = model.supports
+    f_ext = sup.f_ext(model.torque_sign * 1e3 * torque_nm)
     Z = len(model.bearing.psi)
     n_keys = len(model.zs) * model.tables.z_g * 2
-    loads, rigid, F_ball, pairs = _start(model, e, warm)
-    state = _Iterate(
-        loads, rigid, F_ball, np.zeros(n_keys), np.zeros(n_keys, dtype=bool), Anderson(model.drive.r_m, ANDERSON_DEPTH)
-    )
+    loads, motion, F_ball, pairs = _start(model, e, warm)
+    F_teeth = _warm_teeth(model, warm, n_keys, float(torque_nm))
+    acc = Anderson(model.drive.r_m, ANDERSON_DEPTH, len(sup.planes))
+    state = _Iterate(loads, motion, F_ball, F_teeth, F_teeth > 0, acc)
     times = {"geometry": 0.0, "solver": 0.0}
     pivots = 0
     change = 0.0
     for it in range(_MAX_LINEARISATIONS):
-        lin = _linearise(
-            model,
-            torque_nm,
-            e,
-            f_ext,
-            pairs,
-            state.loads,
-            state.rigid,
-            state.F_ball,
-            state.F_teeth,
-            state.active,
-            it,
-            tooth_errors,
-        )
-        keys, F, sol = lin.keys, lin.F, lin.sol
+        lin = _linearise(model, torque_nm, e, f_ext, pairs, state, it, tooth_errors)
+        keys, F = lin.keys, lin.F
         pivots += lin.pivots
         times["geometry"] += lin.t_geo
         times["solver"] += lin.t_sol
-        last = (keys, F, sol, lin.idx, lin.b, lin.f, pairs.point[keys], pairs.normal[keys], lin.cam_shift)
-        loads_new = dense_loads(len(model.tables.angles), lin.idx, F, lin.f, lin.b)
+        last = (keys, F, lin, pairs.point[keys], pairs.normal[keys])
+        loads_new = dense_loads(len(model.tables.angles), lin.prob.idx, F, lin.prob.f, lin.prob.b)
         F_t_new = np.zeros(n_keys)
         F_t_new[keys] = F[Z:]
-        # convergence: the largest move of an engaging tooth from the linearisation's poses to the solution's
-        # (the fixed-point residual itself, from the tables: no engine call)
-        o_new = tooth_origins(model, loads_new, sol.a, tooth_errors)
-        k2 = keys // 2
-        d = np.hypot(*(o_new[k2] - lin.origin[k2]).T)
-        change = max(float(d.max()) if d.size else 0.0, abs(float(sol.a[2] - state.rigid[2])) * model.drive.r_m)
+        change = _change(model, loads_new, lin, state.motion, tooth_errors)
         if _TRACE is not None:
             _TRACE.append((it, change, state.omega, len(keys), int((F > 0).sum())))
-        if change < tol:
-            break
-        if state.settled_after(change, tol):
+        if change < tol or state.settled_after(change, tol):
             break
         active = np.zeros(n_keys, dtype=bool)
         active[keys] = F[Z:] > 0
-        state.advance(it, change, tol, _Plain(loads_new, sol.a, F[:Z], F_t_new, active))
+        state.advance(it, change, tol, _Plain(loads_new, lin.motion, F[:Z], F_t_new, active))
     else:
         raise ContactSolveError(
             f"the elastic model did not converge at {torque_nm:g} N m: tooth positions still moving by "
@@ -260,7 +310,37 @@ def solve_load(
         "position_change_mm": change,
         "settled_by_relaxation": state.relaxed,
     }
-    return _report(model, torque_nm, e, pairs, last, progress, times, tooth_errors)
+    return _report(model, torque_nm, e, pairs, last, progress, times, tooth_errors, exact_report)
+
+
+def _change(model, loads_new, lin: _Pass, motion: Motion, tooth_errors) -> float:
+    """The largest move of an engaging tooth from the linearisation's poses to the solution's, mm (the fixed-point
+    residual itself, from the tables: no engine call), and of the rim's rotation at its radius."""
+    o_new = tooth_origins(model, loads_new, lin.motion.sections, tooth_errors)
+    k2 = lin.keys // 2
+    d = np.hypot(*(o_new[k2] - lin.origin[k2]).T)
+    d_rot = np.abs(lin.motion.rim[:, 2] - motion.rim[:, 2]).max() * model.drive.r_m
+    return max(float(d.max()) if d.size else 0.0, float(d_rot))
+
+
+def _ramp(model, torque_nm, cam_offset_um, cam_offset_deg, tol, tooth_errors) -> LoadState:
+    """The states a cold start passes through first. At full torque one linearisation about the unloaded rim would
+    carry it all: on soft supports the first passes then swing the members by hundreds of micrometres. The
+    torque is brought up in steps instead, each state warm-starting the next (the fixed point is the same)."""
+    warm = None
+    for share in _RAMP:
+        warm = solve_load(
+            model,
+            share * torque_nm,
+            cam_offset_um,
+            cam_offset_deg,
+            tol,
+            warm,
+            tooth_errors,
+            ramp=False,
+            exact_report=False,
+        )
+    return warm
 
 
 def _check_load_inputs(torque_nm, cam_offset_um, tol) -> None:
@@ -272,13 +352,13 @@ def _check_load_inputs(torque_nm, cam_offset_um, tol) -> None:
         raise DesignError("tol", f"must be > 0 mm, got {tol:g}")
 
 
-@record
+@dataclass(slots=True)
 class _Iterate:
-    """The fixed-point iteration's state between linearisations: the loads on the rim, the rim's rigid-body
-    position, the ball and tooth forces, which teeth carried load, and the relaxation."""
+    """The fixed-point iteration's state between linearisations: the loads on the rim, where the members stand,
+    the ball and tooth forces, which teeth carried load, and the relaxation."""
 
     loads: np.ndarray
-    rigid: np.ndarray
+    motion: Motion
     F_ball: np.ndarray
     F_teeth: np.ndarray
     active: np.ndarray
@@ -310,13 +390,19 @@ class _Iterate:
             self.acc.reset()
         self.last_change = change
         w = self.omega
+        if change > STEP_LIMIT:
+            # a pass that would swing the teeth by more than the radial margin (a warm start from a state far off, a
+            # soft member): the linearisation does not reach that far, so only that far is taken (the fixed point
+            # is the same; the acceleration starts afresh)
+            w = min(w, STEP_LIMIT / change)
+            self.acc.reset()
         if w < 1.0:
             self.loads = (1 - w) * self.loads + w * plain.loads
-            self.rigid = (1 - w) * self.rigid + w * plain.rigid
+            self.motion = self.motion.mix(plain.motion, w)
             self.F_ball = (1 - w) * self.F_ball + w * plain.F_ball
             self.F_teeth = (1 - w) * self.F_teeth + w * plain.F_teeth
         else:
-            self.loads, self.rigid = self.acc.step(self.loads, self.rigid, plain.loads, plain.rigid, change)
+            self.loads, self.motion = self.acc.step(self.loads, self.motion, plain.loads, plain.motion, change)
             self.F_ball = plain.F_ball.copy()
             self.F_teeth = plain.F_teeth
         self.active = plain.active
@@ -326,92 +412,118 @@ class _Plain(NamedTuple):
     """The linearisation's solution as the next iterate of the plain fixed-point iteration."""
 
     loads: np.ndarray
-    rigid: np.ndarray
+    motion: Motion
     F_ball: np.ndarray
     F_teeth: np.ndarray
     active: np.ndarray
 
 
+def _warm_teeth(model: ElasticModel, warm: LoadState | None, n_keys: int, torque_nm: float) -> np.ndarray:
+    """The tooth forces of the state a run starts from at the same torque, by pair key (else zero): the first pass
+    linearises the Hertz contacts about them and starts its active set from the pairs they load. From another
+    torque (a ramp, a torque sweep) the first pass starts from the closed pairs and linearises again as it goes."""
+    out = np.zeros(n_keys)
+    if warm is not None and warm.torque_nm == torque_nm:
+        c = warm.contacts
+        t = c["kind"] == 1
+        out[(c["section"][t] * model.tables.z_g + c["tooth"][t]) * 2 + c["flank"][t]] = c["force"][t]
+    return out
+
+
 def _start(model: ElasticModel, e: np.ndarray, warm: LoadState | None):
-    """The state the iteration starts from: ring loads per table angle, rim freedoms, ball forces, measured pairs."""
+    """The state the iteration starts from: ring loads per table angle, where the members stand, ball forces,
+    measured pairs."""
     tab = model.tables
     if warm is not None:
-        loads, rigid = loads_on_table(tab, warm.laws[0].psi, warm.laws[0].loads), np.array(warm.rigid)
+        loads, motion = loads_on_table(tab, warm.laws[0].psi, warm.laws[0].loads), warm.motion
         F_ball = warm.contacts["force"][warm.contacts["kind"] == 0].copy()
     else:
         # a cold start begins on the cam: the rim pressed onto it by the balls alone (no teeth, no torque)
         mnt = mounted(model, e)
-        loads, rigid, F_ball = mnt.loads.copy(), mnt.rigid.copy(), mnt.force.copy()
+        loads, motion, F_ball = mnt.loads.copy(), mnt.motion, mnt.force.copy()
     # a warm start's pairs were measured at exactly its state: the first pass measures only what moves
     if warm is not None and warm.pairs is not None and warm.pairs.model is model:
-        return loads, rigid, F_ball, warm.pairs.copy()
+        return loads, motion, F_ball, warm.pairs.copy()
     # a cold start's first pass is the mounted state: its pairs are measured once per model and cam offset
     key = ("mounted_pairs", float(e[0]), float(e[1]))
     if key not in model.cache:
         nominal = MeasuredPairs(model)
-        rot0, shift0, origin0, el0, cand0 = tooth_poses(model, loads, rigid)
-        nominal.update(rot0, shift0, origin0, el0, cand0, rigid, full=True)
+        sec = motion.sections
+        rot0, shift0, origin0, el0, cand0 = tooth_poses(model, loads, sec)
+        nominal.update(rot0, shift0, origin0, el0, cand0, sec, full=True)
         model.cache[key] = nominal
-    return loads, rigid, F_ball, model.cache[key].copy()
+    return loads, motion, F_ball, model.cache[key].copy()
 
 
-@record
+@dataclass(slots=True)
 class _Pass:
     """One linearisation: the pairs measured at the current poses and the contact problem's solution there."""
 
     keys: np.ndarray
     F: np.ndarray
     sol: object
-    idx: np.ndarray
-    b: np.ndarray
-    f: np.ndarray
+    prob: _Problem
     origin: np.ndarray
-    cam_shift: np.ndarray
+    motion: Motion
     pivots: int
     t_geo: float
     t_sol: float
 
 
-def _linearise(model, torque_nm, e, f_ext, pairs, loads, rigid, F_ball, F_teeth_prev, prev_active, it, tooth_errors):
+def _linearise(model, torque_nm, e, f_ext, pairs, state: _Iterate, it, tooth_errors):
     """Measure the contact geometry at the current loaded poses (the clearance engine) and solve the linearised
     contact problem there (docs/models.md 4.1); the first pass linearises the Hertz contacts again about the
     forces it finds before the teeth move."""
+    loads, motion, F_ball, F_teeth_prev, prev_active = (
+        state.loads,
+        state.motion,
+        state.F_ball,
+        state.F_teeth,
+        state.active,
+    )
     Z = len(model.bearing.psi)
     t0 = time.perf_counter()
-    rot, shift, origin, el, cand = tooth_poses(model, loads, rigid, tooth_errors)
+    sec = motion.sections
+    rot, shift, origin, el, cand = tooth_poses(model, loads, sec, tooth_errors)
     if cand.size == 0 and torque_nm > 0:
         raise DesignError(
             "generator.w0_coef",
             "the flexspline teeth never reach the rigid teeth (no tooth tip within "
             f"{RADIAL_MARGIN:g} mm of the rigid tip circle): no torque can be carried",
         )
-    keys = pairs.update(rot, shift, origin, el, cand, rigid) if cand.size else np.zeros(0, dtype=int)
+    keys = pairs.update(rot, shift, origin, el, cand, sec) if cand.size else np.zeros(0, dtype=int)
     t1 = time.perf_counter()
-    idx, b, f, A, q, s_c = _assemble(model, pairs, keys, el, rigid, e, F_ball, F_teeth_prev[keys])
-    M = Compliance(model.tables, idx, b * f[:, None], s_c)
+    prob = _assemble(model, pairs, keys, e, F_ball, F_teeth_prev[keys])
+    M = Compliance(model.tables, prob.idx, prob.b * prob.f[:, None], prob.s)
     active = np.concatenate([F_ball > 0, prev_active[keys]])
-    F_h = F = None  # F: the solution of the pass (set by the first solve below)
+    carried = bool(prev_active[keys].any())  # a warm start's loaded teeth: the first guess of the active set
+    # F: the solution of the pass (set by the first solve below); F_h: the forces the Hertz contacts were
+    # linearised about (a warm start's, else none)
+    F_h = np.concatenate([F_ball, F_teeth_prev[keys]]) if carried else None
+    F = None
     pivots = 0
+    q = prob.q
     for h in range(_HERTZ_START if it == 0 else 1):
         if h:
             if F_h is not None and np.abs(F - F_h).max() <= _HERTZ_TOL * F.max():
                 break
             # the first pass: the Hertz contacts linearised again about the forces just found,
             # on the same geometry (its poses have not moved: no engine call), before the teeth move
-            _, _, _, _, q, s_c = _assemble(model, pairs, keys, el, rigid, e, F[:Z], F[Z:])
-            M = M.with_contact(s_c)
+            again = _assemble(model, pairs, keys, e, F[:Z], F[Z:])
+            q = again.q
+            M = M.with_contact(again.s)
+            prob = prob._replace(q=q, s=again.s)
             active = F > 0
         try:
             sol = solve_supported(
                 M,
                 q,
-                A,
+                prob.A,
                 f_ext,
                 model.support_stiffness,
-                active=active if (it or h) else _first_guess(model, keys, q, Z, torque_nm),
+                active=active if (it or h or carried) else _first_guess(model, keys, q, Z, torque_nm),
+                field=prob.field,
             )
-            cam_shift = sol.a[3:].copy()
-            sol = replace(sol, a=sol.a[:3])
         except ContactSolveError as exc:
             if torque_nm > 0 and len(keys) and "balance" in str(exc):
                 raise DesignError(
@@ -420,12 +532,15 @@ def _linearise(model, torque_nm, e, f_ext, pairs, loads, rigid, F_ball, F_teeth_
                 ) from None
             raise
         pivots += sol.iterations
-        F_h, F = (F if h else None), sol.F
-    return _Pass(keys, F, sol, idx, b, f, origin, cam_shift, pivots, t1 - t0, time.perf_counter() - t1)
+        F_h, F = (F if h else F_h), sol.F
+    new_motion = model.supports.plane_motion(sol.a, field_displacement(prob.field, F))
+    return _Pass(keys, F, sol, prob, origin, new_motion, pivots, t1 - t0, time.perf_counter() - t1)
 
 
-def _report(model, torque_nm, e, pairs, last, progress, times, tooth_errors) -> LoadState:
-    """The loaded state of the last contact solution: contacts, residuals, the laws of the loaded rim."""
+def _report(model, torque_nm, e, pairs, last, progress, times, tooth_errors, exact: bool = True) -> LoadState:
+    """The loaded state of the last contact solution: contacts, residuals, the laws of the loaded rim. ``exact``
+    False: the tooth gaps are the last linearisation's (no measurement at the final poses; ``gap_exact`` False
+    and the nonlinear residual not checked, NaN)."""
     tab = model.tables
     n_ang = len(tab.angles)
     Z = len(model.bearing.psi)
@@ -433,18 +548,25 @@ def _report(model, torque_nm, e, pairs, last, progress, times, tooth_errors) -> 
     centre = model.drive.law
     # the reported state is the last contact solution itself (not a relaxed mixture): its forces, points and
     # normals are in equilibrium to round-off; the exact gaps are then measured on the final poses
-    keys, F, sol, idx, b, f, point, normal, cam_shift = last
-    loads = dense_loads(n_ang, idx, F, f, b)
-    rigid = sol.a.copy()
+    keys, F, lin, point, normal = last
+    sol, prob, motion = lin.sol, lin.prob, lin.motion
+    loads = dense_loads(n_ang, prob.idx, F, prob.f, prob.b)
+    sec_motion = motion.sections
     F_ball, Ft = F[:Z], F[Z:]
     model.bearing.check(F_ball)
     t0 = time.perf_counter()
     pairs2 = pairs.copy()
-    keys2, gaps2, exact2 = pairs2.report(*tooth_poses(model, loads, rigid, tooth_errors), rigid)
+    if exact:
+        keys2, gaps2, exact2 = pairs2.report(*tooth_poses(model, loads, sec_motion, tooth_errors), sec_motion)
+    else:
+        keys2 = keys
+        gaps2 = sol.gap[Z:] - (model.teeth.bending(point, normal, model.widths[(keys // 2) // tab.z_g]) * F[Z:])
+        gaps2 = gaps2 - model.teeth.hertz(F[Z:], model.widths[(keys // 2) // tab.z_g])
+        exact2 = np.zeros(len(keys), dtype=bool)
     times["geometry"] += time.perf_counter() - t0
     psi, law_loads = merge_loads(tab.angles, loads)
     laws = [
-        LoadedLaw(centre, model.section_law(i), model.ring, psi, law_loads, model.scales[i], tuple(rigid))
+        LoadedLaw(centre, model.section_law(i), model.ring, psi, law_loads, model.scales[i], tuple(sec_motion[i]))
         for i in range(len(model.zs))
     ]
     n_t = len(keys)
@@ -466,13 +588,13 @@ def _report(model, torque_nm, e, pairs, last, progress, times, tooth_errors) -> 
     w_nom, v_nom, _ = tab.centre_ball
     rows = ball_rows(model, cam_excess(model), e)
     U_b = (tab.influence[3 * tab.z_g :] @ loads.ravel()).reshape(-1, 3)
-    gap_b = rows.q - (rows.b * U_b).sum(axis=1) - rows.A @ np.concatenate([rigid, cam_shift])
+    gap_b = rows.q - (rows.b * U_b).sum(axis=1) - rows.A @ np.concatenate([motion.ball, motion.cam])
     appr_b = model.bearing.approach(F_ball)
     # exact complementarity of the nonlinear contacts: gap + approach >= 0, F >= 0, F (gap + approach) = 0
     g_all = np.concatenate([gap_b + appr_b, gap_t + appr_t])
     F_all = np.concatenate([F_ball, Ft])
     loaded = F_all > 0
-    lin = float(np.abs(g_all[loaded]).max()) if loaded.any() else 0.0
+    lin_res = (float(np.abs(g_all[loaded]).max()) if loaded.any() else 0.0) if exact else float("nan")
     r_b = centre.r_m + w_nom
     ball_pt = np.stack([r_b * cb - v_nom * sb, r_b * sb + v_nom * cb], axis=-1)
     empty2 = np.zeros((0, 2))
@@ -492,7 +614,7 @@ def _report(model, torque_nm, e, pairs, last, progress, times, tooth_errors) -> 
     residuals = {
         "equilibrium": sol.equilibrium,
         "complementarity": sol.complementarity,
-        "linearisation_mm": lin,
+        "linearisation_mm": lin_res,
         "min_gap_plus_approach_mm": float(g_all.min()) if g_all.size else 0.0,
         **progress,
     }
@@ -502,11 +624,12 @@ def _report(model, torque_nm, e, pairs, last, progress, times, tooth_errors) -> 
         float(torque_nm),
         e,
         laws,
-        rigid,
+        motion.centre,
         contacts,
         residuals,
         times,
         pairs2,
         generator_torque(rows, F_ball),
-        cam_shift,
+        motion,
+        np.asarray(sol.a, dtype=float),
     )

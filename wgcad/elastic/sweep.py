@@ -4,13 +4,13 @@
 from __future__ import annotations
 
 import time
+from dataclasses import dataclass
 from math import pi
 
 import numpy as np
 
 from wgcad.constants import INTERFERENCE_TOL
 
-from ..records import record
 from .cam import MountedState, mounted
 from .mesh import entry_gaps
 from .model import ElasticModel
@@ -29,7 +29,7 @@ def _entry_laws(st: LoadState) -> list:
     return [law.shifted(phase) for phase in (0.0, pi) for law in st.laws]
 
 
-@record
+@dataclass(slots=True)
 class LoadLevel:
     """One torque level: its load state and the entry of its teeth (:class:`wgcad.clearance.entry.EntryPassage` of
     each wave, 0 then pi, and section, ``model.zs``)."""
@@ -78,7 +78,7 @@ class LoadLevel:
         return c["force"][~self.tooth]
 
 
-@record
+@dataclass(slots=True)
 class LoadSweep:
     """Every torque level of a sweep (each warm-started from the previous), with the drive's model and the inputs."""
 

@@ -2,17 +2,17 @@
 
 from __future__ import annotations
 
+from dataclasses import dataclass
 from math import pi
 
 import numpy as np
 
-from ..records import record
 from .ring import Ring
 
 __all__ = ["RingTables", "ring_tables", "Compliance"]
 
 
-@record(frozen=True)
+@dataclass(frozen=True)
 class RingTables:
     """Everything of the ring that one load state evaluates again and again, at the only angles that occur.
 
@@ -73,7 +73,8 @@ def ring_tables(ring: Ring, z_g: int, ball_psi: np.ndarray, section_laws, centre
 
 
 class Compliance:
-    """The ring part of the contact compliance, ``D_jl = f_j f_l b_j' C(phi_j - phi_l) b_l``, plus ``diag(s)``, by columns.
+    """The contact compliance by columns: the ring part ``D_jl = f_j f_l b_j' C(phi_j - phi_l) b_l``, the contacts'
+    own ``diag(s)``, and low-rank parts ``L R'`` (the cup's fields: docs/models.md 4.2).
 
     The contact solver needs only the columns of the contacts it loads (a
     few dozen of some hundreds in the band), so they are built on demand from
@@ -99,6 +100,7 @@ class Compliance:
         self._s = s
         self._D = np.empty((m, m))
         self._have = np.zeros(m, dtype=bool)
+        self._extra = []  # (L, R): the low-rank parts L R', (m, k) each
         self.shape = (m, m)
         # D_jj = fb_j' C(0) fb_j: the 3x3 block at zero angle is the same for every angle
         c0 = self._K[:3, :3]
@@ -115,27 +117,29 @@ class Compliance:
             Z = np.einsum("kar,ka->kr", src, self._fb[new])  # (k, 3 n)
             D = np.einsum("kja,ja->jk", Z[:, self._rows].reshape(len(new), m, 3), self._fb)
             D[new, np.arange(len(new))] += self._s[new]
-            if getattr(self, "_At", None) is not None:
-                D += (self._At * self._c_sup) @ self._At[new].T
+            for L, R in self._extra:
+                D += L @ R[new].T
             self._D[:, new] = D
             self._have[new] = True
         return self._D[:, W]
 
-    def with_support(self, At: np.ndarray, c) -> Compliance:
-        """The same compliance plus elastic supports of rigid-body freedoms: ``At diag(c) At'`` (``At`` ``(m, k)``: each
-        contact's ``A`` rows for those freedoms, ``c`` ``(k,)`` the supports' compliances). Contact forces move the
-        bodies by ``-c At' F`` against their supports, which every gap feels (docs/models.md 4.1)."""
+    def _with_extra(self, L: np.ndarray, R: np.ndarray) -> Compliance:
         new = object.__new__(Compliance)
         new.__dict__.update(self.__dict__)
-        new._At = np.asarray(At, dtype=float)
-        new._c_sup = np.broadcast_to(np.asarray(c, dtype=float), (new._At.shape[1],)).copy()
+        new._extra = self._extra + [(L, R)]
         new._D = self._D.copy()
         j = np.nonzero(self._have)[0]
         if j.size:
-            new._D[:, j] += (new._At * new._c_sup) @ new._At[j].T
+            new._D[:, j] += L @ R[j].T
         new._have = self._have.copy()
-        new.diag = self.diag + (new._At * new._At * new._c_sup).sum(axis=1)
+        new.diag = self.diag + (L * R).sum(axis=1)
         return new
+
+    def with_field(self, U: np.ndarray, W: np.ndarray) -> Compliance:
+        """The same compliance plus ``U W U'``: an elastic field (the cup's bending and twist between the contact
+        planes, ``W`` symmetric positive semidefinite) that every contact feels through its rows ``U``."""
+        U = np.asarray(U, dtype=float)
+        return self._with_extra(U @ np.asarray(W, dtype=float), U)
 
     def with_contact(self, s: np.ndarray) -> Compliance:
         """The same ring part with contact compliances ``s`` ``(m,)`` on the diagonal (the columns built so far kept)."""

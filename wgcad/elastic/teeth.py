@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import numpy as np
 import shapely
 
@@ -9,12 +11,10 @@ from wgcad.clearance.engine import Scene
 from wgcad.placement import transform
 from wgcad.plane import rotate
 
-from ..records import record
-
 __all__ = ["ContactGeometry", "flank_contacts", "pair_contacts", "ToothCompliance"]
 
 
-@record(frozen=True)
+@dataclass(frozen=True, slots=True)
 class ContactGeometry:
     """Linearised contacts between placed flexspline teeth and rigid teeth (rigid-gear frame), arrays of length K.
 
@@ -212,7 +212,7 @@ def pair_contacts(scene: Scene, rot: np.ndarray, shift: np.ndarray, rigid: np.nd
     return ContactGeometry(gap, point, normal, idx)
 
 
-@record(frozen=True)
+@dataclass(frozen=True, slots=True)
 class ToothCompliance:
     """Compliance of one tooth pair along the contact normal over a face-width slice (docs/models.md 4.1).
 
@@ -221,7 +221,8 @@ class ToothCompliance:
     plus shear ``1.2 h / (G b s)``, times ``cos^2`` of the angle between the
     normal and the tooth's tangential direction. The flanks' approach is
     Palmgren's steel line contact ``3.84e-5 Q^0.9 / b^0.8`` (mm, N, mm)
-    scaled by ``E'_steel / E'``.
+    scaled by ``E'_steel / E'``. ``with_bending`` False leaves the flanks' approach alone, as [S1] writes the
+    pair's ``lambda(Q)`` (``[load] tooth_compliance = "hertz"``).
     """
 
     E: float  # MPa
@@ -229,9 +230,12 @@ class ToothCompliance:
     s: float  # mm, tooth thickness
     r_root_flex: float
     r_root_rigid: float
+    with_bending: bool = True
 
     def bending(self, point, normal, width):
         """Bending + shear compliance of both teeth, mm/N, for flexspline contact points ``(K, 2)``."""
+        if not self.with_bending:
+            return np.zeros(len(point))
         R = np.hypot(point[:, 0], point[:, 1])
         er = point / R[:, None]
         c_t = np.abs(normal[:, 0] * -er[:, 1] + normal[:, 1] * er[:, 0])  # |n . e_t|

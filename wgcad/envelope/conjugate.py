@@ -19,11 +19,11 @@ bound the rigid tooth is the caller's choice, stated where it is made.
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import numpy as np
 
 from wgcad.plane import rotate
-
-from ..records import record
 
 __all__ = ["EnvelopePoints", "envelope", "flank_pieces"]
 
@@ -32,7 +32,7 @@ STEP_TOL = 1e-13
 _MAX_ITER = 60
 
 
-@record(frozen=True)
+@dataclass(frozen=True, slots=True)
 class EnvelopePoints:
     """Points of the envelope (read-only arrays, ``M`` of them).
 
@@ -75,37 +75,48 @@ def flank_pieces(gear, side: int = 1) -> list:
 
 
 def _g(p, dp, ddp, rot, drot, dshift):
-    """``g`` and ``dg/ds`` for points ``(..., 2)`` and the motion at matching ``(...)``."""
+    """``g`` and ``dg/ds`` for points ``(..., 2)`` and the motion at matching ``(...)`` (``ddp`` None: ``g`` alone)."""
     c, s = np.cos(rot), np.sin(rot)
     # J R v = (-(R v)_y, (R v)_x)
     rdp_x, rdp_y = c * dp[..., 0] - s * dp[..., 1], s * dp[..., 0] + c * dp[..., 1]
-    rddp_x, rddp_y = c * ddp[..., 0] - s * ddp[..., 1], s * ddp[..., 0] + c * ddp[..., 1]
     g = drot * np.einsum("...i,...i->...", dp, p) + (-rdp_y * dshift[..., 0] + rdp_x * dshift[..., 1])
+    if ddp is None:
+        return g, None
+    rddp_x, rddp_y = c * ddp[..., 0] - s * ddp[..., 1], s * ddp[..., 0] + c * ddp[..., 1]
     dg = drot * (np.einsum("...i,...i->...", ddp, p) + np.einsum("...i,...i->...", dp, dp))
     dg = dg + (-rddp_y * dshift[..., 0] + rddp_x * dshift[..., 1])
     return g, dg
 
 
 def _refine(piece, s_lo, s_hi, rot, drot, dshift):
-    """Newton's method safeguarded by the brackets ``[s_lo, s_hi]`` (arrays), at the motion states given."""
+    """Newton's method safeguarded by the brackets ``[s_lo, s_hi]`` (arrays), at the motion states given.
+
+    Each root is done once its step is below :data:`STEP_TOL` (a Newton step that small is taken even where it
+    leaves the bracket by rounding: bisecting there threw a converged root back to the middle of its bracket); the
+    others go on, so a root comes out the same whichever roots it is refined with."""
     s = 0.5 * (s_lo + s_hi)
     lo, hi = np.minimum(s_lo, s_hi), np.maximum(s_lo, s_hi)
-    g_lo, _ = _g(piece.point(lo), piece.deriv(lo), piece.deriv2(lo), rot, drot, dshift)
-    step = np.full_like(s, np.inf)
+    sign_lo = np.sign(_g(piece.point(lo), piece.deriv(lo), None, rot, drot, dshift)[0])
+    live = np.arange(len(s))
     for _ in range(_MAX_ITER):
-        p, dp, ddp = piece.point(s), piece.deriv(s), piece.deriv2(s)
-        g, dg = _g(p, dp, ddp, rot, drot, dshift)
+        sl = s[live]
+        p, dp, ddp = piece.point(sl), piece.deriv(sl), piece.deriv2(sl)
+        g, dg = _g(p, dp, ddp, rot[live], drot[live], dshift[live])
         # keep the bracket: the side whose sign matches the low end moves up
-        same = np.sign(g) == np.sign(g_lo)
-        lo = np.where(same, s, lo)
-        hi = np.where(same, hi, s)
+        same = np.sign(g) == sign_lo[live]
+        lo_l = np.where(same, sl, lo[live])
+        hi_l = np.where(same, hi[live], sl)
+        lo[live], hi[live] = lo_l, hi_l
         with np.errstate(divide="ignore", invalid="ignore"):
-            new = s - g / dg
-        bad = ~np.isfinite(new) | (new <= lo) | (new >= hi)
-        new = np.where(bad, 0.5 * (lo + hi), new)
-        step = np.abs(new - s) * np.linalg.norm(dp, axis=-1)
-        s = new
-        if np.all(step < STEP_TOL):
+            new = sl - g / dg
+        speed = np.hypot(dp[:, 0], dp[:, 1])
+        done = np.abs(new - sl) * speed < STEP_TOL
+        bad = ~done & (~np.isfinite(new) | (new <= lo_l) | (new >= hi_l))
+        new = np.where(bad, 0.5 * (lo_l + hi_l), new)
+        done |= np.abs(new - sl) * speed < STEP_TOL
+        s[live] = new
+        live = live[~done]
+        if not live.size:
             break
     p, dp, ddp = piece.point(s), piece.deriv(s), piece.deriv2(s)
     g, dg = _g(p, dp, ddp, rot, drot, dshift)
@@ -126,8 +137,8 @@ def envelope(pieces, motion, t, samples: int = 256) -> EnvelopePoints:
     out = {k: [] for k in ("t", "piece", "s", "points", "normal", "branch", "residual_mm")}
     for k, pc in enumerate(pieces):
         sg = np.linspace(pc.t0, pc.t1, samples)
-        P, dP, ddP = pc.point(sg), pc.deriv(sg), pc.deriv2(sg)
-        g, _ = _g(P[None], dP[None], ddP[None], rot[:, None], drot[:, None], dshift[:, None, :])
+        P, dP = pc.point(sg), pc.deriv(sg)
+        g, _ = _g(P[None], dP[None], None, rot[:, None], drot[:, None], dshift[:, None, :])
         sign = np.sign(g)
         ti, si = np.nonzero(sign[:, :-1] * sign[:, 1:] < 0)
         zi, zs = np.nonzero(sign == 0)  # a sample exactly on a root
@@ -138,7 +149,8 @@ def envelope(pieces, motion, t, samples: int = 256) -> EnvelopePoints:
         s_root, res = _refine(pc, sg[si], sg[si + 1], rot[ti], drot[ti], dshift[ti])
         # one root per (t, bracket): duplicates from exact zeros merge
         key = np.round(s_root, 12)
-        _, first = np.unique(np.stack([ti.astype(float), key], axis=1), axis=0, return_index=True)
+        o = np.lexsort((key, ti))  # stable: the first of equal rows leads (np.unique would load numpy.ma)
+        first = o[np.concatenate([[True], (np.diff(ti[o]) != 0) | (np.diff(key[o]) != 0)])]
         ti, s_root, res = ti[first], s_root[first], res[first]
         order = np.lexsort((s_root, ti))
         ti, s_root, res = ti[order], s_root[order], res[order]

@@ -8,16 +8,16 @@ needs only that.
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import numpy as np
 
 from wgcad.kinematics import flex_rotation
 
-from ..records import record
-
 __all__ = ["LawMotion", "RotationMotion"]
 
 
-@record(frozen=True)
+@dataclass(frozen=True, slots=True)
 class LawMotion:
     """Tooth 0 of a flexspline placed by a deformation law (docs/models.md 3.1) as the generator turns by ``t``
     (rad) in the rigid gear's frame, the rigid gear fixed: the tooth sits ``phi = t/u_hg - t`` from the major
@@ -75,7 +75,7 @@ class LawMotion:
         return drot, dshift
 
 
-@record(frozen=True)
+@dataclass(frozen=True, slots=True)
 class RotationMotion:
     """A gear of ``z1`` teeth turning about a fixed centre in mesh with a gear of ``z2`` (internal: ``z2 > z1``,
     same sense) whose centre is ``a`` away, seen from the second gear: ``rot = t (1 - z1/z2)``, ``shift =

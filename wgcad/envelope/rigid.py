@@ -16,15 +16,16 @@ the design's tooth count, module and radii; only its flanks change.
 
 from __future__ import annotations
 
-from dataclasses import replace
+from dataclasses import dataclass, replace
 from math import pi
 
 import numpy as np
+import shapely
 
 from wgcad.profiles import pieces as pc
 from wgcad.profiles.gear import Gear
 
-from ..records import record
+from .conjugate import flank_pieces
 from .space import conjugate_flank
 
 __all__ = ["conjugate_rigid_gear"]
@@ -43,7 +44,14 @@ WALL_MARGIN = 2e-4
 def _reaching(pts: np.ndarray, rot: np.ndarray, shift: np.ndarray, r_last: float):
     """The poses at which some of the points ``pts`` can lie beyond the radius ``r_last``: every 8th point is placed,
     and every point lies within ``reach`` of one of those (a rigid motion keeps distances), so a pose whose placed
-    points all stay within ``r_last - reach`` has none beyond it. The others are the only ones that count."""
+    points all stay within ``r_last - reach`` has none beyond it. The others are the only ones that count. First,
+    likewise, the poses whose placed circle about all the points stays within ``r_last`` (most of them) are left."""
+    c0 = 0.5 * (pts.min(axis=0) + pts.max(axis=0))
+    rho = float(np.hypot(*(pts - c0).T).max())
+    far = np.hypot(
+        np.cos(rot) * c0[0] - np.sin(rot) * c0[1] + shift[:, 0], np.sin(rot) * c0[0] + np.cos(rot) * c0[1] + shift[:, 1]
+    )
+    rot, shift = rot[far + rho > r_last], shift[far + rho > r_last]
     n = len(pts)
     i = np.arange(n)
     i0 = (i // 8) * 8
@@ -61,8 +69,6 @@ def _tip_wall(drive, cf, side: int = 1, clearance: float = 0.0, last=None) -> np
     the tooth's corners there trace paths, not envelopes (D1: the tip corner passed a radial wall by 2.3 um), so
     the wall steps along the circle of the last point to the largest angle the tooth reaches beyond it (1 um bands
     of radius) plus :data:`WALL_MARGIN`, and then runs radially."""
-    from .conjugate import flank_pieces
-
     last = cf.points[-1] if last is None else np.asarray(last, float)  # the flank's last point (set back, if it is)
     r_last = float(np.hypot(*last))
     pts = np.concatenate(
@@ -75,7 +81,7 @@ def _tip_wall(drive, cf, side: int = 1, clearance: float = 0.0, last=None) -> np
     r_all, a_all = [], []
     for k in range(0, len(rot), 500):
         c, s = np.cos(rot[k : k + 500])[:, None], np.sin(rot[k : k + 500])[:, None]
-        # turned and shifted by broadcasting (einsum's generic loop took 0.8 s of the 1.1 s here)
+        # turned and shifted by broadcasting (einsum's generic loop was most of this function's time)
         sh = shift[k : k + 500]
         X0 = c * pts[:, 0] + (-s) * pts[:, 1] + sh[:, 0, None]
         X1 = s * pts[:, 0] + c * pts[:, 1] + sh[:, 1, None]
@@ -173,13 +179,26 @@ def conjugate_rigid_gear(drive, z: float | None = None, clearance: float = 0.0) 
     flank = np.vstack([tip_pt, up]) if np.hypot(*(up[0] - tip_pt)) > 1e-12 else up
 
     sampler = _ConjugateSampler(
-        spec, rg.r, r_a, r_f, float(2.0 * r_a * a_up[0]), pieces, flank, a_up[0], a_up[-1], half, zr, rg.spec.phase
+        spec,
+        rg.r,
+        r_a,
+        r_f,
+        float(2.0 * r_a * a_up[0]),
+        pieces,
+        flank,
+        a_up[0],
+        a_up[-1],
+        half,
+        zr,
+        rg.spec.phase,
+        float(np.max(cf.residual_mm)),
+        float(cf.sagitta_mm),
     )
     gear = sampler(drive.tol)
     return gear, cf
 
 
-@record(frozen=True)
+@dataclass(frozen=True, slots=True)
 class _ConjugateSampler:
     """A conjugate rigid gear's outline sampled at a chord tolerance from its exact pieces and flank points (a record,
     so a drive holding the gear pickles): arcs by their sagitta, the flank's exact points thinned (Douglas-Peucker
@@ -198,10 +217,10 @@ class _ConjugateSampler:
     half: float
     z: int
     phase: float
+    residual_mm: float = 0.0
+    sagitta_mm: float = 0.0
 
     def __call__(self, tol: float) -> Gear:
-        import shapely
-
         def arc_pts(r, a0, a1):
             n = max(2, int(np.ceil(abs(a1 - a0) * r / np.sqrt(8.0 * r * tol))) + 1)
             a = np.linspace(a0, a1, n)
@@ -234,4 +253,6 @@ class _ConjugateSampler:
             tol,
             self.pieces,
             resample=self,
+            envelope_residual_mm=self.residual_mm,
+            envelope_sagitta_mm=self.sagitta_mm,
         )

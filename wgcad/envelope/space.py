@@ -15,18 +15,20 @@ sagitta is reported.
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import numpy as np
+import shapely
 
 from wgcad.plane import rotate
 
-from ..records import record
-from .conjugate import envelope, flank_pieces
+from .conjugate import STEP_TOL, envelope, flank_pieces
 from .motion import LawMotion
 
 __all__ = ["ConjugateFlank", "conjugate_flank"]
 
 
-@record(frozen=True)
+@dataclass(frozen=True, slots=True)
 class ConjugateFlank:
     """One flank of the rigid tooth space conjugate to the flexspline tooth (rigid frame, mm, rad).
 
@@ -57,24 +59,30 @@ def _outside_all(x: np.ndarray, polys: np.ndarray, tol: float, exact) -> np.ndar
     """For points ``x (M, 2)``: whether no position of the tooth covers one. The chord polygons ``polys (K, N, 2)``
     decide where they cover a point by more than ``tol`` (their distance from the exact pieces); closer calls go to
     ``exact(I, J)``, the points' ``I`` exact signed distances from the tooth at positions ``J`` (positive: inside),
-    all in one call."""
-    import shapely
-
+    all in one call. The points are the tree and each polygon asks it once (a polygon asking is prepared once; the
+    points asking a tree of polygons met an unprepared polygon at every pair)."""
     geoms = shapely.polygons(polys)
-    tree = shapely.STRtree(geoms)
     pts = shapely.points(x)
     ok = np.ones(len(x), dtype=bool)
-    hi, hj = tree.query(pts, predicate="intersects")
+    hj, hi = shapely.STRtree(pts).query(geoms, predicate="intersects")
     if not hi.size:
         return ok
-    depth = shapely.distance(pts[hi], shapely.get_exterior_ring(geoms[hj]))
+    order = np.lexsort((hj, hi))  # by point, then position: the same pairs whatever the tree's order
+    hi, hj = hi[order], hj[order]
+    depth = shapely.distance(pts[hi], shapely.get_exterior_ring(geoms)[hj])
     # covered, or within the chord tolerance of being covered by a sampled position: between the pass's
     # positions (2e-3 rad apart) a tooth corner sweeps farther than the exact test at the samples sees (held
     # to the strict test, the cycloidal flank kept points below the tip's path, crossed by 0.17 um)
     ok[hi[depth > tol]] = False
     ask = np.flatnonzero((depth <= tol) & ok[hi])
     if ask.size:
-        ok[hi[ask[exact(hi[ask], hj[ask]) > -tol]]] = False
+        # one covering position is enough: each point's deepest pair first, then the others of the points it left
+        ask = ask[np.lexsort((-depth[ask], hi[ask]))]
+        lead = np.concatenate([[True], hi[ask][1:] != hi[ask][:-1]])
+        for part in (ask[lead], ask[~lead]):
+            part = part[ok[hi[part]]]
+            if part.size:
+                ok[hi[part[exact(hi[part], hj[part]) > -tol]]] = False
     return ok
 
 
@@ -85,28 +93,68 @@ def _side_distance(piece, s0, x, rot, shift, with_gap: bool = False):
     A tooth's pieces run from its centre line toward the space with the material on their left; the parameter
     may run either way (an involute's roll parameter falls toward the root, an arc's angle may rise), so the
     side is taken from the direction of travel, ``t0 -> t1``, not from ``p'`` alone (a double-arc flank, whose
-    angles rise, read every point on the wrong side)."""
-
-    def place(v):
-        return rotate(v, rot)
-
+    angles rise, read every point on the wrong side). A point is done once its step along the piece is below
+    :data:`~wgcad.envelope.conjugate.STEP_TOL` (1e-13 mm: the rounding of coordinates near 80 mm moves the
+    iterates by ~1e-14 mm for ever, and the distance's error is of second order in the step); at most 30 steps."""
     s = np.array(s0, dtype=float)
     lo, hi = min(piece.t0, piece.t1), max(piece.t0, piece.t1)
+    live = np.arange(len(s))
     for _ in range(30):
-        X = place(piece.point(s)) + shift
-        d1, d2 = place(piece.deriv(s)), place(piece.deriv2(s))
-        f = np.einsum("ij,ij->i", X - x, d1)
-        df = np.einsum("ij,ij->i", d1, d1) + np.einsum("ij,ij->i", X - x, d2)
-        s_new = np.clip(s - f / df, lo, hi)
-        if np.array_equal(s_new, s):  # converged to the last bit: the remaining steps would change nothing
+        r, sl = rot[live], s[live]
+        X = rotate(piece.point(sl), r) + shift[live]
+        d1, d2 = rotate(piece.deriv(sl), r), rotate(piece.deriv2(sl), r)
+        e = X - x[live]
+        f = np.einsum("ij,ij->i", e, d1)
+        df = np.einsum("ij,ij->i", d1, d1) + np.einsum("ij,ij->i", e, d2)
+        s_new = np.clip(sl - f / df, lo, hi)
+        moved = np.abs(s_new - sl) * np.hypot(d1[:, 0], d1[:, 1]) >= STEP_TOL
+        s[live] = s_new
+        live = live[moved]
+        if not live.size:
             break
-        s = s_new
-    X = place(piece.point(s)) + shift
-    d1 = place(piece.deriv(s))
+    X = rotate(piece.point(s), rot) + shift
+    d1 = rotate(piece.deriv(s), rot)
     travel = 1.0 if piece.t1 >= piece.t0 else -1.0
     n = -travel * np.stack([d1[:, 1], -d1[:, 0]], axis=-1) / np.linalg.norm(d1, axis=-1)[:, None]  # left of travel
     side = np.einsum("ij,ij->i", x - X, n)
     return (side, np.hypot(*(x - X).T)) if with_gap else side
+
+
+def _exact_side(x: np.ndarray, rot: np.ndarray, shift: np.ndarray, outline, starts) -> np.ndarray:
+    """The signed distance of each point ``x (M, 2)`` from the tooth (its pieces ``outline``) placed at ``(rot,
+    shift)`` (one pose a point), positive inside: the side of the nearest point of the tooth (by distance: a
+    projection clamped to a piece's end measures along that end's normal, which can point either way for a point
+    off the piece). Each piece's projection starts at the nearest of its ``starts``; a piece is projected on only
+    where it can hold the nearest point: its nearest start no farther than the nearest start of all plus the
+    longest step between its own starts (a point of the piece lies within half a step of a start), and again,
+    against the nearest projection found, where a projection lands farther than its start."""
+    c, sn = np.cos(rot)[:, None], np.sin(rot)[:, None]
+    s0, near, step = [], [], []
+    for p, sg in zip(outline, starts):
+        P = p.point(sg)
+        px = P[None, :, 0] * c - P[None, :, 1] * sn + shift[:, None, 0]
+        py = P[None, :, 0] * sn + P[None, :, 1] * c + shift[:, None, 1]
+        dist = np.hypot(px - x[:, None, 0], py - x[:, None, 1])
+        k = np.argmin(dist, axis=1)
+        s0.append(sg[k])
+        near.append(dist[np.arange(len(x)), k])
+        step.append(float(np.hypot(*np.diff(P, axis=0).T).max()))
+    near = np.array(near)  # (pieces, M)
+    best, gap = np.full(len(x), np.inf), np.full(len(x), np.inf)
+    done = np.zeros(near.shape, dtype=bool)
+    bound = near.min(axis=0)  # the nearest start of all: the nearest point is no farther
+    while True:
+        # in the pieces' order, as one pass over them all would take them (ties: the first piece's side)
+        todo = ~done & (near <= bound[None, :] + np.array(step)[:, None])
+        if not todo.any():
+            return best
+        for j in np.flatnonzero(todo.any(axis=1)):
+            i = np.flatnonzero(todo[j])
+            d, g = _side_distance(outline[j], s0[j][i], x[i], rot[i], shift[i], with_gap=True)
+            closer = g < gap[i]
+            best[i[closer]], gap[i[closer]] = d[closer], g[closer]
+        done |= todo
+        bound = gap  # a piece left out whose start step reaches below the nearest projection found is taken next
 
 
 def _locally_outside(env, idx, pieces, mot, h: float = 2e-4) -> np.ndarray:
@@ -136,24 +184,12 @@ def _boundary(env, idx, t, polys, tol, pieces, mot, outline):
     starts = [np.linspace(p.t0, p.t1, 64) for p in outline]
 
     def exact(I, J):
-        # the side of the nearest point of the flank (by distance: a projection clamped to a piece's end measures
-        # along that end's normal, which can point either way for a point off the piece); every pair at once,
-        # in chunks that keep the start grid's arrays small
+        # every pair at once, in chunks that keep the start grid's arrays small
         out = np.empty(len(I))
         for a in range(0, len(I), 4096):
             i, j = I[a : a + 4096], J[a : a + 4096]
             rot, shift = mot.pose(t[j])
-            c, sn = np.cos(rot)[:, None], np.sin(rot)[:, None]
-            best, gap = np.full(len(i), np.inf), np.full(len(i), np.inf)
-            for p, sg in zip(outline, starts):
-                P = p.point(sg)
-                px = P[None, :, 0] * c - P[None, :, 1] * sn + shift[:, None, 0]
-                py = P[None, :, 0] * sn + P[None, :, 1] * c + shift[:, None, 1]
-                s0 = sg[np.argmin(np.hypot(px - x[i, None, 0], py - x[i, None, 1]), axis=1)]
-                d, g = _side_distance(p, s0, x[i], rot, shift, with_gap=True)
-                closer = g < gap
-                best[closer], gap[closer] = d[closer], g[closer]
-            out[a : a + 4096] = best
+            out[a : a + 4096] = _exact_side(x[i], rot, shift, outline, starts)
         return out
 
     keep = idx[_outside_all(x, polys, tol, exact)]
@@ -249,9 +285,13 @@ def _sagitta(env, keep, pieces, mot) -> float:
         dist = np.hypot(*(e.points - mid[pos]).T)
         best = np.full(len(idx), np.inf)
         np.minimum.at(best, pos, dist)
-        for j in np.flatnonzero(np.isfinite(best)):
-            x = e.points[(pos == j) & (dist == best[j])][0]
-            seg = pts[idx[j] + 1] - pts[idx[j]]
-            d = x - pts[idx[j]]
-            sag = max(sag, abs(float(seg[0] * d[1] - seg[1] * d[0])) / float(np.hypot(*seg)))
+        # each chord's nearest root (the first in the envelope's order where two tie) against the chord
+        hit = np.flatnonzero(dist == best[pos])
+        hit = hit[np.argsort(pos[hit], kind="stable")]
+        hit = hit[np.concatenate([[True], pos[hit][1:] != pos[hit][:-1]])]
+        p0 = pts[idx[pos[hit]]]
+        seg, d = pts[idx[pos[hit]] + 1] - p0, e.points[hit] - p0
+        sag = max(
+            sag, float((np.abs(seg[:, 0] * d[:, 1] - seg[:, 1] * d[:, 0]) / np.hypot(seg[:, 0], seg[:, 1])).max())
+        )
     return sag

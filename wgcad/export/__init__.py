@@ -1,12 +1,7 @@
 """File exporters (DXF outlines and arcs, STL, 3MF, STEP, SVG; the part set in parts/) and the pictures; the atomic writes they use live in :mod:`wgcad.atomic`.
 
-Reading DXF imports ezdxf, a ring the zipper cannot triangulate manifold3d
-(together ~0.15 s warm, more on a cold start), so the modules are loaded on first use of a name that needs them
-(PEP 562 module ``__getattr__``): ``import wgcad.atomic`` or
-``wgcad --help`` stays light.
+ezdxf, manifold3d, OpenCASCADE, matplotlib and plotly are imported inside the functions that need them.
 """
-
-import importlib
 
 from wgcad.atomic import (
     atomic_batch,
@@ -16,6 +11,8 @@ from wgcad.atomic import (
     discard_all,
     ensure_writable_dir,
 )
+from wgcad.export.dxf import DxfLayer, audit_dxf, build_dxf, read_dxf, write_dxf
+from wgcad.export.stl import ring_solid, stl_bytes, write_stl
 
 __all__ = [
     "atomic_batch",
@@ -33,27 +30,3 @@ __all__ = [
     "stl_bytes",
     "write_stl",
 ]
-
-_LAZY = {
-    "DxfLayer": "wgcad.export.dxf",
-    "build_dxf": "wgcad.export.dxf",
-    "write_dxf": "wgcad.export.dxf",
-    "read_dxf": "wgcad.export.dxf",
-    "audit_dxf": "wgcad.export.dxf",
-    "ring_solid": "wgcad.export.stl",
-    "stl_bytes": "wgcad.export.stl",
-    "write_stl": "wgcad.export.stl",
-}
-
-
-def __getattr__(name):
-    if name in _LAZY:
-        value = getattr(importlib.import_module(_LAZY[name]), name)
-    else:
-        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
-    globals()[name] = value  # cache: later lookups bypass __getattr__
-    return value
-
-
-def __dir__():
-    return sorted(set(globals()) | set(__all__))

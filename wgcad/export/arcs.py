@@ -14,11 +14,11 @@ and meet at an angle only where the pieces do (tooth corners).
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import numpy as np
 
 from wgcad.plane import rotate
-
-from ..records import record
 
 __all__ = [
     "ArcPath",
@@ -42,7 +42,7 @@ N_CHECK = 24
 MAX_DEPTH = 40
 
 
-@record(frozen=True)
+@dataclass(frozen=True, slots=True)
 class ArcPath:
     """A closed path of arcs, as an LWPOLYLINE stores it.
 

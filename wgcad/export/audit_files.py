@@ -6,6 +6,9 @@ from __future__ import annotations
 
 from pathlib import Path
 
+from ..atomic import atomic_batch
+from .audit_figures import audit_plot_data, audit_pngs
+from .html import audit_html
 from .json_text import json_text
 
 __all__ = ["plot_paths", "write_audit_files"]
@@ -24,8 +27,6 @@ def write_audit_files(
     to ``json_path``, the baseline document ``baseline`` to ``baseline_path``, the pictures named after ``plot``
     (:func:`plot_paths`), the page to ``html``. Nothing is written unless all is; ``on_pictures()`` is called
     when the pictures start. Returns the paths written."""
-    from ..atomic import atomic_batch
-
     texts = []
     if json_path:
         texts.append((Path(json_path), json_text(run.doc) + "\n"))
@@ -41,7 +42,6 @@ def write_audit_files(
         if plot or html:
             if on_pictures is not None:
                 on_pictures()
-            from .audit_figures import audit_plot_data, audit_pngs
 
             data = audit_plot_data(run.drive, run.result)
         if plot:
@@ -50,8 +50,6 @@ def write_audit_files(
                 Path(batch.temp_path(path)).write_bytes(pngs[suffix])
                 files.append(path)
         if html:
-            from .html import audit_html
-
             Path(batch.temp_path(html)).write_text(audit_html(run.drive, run.result, run.doc, data), encoding="utf-8")
             files.append(Path(html))
     return files

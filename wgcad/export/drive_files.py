@@ -5,11 +5,24 @@ generator angles, ``<design>.report.json`` and the folder's manifest, written in
 from __future__ import annotations
 
 import os
+from dataclasses import dataclass
 from pathlib import Path
 
+import numpy as np
+
+from ..atomic import atomic_batch, check_target
+from ..errors import OutputError
+from ..placement.imperfect import Imperfections
 from ..plane import circle_polygon
-from ..records import record
+from ..profiles.band import gear_band_outline
+from ..report import drive_report
+from ..report.deformed import deformed_scene
+from ..report.notes import not_modelled
+from .dxf import DxfLayer, write_dxf
+from .figures import assembly_png
 from .json_text import json_text
+from .manifest import Manifest, manifest_name
+from .stl import ring_solid, write_stl
 
 __all__ = ["DriveFiles", "angle_tag", "report_name", "planned_names", "write_drive_files"]
 
@@ -34,15 +47,13 @@ def angle_tag(deg: float) -> str:
 
 def planned_names(stem: str, angles_deg, stl: bool) -> list[str]:
     """Every file name a run writes for the design ``stem``, its manifest included."""
-    from .manifest import manifest_name
-
     names = [f"{stem}.dxf", report_name(stem), manifest_name(stem)]
     names += [f"{stem}_flexspline.stl", f"{stem}_rigid.stl"] if stl else []
     names += [f"{stem}_phi{angle_tag(deg)}.{ext}" for deg in angles_deg for ext in ("dxf", "png")]
     return names
 
 
-@record
+@dataclass(slots=True)
 class DriveFiles:
     """What :func:`write_drive_files` did: the report document, the files written (report last), the previous
     run's files it removed, and the names it kept because they changed since that run wrote them."""
@@ -55,10 +66,6 @@ class DriveFiles:
 
 def _judge_targets(out: Path, source: Path, angles, stl: bool, force: bool):
     """The folder's manifest for the design, once every file the run writes is judged writable."""
-    from ..atomic import check_target
-    from ..errors import OutputError
-    from .manifest import Manifest
-
     manifest = Manifest(out, source.stem, source)
     manifest.check_collision(force)
     # every file this run will write is judged before any work: a device, FIFO, folder or link in the way stops
@@ -72,17 +79,12 @@ def _judge_targets(out: Path, source: Path, angles, stl: bool, force: bool):
 
 def _report(drive) -> tuple[dict, object]:
     """The drive's report document and the errors its deformed assembly is drawn with (None: perfect parts)."""
-    from ..report import drive_report
-    from ..report.notes import not_modelled
-
     design = drive.design
     rep = drive_report(drive)
     # the deformed assembly places the parts with their errors (rigid gear fixed: docs/models.md 6.2); the gears'
     # own DXF and STL stay nominal, the part a shop makes
     imp = None
     if design.imperfections.any and design.drive.fixed == "rigid":
-        from ..placement.imperfect import Imperfections
-
         imp = Imperfections.from_spec(design.imperfections)
     rep["not_modelled"] = not_modelled(design, "generate", imperfections=imp is not None)
     if imp is not None:
@@ -95,8 +97,6 @@ def _report(drive) -> tuple[dict, object]:
 
 def _gear_solid(drive, gear, outline, rim: float):
     """The gear's solid over the face width: its exported outline and its rim circle, whichever is inside."""
-    from .stl import ring_solid
-
     rim_circle = circle_polygon(rim, drive.tol)
     if rim < min(gear.r_a, gear.r_f):  # bore inside the teeth
         return ring_solid(outline, [rim_circle], drive.design.drive.face_width)
@@ -105,8 +105,6 @@ def _gear_solid(drive, gear, outline, rim: float):
 
 def _deformed_layers(drive, scene) -> list:
     """The deformed assembly's DXF layers at one generator angle."""
-    from .dxf import DxfLayer
-
     return [
         DxfLayer("RIGID", outlines=(scene["rigid_outline"],), color=1),
         DxfLayer("RIGID_RIM", circles=((0.0, 0.0, drive.rigid_rim_radius),), color=1),
@@ -118,8 +116,6 @@ def _deformed_layers(drive, scene) -> list:
 
 def _deformed_png(drive, scene, deg: float, imperfect: bool) -> bytes:
     """The deformed assembly's picture at the generator angle ``deg``."""
-    from .figures import assembly_png
-
     d = drive.design
     return assembly_png(
         scene,
@@ -140,13 +136,6 @@ def write_drive_files(
     is an :class:`~wgcad.errors.OutputError`); a folder holding another design file's run of the same name is
     refused unless ``force``. Nothing is written unless all is: one atomic batch, which also removes the previous
     run's files this run does not write again. ``progress(fraction, stage)`` follows the work."""
-    import numpy as np
-
-    from ..atomic import atomic_batch
-    from ..profiles.band import gear_band_outline
-    from .dxf import DxfLayer, write_dxf
-    from .manifest import manifest_name
-
     tick = progress or (lambda f, stage: None)
     out, source = Path(out), Path(source)
     angles = [float(a) for a in angles_deg]
@@ -185,8 +174,6 @@ def write_drive_files(
         files.append(path)
         step(_COST["dxf"], "STL")
         if stl:
-            from .stl import write_stl
-
             for name, (gear, rim) in gears.items():
                 tick(done / total, f"STL {name}")
                 mesh = _gear_solid(drive, gear, band[name], rim)
@@ -195,8 +182,6 @@ def write_drive_files(
                 write_stl(batch.temp_path(path), mesh)
                 files.append(path)
                 step(_COST["stl"], f"STL {name}")
-        if angles:
-            from ..report.deformed import deformed_scene
         for deg in angles:
             tick(done / total, f"{deg:g} deg: DXF")
             scene = deformed_scene(drive, np.deg2rad(deg), imp)

@@ -3,9 +3,11 @@
 from __future__ import annotations
 
 import contextlib
+import io
 import math
 import os
-from dataclasses import field
+from collections import OrderedDict
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -13,16 +15,13 @@ from wgcad.atomic import atomic_write
 from wgcad.constants import DUPLICATE_TOL  # noqa: F401  (re-exported for callers)
 from wgcad.errors import InputFileError
 from wgcad.export.arcs import arc_points
-from wgcad.export.dxf_tags import CENTER_DESCRIPTION, CENTER_PATTERN, dxf_text
 from wgcad.export.rings import clean_outline, min_spacing
-
-from ..records import record
 
 __all__ = [
     "DxfLayer",
     "build_dxf",
     "write_dxf",
-    "ezdxf_dxf_text",
+    "dxf_text",
     "prepare",
     "read_dxf",
     "audit_dxf",
@@ -39,19 +38,17 @@ INSUNITS_MM = 4
 #: ``$MEASUREMENT`` 1 = metric.
 MEASUREMENT_METRIC = 1
 
-
-#: characters DXF forbids in a layer name (AutoCAD's symbol-table rule)
-_BAD_LAYER_CHARS = frozenset('<>/\\":;?*=`')
+#: The CENTER linetype of construction layers: ISO-style long dash, gap, short dash, gap (mm; total length first).
+CENTER_PATTERN = (20.0, 12.0, -3.0, 2.0, -3.0)
+CENTER_DESCRIPTION = "Center ____ _ ____ _"
 
 
 def is_valid_layer_name(name: str) -> bool:
-    """A plain DXF layer name: 1-255 printable characters, none of ``<>/\\":;?*=`` or the backquote.
+    """A plain DXF layer name: 1-255 printable characters that ezdxf's table-name rule accepts, not an
+    AutoCAD-special ``*`` layer (wgcad never writes one; ``|`` is allowed: external-reference layers)."""
+    from ezdxf.lldxf.validator import is_valid_table_name
 
-    ezdxf's rule less AutoCAD-special ``*`` layers and ``\\U+`` escapes, which
-    wgcad's names never need (``|`` is allowed: external-reference layers); checked here so that building
-    layers does not import ezdxf (tests/test_dxf.py compares the two).
-    """
-    return 0 < len(name) <= 255 and name.isprintable() and not (_BAD_LAYER_CHARS & set(name))
+    return 0 < len(name) <= 255 and name.isprintable() and not name.startswith("*") and is_valid_table_name(name)
 
 
 def _readonly(a: np.ndarray) -> np.ndarray:
@@ -60,7 +57,7 @@ def _readonly(a: np.ndarray) -> np.ndarray:
     return a
 
 
-@record(frozen=True)
+@dataclass(frozen=True, slots=True)
 class DxfLayer:
     """One DXF layer: closed outlines and circles, in mm.
 
@@ -136,7 +133,7 @@ class DxfLayer:
         object.__setattr__(self, "color", int(self.color))
 
 
-@record(frozen=True)
+@dataclass(frozen=True, slots=True)
 class Prepared:
     """A layer as it is written: outlines and paths cleaned (see :func:`prepare`)."""
 
@@ -212,8 +209,7 @@ def build_dxf(layers):
     each circle one CIRCLE; entities take their layer's colour (BYLAYER).
     The header says millimetres (``$INSUNITS`` 4, ``$MEASUREMENT`` 1) and
     ``$EXTMIN``/``$EXTMAX`` hold the drawing's bounding box so viewers can
-    zoom to it. :func:`write_dxf` writes the same file without ezdxf (see
-    :mod:`wgcad.export.dxf_tags`); this is the drawing to extend with ezdxf.
+    zoom to it. :func:`write_dxf` writes this drawing; it is the one to extend with ezdxf.
 
     Parameters
     ----------
@@ -230,7 +226,7 @@ def build_dxf(layers):
         On a duplicate layer name or an outline with fewer than 3 distinct
         vertices.
     """
-    import ezdxf  # here, not at the top: writing needs no ezdxf
+    import ezdxf  # here, not at the top: the modules that only build layers (SVG, PNG) need no ezdxf
 
     prepared, lo, hi = prepare(layers)
     with _fixed_metadata():
@@ -271,13 +267,15 @@ def build_dxf(layers):
     return doc
 
 
-def ezdxf_dxf_text(layers) -> str:
-    """The DXF file ezdxf writes for the layers (:func:`build_dxf`), as text.
+def dxf_text(layers) -> str:
+    """The DXF file of the layers as ezdxf writes :func:`build_dxf`'s drawing, the same text for the same layers.
 
-    The reference :func:`write_dxf` is tested against (tests/test_dxf_writer.py): same bytes.
+    ezdxf stamps the creation and update times and random GUIDs into a drawing;
+    its option ``write_fixed_meta_data_for_testing`` (made for comparing files)
+    fixes them, and the CLASSES section is put in an order that does not
+    follow the hash seed (:func:`_canonical_classes`). Handles are given in
+    order, so the file depends on the layers alone.
     """
-    import io
-
     doc = build_dxf(layers)
     with _fixed_metadata():
         _canonical_classes(doc)
@@ -337,11 +335,7 @@ def _fixed_metadata():
 
 
 def write_dxf(path: str | os.PathLike, layers) -> None:
-    """Write the layers to an ASCII DXF R2010 file, atomically.
-
-    The file is the one ezdxf writes for :func:`build_dxf`'s drawing, byte
-    for byte (tests/test_dxf_writer.py), written by :mod:`wgcad.export.dxf_tags`
-    without importing ezdxf (0.3 s of a ``generate``).
+    """Write the layers to an ASCII DXF R2010 file, atomically: :func:`dxf_text`.
 
     Parameters
     ----------
@@ -357,7 +351,7 @@ def write_dxf(path: str | os.PathLike, layers) -> None:
     OutputError
         When the file cannot be written (``path`` is then unchanged).
     """
-    text = dxf_text(*prepare(layers))
+    text = dxf_text(layers)
     atomic_write(path, text.encode("utf-8"))
 
 
@@ -372,8 +366,6 @@ def _canonical_classes(doc) -> None:
     ``add_required_classes`` inside ``doc.write`` a no-op (it only adds
     missing keys) and the file byte-reproducible.
     """
-    from collections import OrderedDict
-
     from ezdxf.sections.classes import REQ_R2004, REQUIRED_CLASSES
 
     section = doc.classes

@@ -17,6 +17,8 @@ __all__ = [
     "clearance_profile_png",
     "clearance_vs_angle_figure",
     "clearance_vs_angle_png",
+    "closeup_limits",
+    "profile_y_range",
     "tightest_spot_figure",
     "tightest_spot_png",
     "velocities_figure",
@@ -29,6 +31,9 @@ DPI = 150
 #: smallest font anywhere in a picture, points (tick labels, legends, tooth labels)
 MIN_FONT_PT = 8.0
 _LEGEND_PT = 8.5
+#: least margin above and below the curves against generator angle, um: an exact ripple of a few nm stays readable,
+#: the view at most twice the ripple or 0.011 um
+VS_ANGLE_MIN_PAD_UM = 0.0025
 # height of one unrolled close-up strip, inches: below ~1 in the teeth of a
 # large drive (D3, 300 teeth) turn into a hatch pattern
 _STRIP_MIN_IN = 1.15
@@ -50,7 +55,7 @@ def _unroll(pts: np.ndarray, r_ref: float, a_ref: float) -> np.ndarray:
     return np.stack([r_ref * ang, np.hypot(pts[..., 0], pts[..., 1]) - r_ref], axis=-1)
 
 
-def _legend_outside(ax, **kw):
+def legend_outside(ax, **kw):
     """A legend to the right of the axes, where it cannot cover a curve."""
     return ax.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), borderaxespad=0.0, fontsize=_LEGEND_PT, **kw)
 
@@ -253,6 +258,23 @@ def _broken(x: np.ndarray, y: np.ndarray, breaks: np.ndarray):
     return np.insert(x, breaks + 1, np.nan), np.insert(np.asarray(y, float), breaks + 1, np.nan)
 
 
+def profile_y_range(profile: dict) -> tuple[float, float]:
+    """The passage profile's y range, um, in the PNG and on the page: from the deepest point (or the contact band)
+    to above the highest marker (entry gaps, the minimum) and at least 150 um; the curves rise to millimetres out of
+    mesh, and showing that would flatten the engagement."""
+    tol = profile["tol_um"]
+    lows = [
+        np.nanmin(np.asarray(sec[k], float)) for sec in profile["sections"] for k in ("working_um", "nonworking_um")
+    ]
+    marks = [profile["worst_um"], tol] + [
+        profile[k] for k in ("entry_um", "entry2_um") if np.isfinite(profile.get(k, np.nan))
+    ]
+    lo = min(min(lows), profile["worst_um"], -tol)
+    hi = max(marks)
+    top = max(150.0, hi + 0.15 * (hi - lo))
+    return lo - 0.08 * (top - lo), top
+
+
 def clearance_profile_figure(profile: dict, title: str):
     """The per-tooth clearance profile as a matplotlib figure (see :func:`clearance_profile_png`)."""
     plt = _pyplot()
@@ -261,7 +283,7 @@ def clearance_profile_figure(profile: dict, title: str):
     fig, ax = plt.subplots(figsize=(13, 5.6), layout="constrained", dpi=DPI)
     ph = np.asarray(profile["phi_deg"], float)
     tol = profile["tol_um"]
-    lows, fold_x = [], []
+    fold_x = []
     for i, sec in enumerate(profile["sections"]):
         lab = "" if sec["z"] is None else f", z = {sec['z']:g} mm"
         c = f"C{i}"
@@ -270,12 +292,9 @@ def clearance_profile_figure(profile: dict, title: str):
         fold_x += [(0.5 * (ph[j] + ph[j + 1]), min(w[j], n[j])) for j in br]
         ax.plot(*_broken(ph, w, br), color=c, lw=1.4, label=f"working flank{lab}")
         ax.plot(*_broken(ph, n, br), color=c, lw=1.0, ls="--", label=f"non-working flank{lab}")
-        lows += [np.nanmin(w), np.nanmin(n)]
     ax.axhline(0.0, color="k", lw=0.8)
     ax.axhspan(-tol, tol, color="0.85", zorder=0, label=f"contact tolerance +-{tol:g} um")
-    marks = [profile["worst_um"], tol]
     if np.isfinite(profile.get("entry_um", np.nan)):
-        marks.append(profile["entry_um"])
         ax.plot(
             [profile["entry_deg"]],
             [profile["entry_um"]],
@@ -287,7 +306,6 @@ def clearance_profile_figure(profile: dict, title: str):
             + f" {profile['entry_um']:.2f} um at {profile['entry_deg']:+.1f}°",
         )
     if np.isfinite(profile.get("entry2_um", np.nan)):
-        marks.append(profile["entry2_um"])
         ax.plot(
             [profile["entry2_deg"]],
             [profile["entry2_um"]],
@@ -307,12 +325,7 @@ def clearance_profile_figure(profile: dict, title: str):
         zorder=5,
         label=profile.get("worst_label", "minimum") + f" {profile['worst_um']:.2f} um at {profile['worst_deg']:+.1f}°",
     )
-    # y: from the deepest point to above the highest marker; the curves rise to
-    # millimetres out of mesh, and showing that would flatten the engagement
-    lo = min(min(lows), profile["worst_um"], -tol)
-    hi = max(marks)
-    top = max(150.0, hi + 0.15 * (hi - lo))
-    bottom = lo - 0.08 * (top - lo)
+    bottom, top = profile_y_range(profile)
     ax.set_ylim(bottom, top)
     half = max(abs(ph[0]), abs(ph[-1]))
     ax.set_xlim(ph[0], ph[-1])
@@ -343,7 +356,7 @@ def clearance_profile_figure(profile: dict, title: str):
             )
         )
     handles.append(Line2D([], [], ls="", label=f"curves above {top:.0f} um not shown\n(teeth out of mesh)"))
-    _legend_outside(ax, handles=handles)
+    legend_outside(ax, handles=handles)
     ax.tick_params(labelsize=9)
     ax.set_xlabel("tooth angle from the generator major axis, deg", fontsize=10)
     ax.set_ylabel("clearance, um (negative: penetration depth)", fontsize=10)
@@ -368,7 +381,7 @@ def clearance_profile_png(profile: dict, title: str) -> bytes:
 # ---------------------------------------------------------------- clearance against generator angle
 
 
-def clearance_vs_angle_figure(angles_deg, working_um, nonworking_um, tol_um: float, title: str):
+def clearance_vs_angle_figure(angles_deg, working_um, nonworking_um, tol_um: float, title: str, reported_um=None):
     """The ripple of the smallest clearance as a matplotlib figure (see :func:`clearance_vs_angle_png`)."""
     plt = _pyplot()
 
@@ -382,13 +395,24 @@ def clearance_vs_angle_figure(angles_deg, working_um, nonworking_um, tol_um: flo
         fin = y[np.isfinite(y)]
         y_min, y_max = (float(fin.min()), float(fin.max())) if fin.size else (0.0, 0.0)
         rip = y_max - y_min
-        ax.plot(ang, y, lw=1.2, ls=style, color="C0" if style == "-" else "C1")
+        ax.plot(
+            ang, y, lw=1.2, ls=style, color="C0" if style == "-" else "C1", label=f"smallest over the teeth, {name}"
+        )
         # scaled to the ripple (the reason for this picture), not from zero
-        pad = max(0.12 * rip, 0.005)
+        pad = max(0.12 * rip, VS_ANGLE_MIN_PAD_UM)
         lo, hi = y_min - pad, y_max + pad
+        shown = reported_um is not None and lo <= reported_um <= hi
+        if shown:
+            # the audit's exact minimum where it is reported: the curve reaches it (a tooth at the spot) or not
+            ax.axhline(reported_um, color="tab:red", lw=1.0, ls=":", label=f"the audit's minimum {reported_um:.3f} um")
         ax.set_ylim(lo, hi)
         ax.ticklabel_format(axis="y", useOffset=False)
         where = "0 um above this scale" if hi <= 0.0 else ("0 um below this scale" if lo >= 0.0 else "0 um: black line")
+        if reported_um is not None and not shown:
+            where += f"; the audit's minimum {reported_um:.3f} um {'below' if reported_um < lo else 'above'} this scale"
+            where += (
+                " (the curve's samples are 0.1 deg of tooth angle apart)" if abs(reported_um - y_min) < 0.05 else ""
+            )
         if hi > -tol_um and lo < tol_um:
             ax.axhspan(-tol_um, tol_um, color="0.85", zorder=0)
             where += f"; grey band: contact within +-{tol_um:g} um"
@@ -402,26 +426,38 @@ def clearance_vs_angle_figure(angles_deg, working_um, nonworking_um, tol_um: flo
         ax.set_ylabel("smallest clearance, um", fontsize=9.5)
         ax.tick_params(labelsize=9)
         ax.grid(alpha=0.3)
+        legend_outside(ax)
     axs[1].set_xlabel("generator angle, deg", fontsize=10)
-    fig.suptitle(title + "\n(read off the per-tooth profile: a picture; the audit's minimum is exact)", fontsize=10)
+    fig.suptitle(
+        title
+        + "\n(read off the per-tooth profile, on the exact curves near its minimum; the audit's minimum is exact)",
+        fontsize=10,
+    )
     return fig
 
 
 def clearance_vs_angle_png(
-    angles_deg: np.ndarray, working_um: np.ndarray, nonworking_um: np.ndarray, tol_um: float, title: str
+    angles_deg: np.ndarray,
+    working_um: np.ndarray,
+    nonworking_um: np.ndarray,
+    tol_um: float,
+    title: str,
+    reported_um: float | None = None,
 ) -> bytes:
     """Smallest clearance over all teeth against the generator angle, one panel per flank, as PNG bytes.
 
     Each panel's y range is the curve's own range plus a margin, stated in
-    its title with the peak-to-peak ripple and where zero lies.
+    its title with the peak-to-peak ripple and where zero lies; the audit's
+    minimum ``reported_um`` is drawn where it lies near that range (else the
+    title says where it is).
     """
-    return _png(clearance_vs_angle_figure(angles_deg, working_um, nonworking_um, tol_um, title))
+    return _png(clearance_vs_angle_figure(angles_deg, working_um, nonworking_um, tol_um, title, reported_um))
 
 
 # ---------------------------------------------------------------- tightest spot
 
 
-def tightest_spot_figure(flex_teeth: np.ndarray, labels, rigid_teeth: np.ndarray, overlap, title: str):
+def tightest_spot_figure(flex_teeth: np.ndarray, labels, rigid_teeth: np.ndarray, overlap, title: str, spot=None):
     """The tightest spot as a matplotlib figure (see :func:`tightest_spot_png`)."""
     plt = _pyplot()
     from matplotlib.patches import Polygon
@@ -463,23 +499,55 @@ def tightest_spot_figure(flex_teeth: np.ndarray, labels, rigid_teeth: np.ndarray
         "flexspline tooth angle from the major axis (red: overlap of the worst tooth)", fontsize=9, color="tab:blue"
     )
     mid = _unroll(flex_teeth[len(flex_teeth) // 2], r_ref, a_ref)
-    if overlap:
-        o = np.vstack([_unroll(p, r_ref, a_ref) for p in overlap])
-        cx, cy = o.mean(axis=0)
-        span = max(0.15, 0.6 * np.ptp(o, axis=0).max())
-    else:
-        cx, cy = mid.mean(axis=0)
-        span = 0.8
-    axs[1].set_xlim(cx - span, cx + span)
-    axs[1].set_ylim(cy - span, cy + span)
-    axs[1].set_title("close-up of the worst tooth", fontsize=9.5)
+    ov = np.vstack([_unroll(p, r_ref, a_ref) for p in overlap]) if overlap else None
+    ends = None if spot is None else _unroll(np.stack([spot["flex"], spot["rigid"]]), r_ref, a_ref)
+    (cx0, cx1), (cy0, cy1) = closeup_limits(ends, ov, mid)
+    axs[1].set_xlim(cx0, cx1)
+    axs[1].set_ylim(cy0, cy1)
+    if ends is not None:
+        _mark_spot(axs, ends, spot.get("label", f"tightest spot: {spot['um']:.2f} um"))
+    axs[1].set_title(
+        "close-up of the tightest spot" if ends is not None else "close-up of the worst tooth", fontsize=9.5
+    )
     fig.suptitle(title, fontsize=10)
     return fig
 
 
-def tightest_spot_png(flex_teeth: np.ndarray, labels, rigid_teeth: np.ndarray, overlap, title: str) -> bytes:
-    """The teeth around the tightest spot, unrolled about the worst tooth: flexspline (blue), rigid (grey), overlaps (red)."""
-    return _png(tightest_spot_figure(flex_teeth, labels, rigid_teeth, overlap, title))
+def closeup_limits(ends, overlap, tooth) -> tuple[tuple[float, float], tuple[float, float]]:
+    """The close-up's ``(x limits, y limits)``, mm in the unrolled frame: centred on the tightest spot (``ends``, the
+    gap's two ends, ``(2, 2)``), wide enough for six times its gap and every overlap, the ends at least a fifth of the
+    view from its edges; without a spot, on the overlaps or else the worst tooth (``tooth``, its outline)."""
+    if ends is not None:
+        ends = np.asarray(ends, float)
+        cx, cy = ends.mean(axis=0)
+        half = float(np.clip(6.0 * np.ptp(ends, axis=0).max(), 0.05, 0.8))
+        if overlap is not None:
+            half = max(half, 0.6 * float(np.ptp(overlap, axis=0).max()))
+        half = max(half, float(np.abs(ends - (cx, cy)).max()) / 0.6)  # the ends inside, with a margin
+    elif overlap is not None:
+        cx, cy = overlap.mean(axis=0)
+        half = max(0.15, 0.6 * float(np.ptp(overlap, axis=0).max()))
+    else:
+        cx, cy = np.asarray(tooth, float).mean(axis=0)
+        half = 0.8
+    return (cx - half, cx + half), (cy - half, cy + half)
+
+
+def _mark_spot(axs, ends, label: str) -> None:
+    """The tightest spot in both panels: a ring in the overview, the gap's two ends joined in the close-up, its
+    figure in the close-up's legend."""
+    mid = ends.mean(axis=0)
+    axs[0].plot(*mid, "o", ms=11, mfc="none", mec="tab:red", mew=1.6, zorder=5)
+    axs[1].plot(ends[:, 0], ends[:, 1], "-", color="tab:red", lw=1.6, zorder=5)
+    axs[1].plot(ends[:, 0], ends[:, 1], "o", ms=4.5, color="tab:red", zorder=6, label=label)
+    axs[1].legend(loc="lower left", fontsize=_LEGEND_PT, framealpha=0.9)
+
+
+def tightest_spot_png(flex_teeth: np.ndarray, labels, rigid_teeth: np.ndarray, overlap, title: str, spot=None) -> bytes:
+    """The teeth around the tightest spot, unrolled about the worst tooth: flexspline (blue), rigid (grey), overlaps
+    (red); ``spot`` (:func:`wgcad.export.audit_figures.tightest_points`, with a ``label``): the close-up framed on
+    it and the spot marked."""
+    return _png(tightest_spot_figure(flex_teeth, labels, rigid_teeth, overlap, title, spot))
 
 
 # ---------------------------------------------------------------- external ring generator velocities

@@ -4,15 +4,15 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..profiles.measure import pin_check, span_check
+
 __all__ = ["span_measurement", "pin_dimension", "gear_data", "data_lines"]
 
 
 def span_measurement(gear) -> dict | None:
     """Span ``W_k`` over ``k`` teeth (external teeth) by the rule of :func:`wgcad.profiles.measure.span_check`, the
-    one ``generate``'s report states: the same ``k`` and ``W_k`` in both (issue 23), with the rule, the method
+    one ``generate``'s report states: the same ``k`` and ``W_k`` in both, with the rule, the method
     and the sensitivity to tooth thickness. None for internal teeth or where no ``k`` puts the jaws on the flanks."""
-    from ..profiles.measure import span_check
-
     sp = span_check(gear)
     if sp is None or sp.get("k") is None:
         return None
@@ -31,8 +31,6 @@ def pin_dimension(gear, pin_diameter: float | None = None) -> dict | None:
     :func:`wgcad.profiles.measure.pin_check` (contact nearest mid-flank with the pin standing out of the teeth
     and clear of the root, gauge pins in 1 um steps), the one ``generate``'s report states, for every tooth form;
     with the sensitivity to tooth thickness. None where no pin fits by that rule."""
-    from ..profiles.measure import pin_check
-
     p = pin_check(gear, pin_diameter)
     if not (p["pin_stands_out_of_the_teeth"] and p["pin_clear_of_the_root"]):
         return None
@@ -68,6 +66,10 @@ def gear_data(gear, tol: float) -> dict:
         "thinning_mm": None if sp.form == "conjugate" else sp.thinning,
         "chord_tolerance_mm": tol,
     }
+    if gear.envelope_residual_mm is not None:
+        # the flank's distance from the envelope condition (docs/models.md 13.2)
+        out["envelope_residual_mm"] = gear.envelope_residual_mm
+        out["envelope_chord_sagitta_mm"] = gear.envelope_sagitta_mm
     if sp.form == "double_arc":
         out["double_arc"] = {
             "convex_radius_mm": sp.convex_radius,
@@ -97,6 +99,10 @@ def data_lines(name: str, data: dict) -> list[str]:
         f"pitch diameter = {f(data['pitch_diameter_mm'])} mm",
         f"base diameter = {f(data['base_diameter_mm'])} mm",
     ]
+    if data.get("envelope_residual_mm") is not None:
+        lines.append(
+            f"envelope residual = {data['envelope_residual_mm']:.1e} mm (chords within {data['envelope_chord_sagitta_mm']:.1e} mm)"
+        )
     if data.get("double_arc"):
         da = data["double_arc"]
         lines.append(

@@ -11,7 +11,10 @@ import html
 
 import numpy as np
 
-__all__ = ["CSS", "fmt", "figure", "table", "notes", "page"]
+__all__ = ["CSS", "GLOSSARY", "fmt", "figure", "table", "notes", "page"]
+
+#: where the names on every page are defined (the page links it in its footer; a path of the source tree)
+GLOSSARY = "docs/glossary.md"
 
 CSS = """
 body { font-family: system-ui, sans-serif; margin: 1.5em; color: #222; max-width: 1200px; }
@@ -72,5 +75,6 @@ def page(title: str, command: str, head: list[str], figs: list[tuple[str, str]],
             tail
             or "\n<p class='note'>wgcad: every figure here is also in the JSON; the page loads nothing from the network.</p>"
         )
-        + "\n</body></html>\n"
+        + f"\n<footer class='note'>Terms (backlash, lost motion, wind-up offset, rated and design torque, ...): "
+        f"<a href='{GLOSSARY}'>{GLOSSARY}</a>, wgcad's glossary.</footer>" + "\n</body></html>\n"
     )

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .figures import DPI, MIN_FONT_PT, _legend_outside
+from .figures import DPI, MIN_FONT_PT, legend_outside
 from .mpl import png_bytes, pyplot
 
 __all__ = ["entry_passages_figure", "entry_passages_png"]
@@ -51,6 +51,6 @@ def entry_passages_figure(phi_h_deg, gap_um, section, sections_z, perfect_um, to
     ax.set_ylabel("entry gap, um (polygon figures)", fontsize=10)
     ax.tick_params(labelsize=max(9, MIN_FONT_PT))
     ax.grid(alpha=0.3)
-    _legend_outside(ax)  # beside the axes: it cannot cover a passage
+    legend_outside(ax)  # beside the axes: it cannot cover a passage
     ax.set_title(title, fontsize=10)
     return fig

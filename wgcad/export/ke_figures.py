@@ -4,12 +4,14 @@ from __future__ import annotations
 
 import numpy as np
 
+from wgcad.accuracy.flank_errors import ENGAGEMENTS, drive_flank_errors
+from wgcad.placement.imperfect import full_cycle_turns
 from wgcad.units import ARCSEC_PER_RAD
 
 from .mpl import png_bytes
 from .mpl import pyplot as _plt
 
-__all__ = ["ke_png", "install_png", "flank_png", "ke_load_png", "strands"]
+__all__ = ["ke_png", "ke_figure", "install_png", "flank_png", "ke_load_png", "strands"]
 
 _AS = ARCSEC_PER_RAD
 
@@ -18,8 +20,15 @@ def _png(fig, plt) -> bytes:
     return png_bytes(fig, tight_layout=True)
 
 
-def ke_png(title: str, res, orders, amp, expected: dict, intrinsic=None) -> bytes:
-    """KE over the record (arcsec against cam turns), its first mesh periods, and its spectrum with the expected orders marked."""
+def ke_png(title: str, res, orders, amp, expected: dict, intrinsic=None, strongest=None) -> bytes:
+    """KE over the record (arcsec against cam turns), its first mesh periods, and its spectrum with the expected
+    orders and the ``strongest`` (``[(order, arcsec)]``, the summary's) marked."""
+    plt = _plt()
+    return _png(ke_figure(title, res, orders, amp, expected, intrinsic, strongest), plt)
+
+
+def ke_figure(title: str, res, orders, amp, expected: dict, intrinsic=None, strongest=None):
+    """The figure of :func:`ke_png`."""
     plt = _plt()
     fig, ax = plt.subplots(3, 1, figsize=(11, 10), dpi=90)
     turns = np.abs(res.phi_h) / (2 * np.pi)
@@ -50,12 +59,13 @@ def ke_png(title: str, res, orders, amp, expected: dict, intrinsic=None) -> byte
     ax[1].legend(fontsize=8, loc="upper right")
     ax[1].grid(alpha=0.3)
     low = {k: v for k, v in expected.items() if k != "mesh"}
-    top = max(low.values()) * 1.6
+    strongest = [(float(o), float(a)) for o, a in (strongest or [])]
+    top = max([max(low.values()) * 1.6] + [1.05 * o for o, _ in strongest if o < 2 * max(low.values())])
     sel = (orders > 0) & (orders <= top)
     a_sel = amp[sel] * _AS
     a_max = float(a_sel.max()) if a_sel.size else 1.0
     # four decades below the strongest order: what lies under that is noise of the sampling, not of the drive
-    # (issue 23: the axis ran over 8 decades down to a clamp at 1e-6)
+    # (once: the axis ran over 8 decades down to a clamp at 1e-6)
     floor = 1e-4 * a_max
     ax[2].semilogy(orders[sel], np.maximum(a_sel, floor), lw=0.8, color="k", label="amplitude")
     ax[2].set_ylim(floor, 2.0 * a_max)
@@ -74,6 +84,18 @@ def ke_png(title: str, res, orders, amp, expected: dict, intrinsic=None) -> byte
                 alpha=0.7,
                 label=f"{gear} orders: {', '.join(f'{x:g}' for x in os_)}" if i == 0 else None,
             )
+    shown = [(o, a) for o, a in strongest if 0 < o <= top]
+    if shown:
+        # the summary's strongest orders where they are (D2's 300 and 301, the second strongest, were unmarked)
+        ax[2].plot(
+            [o for o, _ in shown],
+            [2.0 * max(a, floor) for _, a in shown],
+            "v",
+            color="tab:green",
+            ms=7,
+            label="strongest: " + ", ".join(f"{o:g} ({a:.3g}'')" for o, a in shown),
+        )
+        ax[2].set_ylim(floor, 5.0 * a_max)
     ax[2].legend(fontsize=8, loc="upper right")
     label = "order, cycles per flexspline revolution"
     if "mesh" in expected:
@@ -85,7 +107,7 @@ def ke_png(title: str, res, orders, amp, expected: dict, intrinsic=None) -> byte
     ax[2].set_ylabel("amplitude, arcsec")
     ax[2].grid(alpha=0.3, which="both")
     fig.suptitle(title)
-    return _png(fig, plt)
+    return fig
 
 
 def install_png(title: str, rigid_deg, rigid_pp, best_deg, best_pp, flex_deg=None, flex_pp=None) -> bytes:
@@ -120,7 +142,7 @@ def flank_png(title: str, turns, errors: dict, zones=("major axis", "second wave
 
     ``errors``: ``{(zone index, engagement): FlankErrors}`` with arrays over ``turns``
     (:func:`wgcad.accuracy.drive_flank_errors`). The errors turn once or twice per generator turn: drawn raw over
-    the whole cycle (100 turns on D2) the six curves filled one band (issue 23); per turn, the beat of the rigid
+    the whole cycle (100 turns on D2) the six curves filled one band; per turn, the beat of the rigid
     gear's order against the flexspline's shows as the amplitude's slow swell.
     """
     plt = _plt()
@@ -176,9 +198,15 @@ def strands(turns: np.ndarray) -> int:
 
 def ke_load_png(title: str, res, loaded: list) -> bytes:
     """No-load KE over the revolution with the loaded KE at its whole mesh periods, one colour per torque, each drawn
-    as its strands (the samples of one cam phase joined; arcsec against generator turns)."""
+    as its strands (the samples of one cam phase joined; arcsec against generator turns); single-zone samples
+    ringed. Below: the share of the tooth torque the lesser engagement zone carries at each sample ([S4]'s
+    explanation of a large KE: single-zone engagement)."""
+    from wgcad.accuracy.ke_load import SINGLE_ZONE_SHARE
+
     plt = _plt()
-    fig, ax = plt.subplots(1, 1, figsize=(11, 5.2), dpi=150)
+    fig, (ax, az) = plt.subplots(
+        2, 1, figsize=(11, 7.6), dpi=150, sharex=True, gridspec_kw={"height_ratios": [2.2, 1.0]}
+    )
     turns = np.abs(res.phi_h) / (2 * np.pi)
     ax.plot(
         turns, res.ke * _AS, lw=0.4, color="0.75", label=f"no load, every angle: {res.ke_pp * _AS:.2f}'' peak to peak"
@@ -217,7 +245,30 @@ def ke_load_png(title: str, res, loaded: list) -> bytes:
                 if j == 0
                 else None,
             )
-    ax.set_xlabel("generator turns (one flexspline revolution)")
+        sz = L.single_zone
+        if sz.any():
+            ax.plot(
+                t[sz],
+                L.ke[sz] * _AS,
+                "o",
+                ms=6,
+                mfc="none",
+                mec=f"C{i}",
+                lw=0.8,
+                label=f"{L.torque_nm:g} N m single-zone ({100 * sz.mean():.0f} % of the samples)",
+            )
+        if L.zone_share.size:
+            lesser = 100 * np.nanmin(L.zone_share, axis=1)
+            order = np.argsort(t)
+            az.plot(t[order], lesser[order], ".", ms=3, color=f"C{i}", label=f"{L.torque_nm:g} N m")
+    az.axhline(
+        100 * SINGLE_ZONE_SHARE, color="0.4", lw=0.8, ls="--", label=f"single-zone below {100 * SINGLE_ZONE_SHARE:g} %"
+    )
+    az.set_ylim(0, 52)
+    az.set_ylabel("lesser zone's share\nof the tooth torque, %")
+    az.set_xlabel("generator turns (one flexspline revolution)")
+    az.legend(fontsize=8.5, loc="upper left", bbox_to_anchor=(1.01, 1.0), borderaxespad=0.0)
+    az.grid(alpha=0.3)
     ax.set_ylabel("KE, arcsec (each curve from its first sample)")
     ax.legend(fontsize=8.5, loc="upper left", bbox_to_anchor=(1.01, 1.0), borderaxespad=0.0)
     ax.grid(alpha=0.3)
@@ -231,12 +282,12 @@ def ke_load_png(title: str, res, loaded: list) -> bytes:
 def ke_pngs(run) -> dict:
     """The pictures of a KE run (:class:`wgcad.report.ke_run.KERun`) as ``{suffix: PNG bytes}``: ``_ke``, ``_flank``
     and, where computed, ``_ke_load`` and ``_install``."""
-    from wgcad.accuracy.flank_errors import ENGAGEMENTS, drive_flank_errors
-    from wgcad.placement.imperfect import full_cycle_turns
-
     drive, imp = run.drive, run.imp
     d = drive.design.drive
-    out = {"_ke": ke_png(f"{d.name}: kinematic error, no load", run.res, run.orders, run.amp, run.expected, run.intr)}
+    top = [(t["order"], t["amplitude_arcsec"]) for t in run.doc.get("spectrum_top", [])[:4]]
+    out = {
+        "_ke": ke_png(f"{d.name}: kinematic error, no load", run.res, run.orders, run.amp, run.expected, run.intr, top)
+    }
     if run.loaded:
         out["_ke_load"] = ke_load_png(
             f"{d.name}: kinematic error under load (elastic model at whole mesh periods) and at no load",

@@ -6,7 +6,8 @@ import numpy as np
 
 from wgcad.units import ARCSEC_PER_RAD
 
-from .html_page import figure, fmt, page, table
+from ..extras import require
+from .html_page import figure, fmt, notes, page, table
 
 __all__ = ["ke_html"]
 
@@ -30,6 +31,10 @@ def _envelope(x: np.ndarray, y: np.ndarray) -> tuple[np.ndarray, np.ndarray, int
     hi = np.argmax(blocks, axis=1) + b * np.arange(m)
     idx = np.unique(np.concatenate([lo, hi, np.arange(m * b, n)]))
     return x[idx], y[idx], b
+
+
+#: the legends under the plots, in rows across the page's width: beside them, their long names took 40 % of it
+BELOW = dict(orientation="h", yanchor="top", y=-0.18, xanchor="left", x=0.0)
 
 
 def _ke(go, run):
@@ -62,8 +67,9 @@ def _ke(go, run):
         )
     fig.update_layout(
         title="kinematic error over one flexspline revolution (zoom in for the mesh ripple)",
-        height=520,
+        height=560,
         template="plotly_white",
+        legend=BELOW,
     )
     fig.update_xaxes(title="generator turns")
     fig.update_yaxes(title="KE, arcsec")
@@ -91,10 +97,24 @@ def _spectrum(go, run):
                 name=f"{label}: order {order:g}",
             )
         )
+    strongest = [(t["order"], t["amplitude_arcsec"]) for t in run.doc.get("spectrum_top", [])[:4]]
+    shown = [(o, a) for o, a in strongest if 0 < o <= top]
+    if shown:
+        # the summary's strongest orders where they are (D2's 300 and 301, the second strongest, were unmarked)
+        fig.add_trace(
+            go.Scatter(
+                x=[o for o, _ in shown],
+                y=[max(a, floor) for _, a in shown],
+                mode="markers",
+                marker=dict(size=11, symbol="circle-open", line=dict(width=2), color="#2ca02c"),
+                name="strongest: " + ", ".join(f"{o:g} ({a:.3g}'')" for o, a in shown),
+            )
+        )
     fig.update_layout(
         title=f"spectrum up to order {top:g} (per flexspline revolution; four decades below the strongest)",
-        height=480,
+        height=540,
         template="plotly_white",
+        legend=BELOW,
     )
     fig.update_xaxes(title="order")
     fig.update_yaxes(title="amplitude, arcsec", type="log")
@@ -116,6 +136,7 @@ def _install(go, run):
 
 def ke_html(run) -> str:
     """The page of a :class:`~wgcad.report.ke_run.KERun`."""
+    require("html")  # plotly draws the page
     import plotly.graph_objects as go
 
     doc = run.doc
@@ -124,9 +145,9 @@ def ke_html(run) -> str:
         ("largest KE, peak to peak", f"{fmt(doc['ke_pp_arcsec'], 2)} arcsec", f"engagement: {fmt(doc['engagement'])}"),
         ("perfect parts", f"{fmt(doc['intrinsic_ke_pp_arcsec'], 3)} arcsec", "the mesh's own ripple"),
         (
-            "lost motion",
-            f"{fmt(doc['lost_motion_arcsec']['min'], 1)} .. {fmt(doc['lost_motion_arcsec']['max'], 1)} arcsec",
-            "over the revolution",
+            "free play between the flanks",
+            f"{fmt(doc['free_play_arcsec']['min'], 1)} .. {fmt(doc['free_play_arcsec']['max'], 1)} arcsec",
+            "no load, over the revolution (negative: the teeth interfere)",
         ),
         (
             "angles",
@@ -139,12 +160,50 @@ def ke_html(run) -> str:
         rows.append(
             (f"KE at {L.torque_nm:g} N m", f"{L.ke_pp * _AS:.2f} arcsec", f"{len(L.ke)} states at whole mesh periods")
         )
+        sz = L.single_zone
+        rows.append(
+            (
+                f"zones at {L.torque_nm:g} N m",
+                f"single-zone at {100 * sz.mean():.1f} % of the samples",
+                f"KE {L.ke_range(sz) * _AS:.2f}'' within them, {L.ke_range(~sz) * _AS:.2f}'' within the two-zone ones",
+            )
+        )
     top = table(
         [(f"{s['order']:g}", f"{s['amplitude_arcsec']:.3f}") for s in doc["spectrum_top"]],
         head=["order", "amplitude, arcsec"],
     )
-    head = [table(rows), "<p>strongest orders:</p>", top]
+    head = [table(rows), notes(doc.get("validity_notes", ()), title="VALIDITY:"), "<p>strongest orders:</p>", top]
     figs = [("Kinematic error", figure(_ke(go, run), "ke")), ("Spectrum", figure(_spectrum(go, run), "spectrum"))]
+    if run.loaded:
+        figs.append(("Zones under load", figure(_zones(go, run), "zones")))
     if run.scan is not None:
         figs.append(("Installation angle", figure(_install(go, run), "install")))
     return page(f"{name}: kinematic error", "ke", head, figs)
+
+
+def _zones(go, run):
+    """The lesser engagement zone's share of the tooth torque at every loaded sample (docs/models.md 4.2)."""
+    from wgcad.accuracy.ke_load import SINGLE_ZONE_SHARE
+
+    fig = go.Figure()
+    for L in run.loaded:
+        t = np.abs(L.phi_h) / (2 * np.pi)
+        order = np.argsort(t)
+        fig.add_trace(
+            go.Scatter(
+                x=t[order],
+                y=100 * np.nanmin(L.zone_share, axis=1)[order],
+                mode="markers",
+                marker=dict(size=4),
+                name=f"{L.torque_nm:g} N m",
+            )
+        )
+    fig.add_hline(y=100 * SINGLE_ZONE_SHARE, line_dash="dash", annotation_text="single-zone below")
+    fig.update_layout(
+        title="the lesser zone's share of the tooth torque (single-zone engagement below the line)",
+        height=420,
+        template="plotly_white",
+    )
+    fig.update_xaxes(title="generator turns")
+    fig.update_yaxes(title="share, %", range=[0, 52])
+    return fig

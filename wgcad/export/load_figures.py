@@ -39,7 +39,7 @@ def entry_gap_png(series: list, title: str, tol_um: float = 1.0) -> bytes:
     log = vals.size and np.nanmax(np.abs(vals)) > 20.0 * max(np.nanmin(np.abs(vals)), 1.0)
     if log:  # series of very different size (e.g. involute ~5 um, cycloidal ~180 um): both readable
         ax.set_yscale("symlog", linthresh=10.0)
-        # ticks where the values lie: the linear band |gap| < 10 um had none but 0 (issue 23), and the decades
+        # ticks where the values lie: the linear band |gap| < 10 um had none but 0, and the decades
         lo, hi = min(float(np.nanmin(vals)), -tol_um), float(np.nanmax(vals))
         ticks = [
             t for t in (-1000, -100, -50, -20, -10, -5, -2, 0, 2, 5, 10, 20, 50, 100, 200, 500, 1000) if lo <= t <= hi
@@ -79,7 +79,7 @@ def force_distribution_png(levels: list, title: str) -> bytes:
     ax.set_ylabel("tooth force, N")
     ax.set_xlim(-180, 180)
     ax.grid(True, alpha=0.3)
-    # beside the panels, not over them: the legend covered the force spikes it is about (issue 23)
+    # beside the panels, not over them: the legend covered the force spikes it is about
     ax.legend(fontsize=7, ncol=1, loc="upper left", bbox_to_anchor=(1.01, 1.0), borderaxespad=0.0, title="torque")
     ax.set_title(title, fontsize=10)
     ax2.set_xlim(-180, 180)

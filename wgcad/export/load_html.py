@@ -4,9 +4,10 @@ from __future__ import annotations
 
 import html
 
+from ..extras import require
 from .html_page import figure, fmt, page, table
 
-__all__ = ["load_html"]
+__all__ = ["load_html", "load_figures"]
 
 
 def _entry(go, res):
@@ -87,10 +88,17 @@ def _wind_up(go, res):
     return fig
 
 
-def load_html(res: dict) -> str:
-    """The page of a load audit's document (:func:`wgcad.elastic.sweep.torque_sweep` without its states)."""
+def load_figures(res: dict) -> dict:
+    """The load page's plotly figures (``plotly.graph_objects.Figure``): ``entry_gap`` (the load curve: entry gap
+    against torque), ``forces`` (around the rim), ``wind_up``; ``res`` the load audit's document."""
+    require("html")
     import plotly.graph_objects as go
 
+    return {"entry_gap": _entry(go, res), "forces": _forces(go, res), "wind_up": _wind_up(go, res)}
+
+
+def load_html(res: dict) -> str:
+    """The page of a load audit's document (:func:`wgcad.elastic.sweep.torque_sweep` without its states)."""
     name = res["design"]
     closes = res["entry_gap_closes"]
     verdict = (
@@ -138,9 +146,6 @@ def load_html(res: dict) -> str:
         f"{res['cam_offset_um']:g} um at {res['cam_offset_deg']:g} deg.</p>",
         levels,
     ]
-    figs = [
-        ("Entry gap against torque", figure(_entry(go, res), "entry_gap")),
-        ("Forces around the rim", figure(_forces(go, res), "forces")),
-        ("Wind-up", figure(_wind_up(go, res), "wind_up")),
-    ]
+    titles = {"entry_gap": "Entry gap against torque", "forces": "Forces around the rim", "wind_up": "Wind-up"}
+    figs = [(titles[k], figure(fig, k)) for k, fig in load_figures(res).items()]
     return page(f"{name}: under load", "audit --torque-nm", head, figs)

@@ -2,10 +2,12 @@
 
 The solids are built by manifold3d; what the exporters need of the result is
 its vertices and faces, whether it is a closed, consistently oriented volume,
-its volume and bounds, and a binary STL. trimesh gave these at 0.33 s of
-import on every ``generate`` (benchmarks/startup.py), for a few array
-operations; the tests read the files back with trimesh, an independent
-reader.
+its volume and bounds, and a binary STL. trimesh (not a dependency of wgcad;
+the tests read the files back with it, an independent reader) would give
+them at a cost of 37 % of the CPU of ``wgcad generate d1_involute`` and
+17 % of ``wgcad parts`` (STL and 3MF), even imported only where the STL is
+written (benchmarks/copies.py, ``mesh``): a copy kept by
+docs/architecture.md's rule. (trimesh's 3MF writer would need networkx too.)
 """
 
 from __future__ import annotations

@@ -4,11 +4,14 @@ from __future__ import annotations
 
 import io
 
+from ..extras import require
+
 __all__ = ["pyplot", "png_bytes"]
 
 
 def pyplot():
-    """matplotlib.pyplot on the Agg backend (no display needed)."""
+    """matplotlib.pyplot on the Agg backend (no display needed); without matplotlib, the extra to install (exit 5)."""
+    require("plots")
     import matplotlib
 
     matplotlib.use("Agg")

@@ -4,12 +4,22 @@ after everything is built. ``wgcad parts`` wraps it: flags, the bar, printing.""
 
 from __future__ import annotations
 
+from dataclasses import dataclass
 from pathlib import Path
 
-from ..records import record
+from ..atomic import atomic_batch, check_writable_dir
+from ..errors import GeometryError
+from .dxf import write_dxf
 from .json_text import json_text
+from .parts import build_parts
+from .parts.kernel import require
+from .parts.title import title_layer
+from .step import step_bytes
+from .stl import write_stl
+from .svg import write_svg
+from .threemf import exploded, write_3mf
 
-__all__ = ["FORMATS", "PartFiles", "write_part_files"]
+__all__ = ["FORMATS", "PartFiles", "write_part_files", "part_report"]
 
 #: the file formats of the part set
 FORMATS = ("dxf", "svg", "stl", "3mf", "step")
@@ -17,15 +27,18 @@ FORMATS = ("dxf", "svg", "stl", "3mf", "step")
 
 def _jsonable(v):
     if isinstance(v, dict):
-        return {
-            k: _jsonable(x) for k, x in v.items() if k not in ("plug_outline", "neutral_line", "meshes", "build_meshes")
-        }
+        return {k: _jsonable(x) for k, x in v.items() if k not in ("plug_outline", "neutral_line")}
     if isinstance(v, float):
         return round(v, 6)
     return v
 
 
-@record
+def part_report(part) -> dict:
+    """The part's entry of ``<design>_parts.json``: its volume and the figures of its ``info``, rounded."""
+    return {"volume_mm3": round(part.volume_mm3, 4), **_jsonable(part.info)}
+
+
+@dataclass(slots=True)
 class PartFiles:
     """What :func:`write_part_files` did: the parts built, the report document (``<design>_parts.json``) and the
     files written (the report last)."""
@@ -40,16 +53,11 @@ def _write_drawings(part, drive, source, fmts, target) -> None:
     (what, from which design, units, scale, material)."""
     if not part.layers:
         return
-    from .parts.title import title_layer
 
     layers = [*part.layers, title_layer(part.name, drive.design, source, part.layers, drive.tol)]
     if "dxf" in fmts:
-        from .dxf import write_dxf
-
         write_dxf(target("dxf"), layers)
     if "svg" in fmts:
-        from .svg import write_svg
-
         write_svg(target("svg"), layers, f"{drive.design.drive.name}: {part.name}")
 
 
@@ -60,20 +68,19 @@ def write_part_files(
     them in ``formats`` into the folder ``out``, named after the design file ``source``.
 
     Every mesh and STEP solid is built before the folder is touched (a mesh that is not watertight is a
-    :class:`~wgcad.errors.GeometryError`, nothing written); ``progress(fraction, stage)`` follows the work."""
-    from ..atomic import atomic_batch, check_writable_dir
-    from ..errors import GeometryError
-    from .parts import build_parts
-
+    :class:`~wgcad.errors.GeometryError`, nothing written; STEP without build123d a
+    :class:`~wgcad.errors.DependencyError` naming the extra); ``progress(fraction, stage)`` follows the work."""
     tick = progress or (lambda f, stage: None)
     fmts = list(formats)
     out, stem = Path(out), Path(source).stem
     parts = build_parts(drive, sizes, style=dxf_style, tol=drive.tol, generator_angles_deg=list(generator_angles_deg))
-    # the steps weighted by what they cost (D1: a mesh ~0.2 s, a STEP solid ~0.8 s and its file ~0.9 s, a DXF/SVG/STL
-    # file ~0.05 s; OCP's import ~0.5 s on the first solid): the progress moves with the work
+    # the steps weighted by what they cost (a mesh or a DXF/SVG/STL file is one unit, a STEP solid and its text
+    # each several): the progress moves with the work
     step_parts = [p for p in parts if not p.name.startswith("assembly")] if "step" in fmts else []
+    if step_parts:
+        require()  # a missing CAD extra is said before anything is built
     n_mesh = len(parts) if {"stl", "3mf"} & set(fmts) else 0
-    total = 1.0 + 1.0 * n_mesh + 4.0 * len(step_parts) + 0.5 * len(parts) + 4.0 * len(step_parts)
+    total = 1.0 + 1.0 * n_mesh + 8.0 * len(step_parts) + 0.5 * len(parts)
     done = 1.0
     tick(done / total, "meshes" if n_mesh else "solids")
     # build everything before the output folder is touched
@@ -86,16 +93,13 @@ def write_part_files(
                 raise GeometryError(f"{p.name}: mesh is not watertight")
             meshes[p.name] = m
             done += 1.0
-    solids, texts = {}, {}
+    texts = {}
     for p in step_parts:
         tick(done / total, f"STEP solid: {p.name}")
-        # the B-rep written without a CAD kernel where the part's recipe applies (OpenCASCADE is then not loaded)
-        brep = p.brep()
-        if brep is not None:
-            texts[p.name] = brep.text(p.name)
-            done += 4.0  # its file is written with the others
-        else:
-            solids[p.name] = p.solid()
+        solid = p.solid()
+        done += 4.0
+        tick(done / total, f"STEP text: {p.name}")
+        texts[p.name] = step_bytes(solid)
         done += 4.0
     check_writable_dir(out)
     files = []
@@ -103,6 +107,8 @@ def write_part_files(
         "design": str(source),
         "chord_tol_mm": drive.tol,
         "dxf_style": dxf_style,
+        # [load] rated_torque_nm: the torque the bolts are sized for, not the datasheet's rated torque (docs/glossary.md)
+        "design_torque_nm": drive.design.load.rated_torque_nm,
         "formats": fmts,
         # only the sizes of parts this drive has (an external drive has no cup and no flange)
         "sizes_mm": _jsonable({k: sizes.values[k] for k in sizes.used if sizes.values.get(k) is not None}),
@@ -120,31 +126,23 @@ def write_part_files(
 
         for p in parts:
             tick(done / total, f"files: {p.name}")
-            report["parts"][p.name] = {"volume_mm3": round(p.volume_mm3, 4), **_jsonable(p.info)}
+            report["parts"][p.name] = part_report(p)
             _write_drawings(p, drive, source, fmts, lambda kind, p=p: target(f"{stem}_{p.name}.{kind}"))
             if "stl" in fmts:
-                from .stl import write_stl
-
                 write_stl(target(f"{stem}_{p.name}.stl"), meshes[p.name])
-            if "step" in fmts and p.name in texts:
-                Path(target(f"{stem}_{p.name}.step")).write_bytes(texts[p.name].encode("ascii"))
-            elif "step" in fmts and p.name in solids:
-                from .step import write_step
-
-                tick(done / total, f"STEP file: {p.name}")
-                write_step(target(f"{stem}_{p.name}.step"), {p.name: solids[p.name]})
-                done += 4.0
+            if p.name in texts:
+                Path(target(f"{stem}_{p.name}.step")).write_bytes(texts[p.name])
             done += 0.5
         if "3mf" in fmts:
-            from .threemf import exploded, write_3mf
-
-            # the parts side by side (issue 23: assembled at the origin they shared 1234 mm^3, which a slicer takes
+            # the parts side by side (once: assembled at the origin they shared 1234 mm^3, which a slicer takes
             # for intersecting objects); the deformed assemblies below stay assembled: that is what they show
             own = {p.name: meshes[p.name] for p in parts if not p.name.startswith("assembly")}
             write_3mf(target(f"{stem}_parts.3mf"), own, exploded(own))
             for p in parts:
                 if p.name.startswith("assembly"):
-                    write_3mf(target(f"{stem}_{p.name}.3mf"), {f"{p.name}_{k}": m for k, m in p.info["meshes"].items()})
+                    write_3mf(
+                        target(f"{stem}_{p.name}.3mf"), {f"{p.name}_{k}": m for k, m in p.member_meshes().items()}
+                    )
         # named by the design, as every other file here: two designs can share a folder
         report["files"] = [f.name for f in files] + [f"{stem}_parts.json"]
         Path(target(f"{stem}_parts.json")).write_text(json_text(report) + "\n")

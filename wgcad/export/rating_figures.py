@@ -1,4 +1,4 @@
-"""The pictures of ``wgcad rating``: wind-up with its three-segment fit, the flexspline's stress around the rim, the criteria against torque (docs/models.md 10)."""
+"""The pictures of ``wgcad rating``: wind-up with its three-segment fit, the flexspline's stress around the rim, the criteria against torque, and the friction panels (docs/models.md 10)."""
 
 from __future__ import annotations
 
@@ -6,9 +6,13 @@ import numpy as np
 
 from wgcad.units import ARCMIN_PER_RAD, UM_PER_MM
 
+from .friction_figures import efficiency_panel, input_panel, loop_panel
 from .mpl import png_bytes, pyplot
 
-__all__ = ["rating_png"]
+#: the legends' font, points (the pictures' smallest font is 8 pt, :data:`wgcad.export.figures.MIN_FONT_PT`)
+LEGEND_PT = 8.5
+
+__all__ = ["LEGEND_PT", "rating_figure", "rating_png"]
 
 
 def _wind_up(ax, ds):
@@ -34,7 +38,7 @@ def _wind_up(ax, ds):
     ax.set_xlabel("output torque, N m")
     ax.set_ylabel("wind-up, arcmin")
     ax.set_title("torsional wind-up (free play included)", fontsize=9)
-    ax.legend(fontsize=7, loc="lower right")
+    ax.legend(fontsize=LEGEND_PT, loc="lower right")
 
 
 def _stress(ax, ds):
@@ -65,7 +69,7 @@ def _stress(ax, ds):
     ax.set_xlabel("angle from the generator's major axis, deg")
     ax.set_ylabel("surface stress, MPa (tension +)")
     ax.set_title("flexspline stress around the rim (n: Goodman safety)", fontsize=9)
-    ax.legend(fontsize=6, ncol=2, loc="upper center", bbox_to_anchor=(0.5, -0.16))
+    ax.legend(fontsize=LEGEND_PT, ncol=2, loc="upper center", bbox_to_anchor=(0.5, -0.14))
 
 
 def _criteria(ax, ds):
@@ -97,18 +101,26 @@ def _criteria(ax, ds):
     um.set_ylabel("um (below 0: tips interfere / teeth skip)")
     h1, l1 = ax.get_legend_handles_labels()
     h2, l2 = um.get_legend_handles_labels()
-    ax.legend(h1 + h2, l1 + l2, fontsize=7, loc="center right")
+    ax.legend(h1 + h2, l1 + l2, fontsize=LEGEND_PT, loc="center right")
 
 
 def rating_png(ds) -> bytes:
-    """One PNG with the three panels of the datasheet."""
+    """One PNG with the six panels of the datasheet: wind-up, stress, criteria; efficiency, hysteresis, input torque."""
+    return png_bytes(rating_figure(ds), bbox_inches="tight", metadata={"Software": None})
+
+
+def rating_figure(ds):
+    """The datasheet's figure (:func:`rating_png`); its legends at :data:`LEGEND_PT` (they were 6 and 7 pt, unreadable
+    at the picture's width), laid out with them (constrained layout)."""
     plt = pyplot()
-    fig = plt.figure(figsize=(15.0, 4.8), dpi=110)
-    axs = fig.subplots(1, 3)
-    _wind_up(axs[0], ds)
-    _stress(axs[1], ds)
-    _criteria(axs[2], ds)
+    fig = plt.figure(figsize=(18.0, 13.0), dpi=110, layout="constrained")
+    axs = fig.subplots(2, 3, height_ratios=[1.25, 1.0])
+    _wind_up(axs[0, 0], ds)
+    _stress(axs[0, 1], ds)
+    _criteria(axs[0, 2], ds)
+    efficiency_panel(axs[1, 0], ds)
+    loop_panel(axs[1, 1], ds)
+    input_panel(axs[1, 2], ds)
     head = f"rated {ds.rated_torque_nm:.0f} N m, bound by" if ds.fit else "NO RATED TORQUE: fails at no load:"
-    fig.suptitle(f"{ds.design.drive.name}: datasheet ({head} {ds.binding})", fontsize=11)
-    fig.tight_layout()
-    return png_bytes(fig, bbox_inches="tight", metadata={"Software": None})
+    fig.suptitle(f"{ds.design.drive.name}: datasheet ({head} {ds.binding})", fontsize=12)
+    return fig

@@ -14,7 +14,7 @@ __all__ = ["clean_outline", "min_spacing", "FLOAT32_ULPS"]
 #: float32 units in the last place (ulp) of the outline's largest coordinate.
 #: STL stores float32: two vertices closer than ``sqrt(2)`` ulp can round to
 #: the same point, and a reader that merges them gets a mesh that is no
-#: longer watertight (issue 13: the d1_cycloidal rigid gear had two root
+#: longer watertight (once: the d1_cycloidal rigid gear had two root
 #: vertices 0.06 nm apart). 4 ulp leaves every neighbour at least two distinct
 #: float32 values apart in one coordinate. At 100 mm this is 4 x 7.6e-6 =
 #: 3.1e-5 mm, 1/30 of the 1 um chord tolerance: dropping such a vertex moves

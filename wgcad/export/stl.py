@@ -1,12 +1,7 @@
-"""Extruded ring solids and deterministic binary STL export, in mm.
+"""Extruded ring solids (manifold3d) and deterministic binary STL export, in mm.
 
-A ring between two outlines that each see the origin once (most gear rings)
-is triangulated by :mod:`wgcad.export.zipper` (a sort; 2-10 ms a gear); any
-other region by manifold3d (35-90 ms a gear, imported only then).
-
-The solids are :class:`wgcad.export.mesh.Mesh` (numpy arrays); trimesh is
-not imported (0.33 s of every ``generate``), the tests read the STL back
-with it.
+The solids are :class:`wgcad.export.mesh.Mesh` (numpy arrays, see there why
+not trimesh's); the tests read the STL back with trimesh.
 """
 
 from __future__ import annotations
@@ -21,7 +16,6 @@ from wgcad.atomic import atomic_write
 from wgcad.errors import GeometryError
 from wgcad.export.mesh import Mesh
 from wgcad.export.rings import clean_outline
-from wgcad.export.zipper import extruded_ring
 from wgcad.plane import signed_area
 
 __all__ = ["ring_solid", "stl_bytes", "write_stl"]
@@ -63,9 +57,8 @@ def ring_solid(outer, holes=(), height: float = 1.0) -> Mesh:
     Mesh
         Watertight, consistently outward-oriented mesh with float64
         vertices, ``(V, 3)`` vertices and ``(F, 3)`` faces. Its volume equals
-        the polygon area times ``height`` to ~1e-12 relative. A zipper
-        triangulation keeps the outlines' vertices exactly (adding some on
-        their edges); manifold3d snaps them to a 1e-8 mm grid.
+        the polygon area times ``height`` to ~1e-12 relative; manifold3d
+        snaps the vertices to a 1e-8 mm grid.
 
     Raises
     ------
@@ -102,39 +95,27 @@ def ring_solid(outer, holes=(), height: float = 1.0) -> Mesh:
     if not polygon.is_valid:
         raise GeometryError(f"ring cross-section is not a valid polygon ({shapely.is_valid_reason(polygon)})")
 
-    if len(ring_holes) == 1:
-        # a gear ring: a zipper triangulation where both outlines see the origin once (module note of
-        # wgcad.export.zipper), closed and outward by construction; manifold3d for the others
-        mesh = extruded_ring(outer, ring_holes[0][::-1], height)
-        if mesh is not None:
-            cap = mesh.faces[: len(mesh.faces) // 4]  # the bottom cap, reversed
-            t = mesh.vertices[cap]
-            u, v = t[:, 1] - t[:, 0], t[:, 2] - t[:, 0]
-            area = -0.5 * float(np.sum(u[:, 0] * v[:, 1] - u[:, 1] * v[:, 0]))
-            if abs(area - polygon.area) > AREA_REL_TOL * polygon.area:
-                raise GeometryError(
-                    f"ring triangulation area {area:.9g} mm^2 differs from the polygon's {polygon.area:.9g} mm^2"
-                )
-            return mesh
-    import manifold3d  # only where the zipper does not apply (0.01 s to import)
+    import manifold3d
 
     section = manifold3d.CrossSection([outer, *ring_holes], manifold3d.FillRule.Positive)
-    if abs(section.area() - polygon.area) > AREA_REL_TOL * polygon.area:
+    area = section.area()
+    if abs(area - polygon.area) > AREA_REL_TOL * polygon.area:
         raise GeometryError(
-            f"ring cross-section area {section.area():.9g} mm^2 differs from the polygon's "
+            f"ring cross-section area {area:.9g} mm^2 differs from the polygon's "
             f"{polygon.area:.9g} mm^2 (manifold3d dropped or merged a contour)"
         )
     solid = manifold3d.Manifold.extrude(section, height)
+    if solid.status() != manifold3d.Error.NoError:
+        raise GeometryError(f"extruded ring is not a manifold ({solid.status().name})")
+    if abs(solid.volume() - area * height) > AREA_REL_TOL * area * height:
+        raise GeometryError(
+            f"extruded ring volume {solid.volume():.9g} mm^3 is not its section's area times {height:g} mm"
+        )
     # to_mesh64: float64 vertices; to_mesh() rounds to float32 (~4 um at 80 mm).
     mesh64 = solid.to_mesh64()
-    vertices = np.asarray(mesh64.vert_properties, dtype=np.float64)[:, :3]
-    faces = np.asarray(mesh64.tri_verts, dtype=np.int64)
-    mesh = Mesh(vertices, faces)
-    if not mesh.is_watertight:
-        raise GeometryError("extruded ring is not watertight")
-    if not mesh.is_volume:
-        raise GeometryError("extruded ring is not a volume (inconsistent winding or self-intersecting)")
-    return mesh
+    return Mesh(
+        np.asarray(mesh64.vert_properties, dtype=np.float64)[:, :3], np.asarray(mesh64.tri_verts, dtype=np.int64)
+    )
 
 
 def stl_bytes(mesh: Mesh) -> bytes:

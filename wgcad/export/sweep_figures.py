@@ -6,6 +6,7 @@ import math
 
 import numpy as np
 
+from ..sweep.summary import MIN_FAILING_TO_RANK, failing_samples, few_failing_note, passes, weakest_figure
 from .mpl import png_bytes
 from .mpl import pyplot as _plt
 
@@ -22,6 +23,16 @@ def _limit_lines(ax, lim, vertical=True):
     for v, lab in ((lim[0], "min"), (lim[1], "max")):
         if v is not None:
             (ax.axvline if vertical else ax.axhline)(v, color="tab:red", ls="--", lw=1.2, label=f"limit {lab} {v:g}")
+
+
+def _constant(ax, value: float, n: int, lo: float, hi: float) -> None:
+    """A figure every sample has the same value of: one line at it and the words, not a histogram bar."""
+    if hi == lo:
+        lo, hi = value - 0.5 * max(abs(value), 1.0), value + 0.5 * max(abs(value), 1.0)
+    ax.set_xlim(lo - 0.05 * (hi - lo), hi + 0.05 * (hi - lo))
+    ax.vlines([value], 0, n, color="0.45", lw=3)
+    ax.text(0.5, 0.6, f"constant: all {n} samples {value:g}", transform=ax.transAxes, ha="center", fontsize=10)
+    ax.set_ylim(0, 1.15 * n)
 
 
 def histograms_png(spec, cols: dict, summ: dict) -> bytes:
@@ -45,13 +56,20 @@ def histograms_png(spec, cols: dict, summ: dict) -> bytes:
             if lim is not None:  # the limit in view even when every sample is far from it
                 lo = min(lo, *(x for x in lim if x is not None))
                 hi = max(hi, *(x for x in lim if x is not None))
-            if hi == lo:
-                hi, lo = hi + 0.5, lo - 0.5
-            ax.hist(
-                v, bins=min(60, max(10, int(np.sqrt(v.size)))), range=(lo, hi), color="0.45", edgecolor="white", lw=0.3
-            )
+            if float(v.min()) == float(v.max()):
+                # one value: a bar of made-up width would read as a spread; say it
+                _constant(ax, float(v[0]), v.size, lo, hi)
+            else:
+                ax.hist(
+                    v,
+                    bins=min(60, max(10, int(np.sqrt(v.size)))),
+                    range=(lo, hi),
+                    color="0.45",
+                    edgecolor="white",
+                    lw=0.3,
+                )
         _limit_lines(ax, lim)
-        title = f
+        title = f + (" (constant)" if v.size and float(v.min()) == float(v.max()) else "")
         if lim is not None and summ["limits"].get(f, {}).get("fraction") is not None:
             title += f": {100 * summ['limits'][f]['fraction']:.1f} % within"
         nan = int((~np.isfinite(cols[f][ok])).sum())
@@ -80,14 +98,13 @@ def sensitivity_png(spec, cols: dict, summ: dict) -> bytes:
     plt = _plt()
     rows = summ["sensitivity"]
     ok = cols["status"] == "ok"
-    by_fail = any(r["failure"] is not None for r in rows)
-    if by_fail:
-        fig_name = min(
-            summ["limits"],
-            key=lambda k: summ["limits"][k]["fraction"] if summ["limits"][k]["fraction"] is not None else 1.0,
-        )
-    else:
-        fig_name = next(iter(spec.limits or spec.record))
+    has_fail = any(r["failure"] is not None for r in rows)
+    # one or two failing samples decide a ranking by failing: below the least, ranked by the figure's own margin
+    few = has_fail and failing_samples(summ) < MIN_FAILING_TO_RANK
+    by_fail = has_fail and not few
+    fig_name = weakest_figure(summ) if summ["limits"] else next(iter(spec.record))
+    if few:
+        rows = sorted(rows, key=lambda r: -abs(r["figures"].get(fig_name) or 0.0))
 
     def score(r):
         v = r["failure"] if by_fail else r["figures"].get(fig_name)
@@ -109,7 +126,10 @@ def sensitivity_png(spec, cols: dict, summ: dict) -> bytes:
     ax[0].axvline(0, color="k", lw=0.6)
     ax[0].set_xlim(-1, 1)
     ax[0].set_xlabel("rank correlation (phases: circular, 0..1)")
-    ax[0].set_title("parameters driving failures" if by_fail else "parameters driving " + fig_name, fontsize=10)
+    title = "parameters driving failures" if by_fail else "parameters driving " + fig_name
+    if few:
+        title += "\nfailures not ranked: " + few_failing_note(summ)
+    ax[0].set_title(title, fontsize=10)
     ax[0].grid(alpha=0.3, axis="x")
     if rows:
         p = next(q for q in spec.parameters if q.name == rows[0]["parameter"])
@@ -121,8 +141,6 @@ def sensitivity_png(spec, cols: dict, summ: dict) -> bytes:
             shown = f" (every {k}th of {len(x)} samples)"
             x, y = x[::k], y[::k]
         if spec.limits:
-            from ..sweep.summary import passes
-
             good = passes(cols, spec.limits)[ok]
             if shown:
                 good = good[::k]
@@ -137,6 +155,21 @@ def sensitivity_png(spec, cols: dict, summ: dict) -> bytes:
         ax[1].grid(alpha=0.3)
         ax[1].legend(fontsize=8, loc="best")
     return _png(fig, plt)
+
+
+def _limit_contours(ax, m, lim) -> None:
+    """A map's limits as dashed red contours (interpolated between the grid points), each named in a legend."""
+    from matplotlib.lines import Line2D
+
+    if lim is None or np.isfinite(m).sum() < 4 or m.shape[0] < 2 or m.shape[1] < 2:
+        return
+    drawn = []
+    for v, lab in zip(lim, ("min", "max")):
+        if v is not None and np.nanmin(m) < v < np.nanmax(m):
+            ax.contour(m.T, levels=[v], colors="tab:red", linestyles="--")
+            drawn.append(Line2D([], [], color="tab:red", ls="--", label=f"limit {lab} {v:g} (interpolated)"))
+    if drawn:
+        ax.legend(handles=drawn, fontsize=7, loc="upper left", framealpha=0.9)
 
 
 def surface_png(spec, summ: dict) -> bytes:
@@ -225,11 +258,7 @@ def surface_png(spec, summ: dict) -> bytes:
             ax.set_xlabel(names[0])
             ax.set_ylabel(names[1])
             fig.colorbar(im, ax=ax, label=f)
-            lim = spec.limits.get(f)
-            if lim is not None and np.isfinite(m).sum() >= 4 and m.shape[0] > 1 and m.shape[1] > 1:
-                for v in lim:
-                    if v is not None and np.nanmin(m) < v < np.nanmax(m):
-                        ax.contour(m.T, levels=[v], colors="tab:red", linestyles="--")
+            _limit_contours(ax, m, spec.limits.get(f))
         extra = " (mean over the other grid parameters)" if len(shape) > 2 else ""
         ax.set_title(f + extra, fontsize=9)
     for k in range(len(items), nrow * ncol):
@@ -240,7 +269,7 @@ def surface_png(spec, summ: dict) -> bytes:
 
 def sweep_pngs(spec, cols: dict, summ: dict) -> dict:
     """``{file name: PNG bytes}``: histograms, and sensitivity (random parameters) and surfaces (grids) where they apply."""
-    # a grid of designs is a table and a surface, not a distribution: no histograms of it (issue 23)
+    # a grid of designs is a table and a surface, not a distribution: no histograms of it
     out = {} if summ.get("kind") == "grid" else {"sweep_histograms.png": histograms_png(spec, cols, summ)}
     if summ["sensitivity"]:
         out["sweep_sensitivity.png"] = sensitivity_png(spec, cols, summ)

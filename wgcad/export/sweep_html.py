@@ -6,6 +6,8 @@ import itertools
 
 import numpy as np
 
+from ..extras import require
+from ..sweep.summary import MIN_FAILING_TO_RANK, failing_samples, few_failing_note, weakest_figure
 from .html_page import figure, fmt, page, table
 
 __all__ = ["sweep_html"]
@@ -17,13 +19,25 @@ def _histograms(go, spec, cols, summ):
     figs = list(spec.record)
     ncol = min(3, len(figs))
     nrow = -(-len(figs) // ncol)
-    fig = make_subplots(rows=nrow, cols=ncol, subplot_titles=figs)
     ok = cols["status"] == "ok"
+    vals = {f: cols[f][ok][np.isfinite(cols[f][ok])] for f in figs}
+    const = {f: v.size > 0 and float(v.min()) == float(v.max()) for f, v in vals.items()}
+    titles = [f"{f} (constant: all {vals[f].size} samples {vals[f][0]:g})" if const[f] else f for f in figs]
+    fig = make_subplots(rows=nrow, cols=ncol, subplot_titles=titles)
     for k, f in enumerate(figs):
         r, c = k // ncol + 1, k % ncol + 1
-        v = cols[f][ok]
-        v = v[np.isfinite(v)]
-        fig.add_trace(go.Histogram(x=v, name=f, showlegend=False, marker_color="#666"), row=r, col=c)
+        v = vals[f]
+        if const[f]:
+            # one value: a histogram bar of made-up width would read as a spread
+            fig.add_trace(
+                go.Scatter(
+                    x=[v[0], v[0]], y=[0, v.size], mode="lines", line=dict(color="#666", width=3), showlegend=False
+                ),
+                row=r,
+                col=c,
+            )
+        else:
+            fig.add_trace(go.Histogram(x=v, name=f, showlegend=False, marker_color="#666"), row=r, col=c)
         for x in spec.limits.get(f) or ():
             if x is not None:
                 fig.add_vline(x=x, line_dash="dash", line_color="red", row=r, col=c)
@@ -84,26 +98,33 @@ def _surface(go, spec, summ):
 
 
 def _sensitivity(go, summ):
-    rows = summ["sensitivity"][:12]
+    rows = summ["sensitivity"]
+    few = any(r["failure"] is not None for r in rows) and failing_samples(summ) < MIN_FAILING_TO_RANK
+    title = "random parameters ranked by their rank correlation with failing (or with the first figure)"
+    if few:
+        # one or two failing samples decide a ranking by failing: ranked by the weakest figure's margin instead
+        f = weakest_figure(summ)
+        rows = sorted(rows, key=lambda r: -abs(r["figures"].get(f) or 0.0))
+        vals = [r["figures"].get(f) or 0.0 for r in rows[:12]]
+        title = f"random parameters ranked by their rank correlation with {f}<br><sub>failures not ranked: {few_failing_note(summ)}</sub>"
+    else:
+        vals = [
+            r["failure"]
+            if r["failure"] is not None
+            else max((v or 0.0 for v in r["figures"].values()), key=abs, default=0.0)
+            for r in rows[:12]
+        ]
+    rows = rows[:12]
     names = [r["parameter"] for r in rows]
-    vals = [
-        r["failure"]
-        if r["failure"] is not None
-        else max((v or 0.0 for v in r["figures"].values()), key=abs, default=0.0)
-        for r in rows
-    ]
     fig = go.Figure(go.Bar(x=vals[::-1], y=names[::-1], orientation="h"))
-    fig.update_layout(
-        height=120 + 30 * len(rows),
-        template="plotly_white",
-        title="random parameters ranked by their rank correlation with failing (or with the first figure)",
-    )
+    fig.update_layout(height=140 + 30 * len(rows), template="plotly_white", title=title)
     fig.update_xaxes(title="rank correlation")
     return fig
 
 
 def sweep_html(spec, cols: dict, summ: dict) -> str:
     """The page of a sweep's summary (:func:`wgcad.sweep.summary.summarize`) and its columns."""
+    require("html")  # plotly draws the page
     import plotly.graph_objects as go
 
     c = summ["counts"]

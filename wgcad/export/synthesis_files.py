@@ -5,14 +5,16 @@ from __future__ import annotations
 
 import csv
 import io
+import textwrap
 from pathlib import Path
 
+from ..atomic import atomic_batch
 from ..report.synthesis import design_text, search_json, trial_rows
 from ..synthesis.requirements import OBJECTIVES
 from .json_text import json_text
 from .mpl import png_bytes, pyplot
 
-__all__ = ["write_search_files", "search_figure"]
+__all__ = ["write_search_files", "search_figure", "search_plot"]
 
 
 def _label(o: str) -> str:
@@ -29,8 +31,14 @@ def _csv(header, rows) -> str:
 
 
 def search_figure(res) -> bytes:
+    """The search's picture as PNG bytes (:func:`search_plot`)."""
+    return png_bytes(search_plot(res), tight_layout=True, dpi=110)
+
+
+def search_plot(res):
     """One objective: its value for every candidate in trial order (feasible ones filled, the best marked). Two: the
-    objectives against each other, the Pareto front joined."""
+    objectives against each other, the Pareto front joined. The title names the search on its own line(s), the
+    counts on the next: it fits the picture's width."""
     plt = pyplot()
     req = res.req
     objs = req.objectives
@@ -65,16 +73,18 @@ def search_figure(res) -> bytes:
         ax.set_xlabel(_label(a))
         ax.set_ylabel(_label(b))
     n_infeasible = len(res.evaluations) - len(feas)
-    ax.set_title(f"{req.name}: {len(feas)} feasible of {len(res.evaluations)} candidates ({n_infeasible} stopped)")
+    name = "\n".join(textwrap.wrap(req.name, 70)) or "design search"
+    counts = (
+        f"{len(feas)} feasible of {len(res.evaluations)} candidates ({n_infeasible} stopped at a check they failed)"
+    )
+    ax.set_title(f"{name}\n{counts}", fontsize=10)
     ax.grid(True, alpha=0.3)
     ax.legend(loc="best", fontsize=8)
-    return png_bytes(fig, tight_layout=True, dpi=110)
+    return fig
 
 
 def write_search_files(res, out_dir, stem: str, base_text: str, plot: bool = True) -> list[Path]:
     """Write the search's files into ``out_dir`` (atomically, together); returns their paths."""
-    from ..atomic import atomic_batch
-
     out_dir = Path(out_dir)
     files = {}
     if res.best is not None:

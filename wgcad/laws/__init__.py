@@ -12,11 +12,11 @@ import numpy as np  # noqa: F401  (the doctest of make_law uses it)
 
 from wgcad.errors import DesignError
 
-from .base import Law, RimState, _check_two_waves, _real
+from .base import Law, RimState, check_two_waves, real_number
 from .coning import coned_w0
 from .ellipse import Ellipse
 from .harmonic import Harmonic
-from .sectioned import _FF_BETA_HI, _FF_BETA_LO, Disc, ExternalRing, FourForce  # noqa: F401  (the bands are tested)
+from .sectioned import FF_BETA_HI, FF_BETA_LO, Disc, ExternalRing, FourForce  # noqa: F401  (the bands are tested)
 
 __all__ = [
     "RimState",
@@ -79,12 +79,12 @@ def make_law(name, *, w0, r_m, n_waves=2, beta=None, offset=0.0) -> Law:
     if not isinstance(name, str) or name not in LAWS:
         choices = ", ".join(sorted(LAWS))
         raise DesignError("generator.law", f"must be one of {choices}, got {name!r}")
-    off = _real(offset, "generator.offset", "offset")
+    off = real_number(offset, "generator.offset", "offset")
     if off < 0.0:
         raise DesignError("generator.offset", f"must be >= 0 mm, got {off:g}")
     if name == "harmonic":
         return Harmonic(w0, r_m, n_waves)
-    _check_two_waves(n_waves, name)
+    check_two_waves(n_waves, name)
     if name == "ellipse":
         return Ellipse(w0, r_m, off)
     return LAWS[name](w0, r_m, beta)

@@ -5,18 +5,16 @@ from __future__ import annotations
 import abc
 import math
 import numbers
-from dataclasses import replace
+from dataclasses import dataclass, replace
 from typing import ClassVar
 
 import numpy as np
 
 from wgcad.errors import DesignError
 
-from ..records import record
-
 __all__ = ["RimState", "Law"]
 
-_HALF_PI = 0.5 * math.pi
+HALF_PI = 0.5 * math.pi
 
 #: W0 must stay below r_m / W0_MAX_DIVISOR. The ring model of docs/models.md 3.1 is
 #: linear in W0/r_m (its first-order kinematics err by O(W0/r_m)); a rim bent
@@ -34,7 +32,7 @@ _W0_MAX_DIVISOR = 4.0
 # state container
 
 
-@record(frozen=True)
+@dataclass(frozen=True, slots=True)
 class RimState:
     """Neutral-line state at angles phi; every field an array with phi's shape (read-only).
 
@@ -81,7 +79,7 @@ class RimState:
 # validation helpers
 
 
-def _real(value, field_name: str, what: str) -> float:
+def real_number(value, field_name: str, what: str) -> float:
     if isinstance(value, bool) or not isinstance(value, numbers.Real):
         raise DesignError(field_name, f"{what} must be a real number, got {value!r}")
     value = float(value)
@@ -90,11 +88,11 @@ def _real(value, field_name: str, what: str) -> float:
     return value
 
 
-def _check_w0_rm(w0, r_m) -> tuple[float, float]:
-    r_m = _real(r_m, "flexspline.rim_thickness", "neutral-line radius r_m")
+def check_w0_rm(w0, r_m) -> tuple[float, float]:
+    r_m = real_number(r_m, "flexspline.rim_thickness", "neutral-line radius r_m")
     if r_m <= 0.0:
         raise DesignError("flexspline.rim_thickness", f"neutral-line radius r_m must be > 0 mm, got {r_m:g}")
-    w0 = _real(w0, "generator.w0_coef", "W0 = w0_coef * module")
+    w0 = real_number(w0, "generator.w0_coef", "W0 = w0_coef * module")
     if w0 <= 0.0:
         raise DesignError("generator.w0_coef", f"W0 = w0_coef * module must be > 0 mm, got {w0:g} mm")
     if w0 >= r_m / _W0_MAX_DIVISOR:
@@ -107,16 +105,16 @@ def _check_w0_rm(w0, r_m) -> tuple[float, float]:
     return w0, r_m
 
 
-def _check_beta(beta, law: str) -> float:
+def check_beta(beta, law: str) -> float:
     if beta is None:
         raise DesignError("generator.beta_deg", f"is required by law '{law}'")
-    beta = _real(beta, "generator.beta_deg", "beta")
-    if not 0.0 < beta < _HALF_PI:
+    beta = real_number(beta, "generator.beta_deg", "beta")
+    if not 0.0 < beta < HALF_PI:
         raise DesignError("generator.beta_deg", f"must be in (0, 90) degrees, got {math.degrees(beta):.10g}")
     return beta
 
 
-def _check_two_waves(n_waves, law: str) -> None:
+def check_two_waves(n_waves, law: str) -> None:
     if isinstance(n_waves, bool) or not isinstance(n_waves, numbers.Integral) or n_waves != 2:
         raise DesignError(
             "drive.waves",
@@ -186,7 +184,7 @@ class Law(abc.ABC):
         """State for a float64 array `phi` (any shape)."""
 
 
-class _TwoWaveLaw(Law):
+class TwoWaveLaw(Law):
     """A two-wave law computed on [0, pi/2] and extended by symmetry.
 
     w is even about phi = 0 and about pi/2 (docs/models.md 3.3: "extend by

@@ -6,7 +6,7 @@ import numpy as np
 
 from wgcad.errors import DesignError
 
-from .base import _real
+from .base import real_number
 
 __all__ = ["coned_w0"]
 
@@ -44,11 +44,11 @@ def coned_w0(w0, z, *, length, z_h):
     >>> coned_w0(1.0, [0.0, 10.0, 160.0], length=160.0, z_h=10.0).tolist()
     [1.0666666666666667, 1.0, 0.0]
     """
-    w0 = _real(w0, "generator.w0_coef", "W0 = w0_coef * module")
+    w0 = real_number(w0, "generator.w0_coef", "W0 = w0_coef * module")
     if w0 <= 0.0:
         raise DesignError("generator.w0_coef", f"W0 = w0_coef * module must be > 0 mm, got {w0:g} mm")
-    length = _real(length, "generator.cone_length", "length")
-    z_h = _real(z_h, "generator.generator_z", "z_h")
+    length = real_number(length, "generator.cone_length", "length")
+    z_h = real_number(z_h, "generator.generator_z", "z_h")
     if length <= 0.0:
         raise DesignError("generator.cone_length", f"must be > 0 mm, got {length:g}")
     if z_h < 0.0:

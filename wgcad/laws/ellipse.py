@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 import math
-from dataclasses import field
+from dataclasses import dataclass, field
 from typing import ClassVar
 
 import numpy as np
@@ -11,8 +11,7 @@ import numpy as np
 from wgcad.constants import NEWTON_TOL
 from wgcad.errors import DesignError, GeometryError
 
-from ..records import record
-from .base import _HALF_PI, _check_w0_rm, _real, _TwoWaveLaw
+from .base import HALF_PI, TwoWaveLaw, check_w0_rm, real_number
 
 __all__ = ["Ellipse", "ellipe", "ellipeinc"]
 
@@ -51,8 +50,8 @@ def _solve_ellipe(target: float) -> float:
             hi = mid
 
 
-@record(frozen=True)
-class Ellipse(_TwoWaveLaw):
+@dataclass(frozen=True, slots=True)
+class Ellipse(TwoWaveLaw):
     """Exact elliptical cam: the neutral line is an ellipse offset outward by `offset`.
 
     Not a ring-theory law: the geometry is exact. The base ellipse (semi-axes
@@ -102,8 +101,8 @@ class Ellipse(_TwoWaveLaw):
     _E: float = field(init=False, repr=False, compare=False)
 
     def __post_init__(self):
-        w0, r_m = _check_w0_rm(self.w0, self.r_m)
-        d = _real(self.offset, "generator.offset", "offset")
+        w0, r_m = check_w0_rm(self.w0, self.r_m)
+        d = real_number(self.offset, "generator.offset", "offset")
         if d < 0.0:
             raise DesignError("generator.offset", f"must be >= 0 mm, got {d:g}")
         a = r_m + w0 - d
@@ -136,7 +135,7 @@ class Ellipse(_TwoWaveLaw):
         g = np.sqrt((a * st) ** 2 + (b * ct) ** 2)  # |dE/dt| of the base ellipse
         # int_0^t g = a [E(m) - E(pi/2 - t | m)]  (substitute t -> pi/2 - u);
         # the offset adds d times the turning angle of the normal.
-        s = a * (self._E - ellipeinc(_HALF_PI - t, self._m)) + d * np.arctan2(a * st, b * ct)
+        s = a * (self._E - ellipeinc(HALF_PI - t, self._m)) + d * np.arctan2(a * st, b * ct)
         return s, g + d * a * b / g**2
 
     def _quarter(self, psi):
@@ -146,11 +145,11 @@ class Ellipse(_TwoWaveLaw):
         for _ in range(60):
             s, ds = self._arc(t)
             step = (s - target) / ds
-            t = np.clip(t - step, 0.0, _HALF_PI)
+            t = np.clip(t - step, 0.0, HALF_PI)
             if not np.any(np.abs(step) > NEWTON_TOL):
                 # quadratic convergence: one more step reaches rounding level
                 s, ds = self._arc(t)
-                t = np.clip(t - (s - target) / ds, 0.0, _HALF_PI)
+                t = np.clip(t - (s - target) / ds, 0.0, HALF_PI)
                 break
         else:  # pragma: no cover - Newton on a smooth monotone arc length from t = psi
             raise GeometryError("Ellipse: inverse arc length did not converge")

@@ -3,14 +3,14 @@
 from __future__ import annotations
 
 import numbers
+from dataclasses import dataclass
 from typing import ClassVar
 
 import numpy as np
 
 from wgcad.errors import DesignError
 
-from ..records import record
-from .base import Law, RimState, _check_w0_rm
+from .base import Law, RimState, check_w0_rm
 
 __all__ = ["Harmonic"]
 
@@ -18,7 +18,7 @@ __all__ = ["Harmonic"]
 # harmonic law
 
 
-@record(frozen=True)
+@dataclass(frozen=True, slots=True)
 class Harmonic(Law):
     """Harmonic law w = W0 cos(n_w phi), any number of waves (docs/models.md 3.2).
 
@@ -46,7 +46,7 @@ class Harmonic(Law):
     tooth_offset: float = 0.0
 
     def __post_init__(self):
-        w0, r_m = _check_w0_rm(self.w0, self.r_m)
+        w0, r_m = check_w0_rm(self.w0, self.r_m)
         n = self.n_waves
         if isinstance(n, bool) or not isinstance(n, numbers.Integral) or n < 1:
             raise DesignError("drive.waves", f"must be an integer >= 1, got {n!r}")

@@ -3,15 +3,14 @@
 from __future__ import annotations
 
 import math
-from dataclasses import field
+from dataclasses import dataclass, field
 from typing import ClassVar
 
 import numpy as np
 
 from wgcad.errors import DesignError
 
-from ..records import record
-from .base import _HALF_PI, RimState, _check_beta, _check_w0_rm, _TwoWaveLaw
+from .base import HALF_PI, RimState, TwoWaveLaw, check_beta, check_w0_rm
 
 __all__ = ["Disc", "ExternalRing", "FourForce"]
 
@@ -22,7 +21,7 @@ def _ff_band_edge() -> float:
     """Root of tan(b) = pi/2 - b by Newton from the right (convex, increasing: monotone)."""
     b = 0.8
     for _ in range(50):
-        step = (math.tan(b) + b - _HALF_PI) / (1.0 / math.cos(b) ** 2 + 1.0)
+        step = (math.tan(b) + b - HALF_PI) / (1.0 / math.cos(b) ** 2 + 1.0)
         b -= step
         if abs(step) <= 4e-16:
             break
@@ -37,16 +36,16 @@ def _ff_band_edge() -> float:
 #: smallest). Outside the band w decreases monotonically from 0 to pi/2
 #: (outward forces below BETA_LO, inward forces above BETA_HI; the two ranges
 #: are mirror images by a quarter turn) and |D| >= 0.258.
-_FF_BETA_LO = _ff_band_edge()
-_FF_BETA_HI = _HALF_PI - _FF_BETA_LO
+FF_BETA_LO = _ff_band_edge()
+FF_BETA_HI = HALF_PI - FF_BETA_LO
 
 
 # --------------------------------------------------------------------------
 # disc law and its mirror image, the external ring
 
 
-@record(frozen=True)
-class _SectionedLaw(_TwoWaveLaw):
+@dataclass(frozen=True, slots=True)
+class _SectionedLaw(TwoWaveLaw):
     """A two-wave law given by two closed-form sections meeting at ``beta`` (docs/models.md 3.3, 3.4).
 
     Subclasses provide ``_sections(phi) -> (section I fields, section II fields)``.
@@ -77,7 +76,7 @@ class _SectionedLaw(_TwoWaveLaw):
         return tuple(np.where(on_section_one, a, b) for a, b in zip(sec1, sec2))
 
 
-@record(frozen=True)
+@dataclass(frozen=True, slots=True)
 class _DiscShape(_SectionedLaw):
     """Disc-generator shape of docs/models.md 3.3 times a sign (+1 disc, -1 external ring)."""
 
@@ -94,8 +93,8 @@ class _DiscShape(_SectionedLaw):
     _K: float = field(init=False, repr=False, compare=False)
 
     def __post_init__(self):
-        w0, r_m = _check_w0_rm(self.w0, self.r_m)
-        beta = _check_beta(self.beta, self.name)
+        w0, r_m = check_w0_rm(self.w0, self.r_m)
+        beta = check_beta(self.beta, self.name)
         if beta > _DISC_BETA_MAX:
             raise DesignError(
                 "generator.beta_deg",
@@ -105,7 +104,7 @@ class _DiscShape(_SectionedLaw):
             )
         sb, cb = math.sin(beta), math.cos(beta)
         # docs/models.md 3.3
-        A = _HALF_PI - sb * cb - beta
+        A = HALF_PI - sb * cb - beta
         B = -2.0 * sb + (4.0 * beta / math.pi) * sb + (4.0 / math.pi) * cb
         C = (4.0 / math.pi) * (beta * sb + cb)  # = B + 2 sin(beta)
         for k, val in (("w0", w0), ("r_m", r_m), ("beta", beta), ("_A", A), ("_B", B), ("_C", C), ("_K", w0 / (A - B))):
@@ -127,7 +126,7 @@ class _DiscShape(_SectionedLaw):
             np.full_like(phi, K * B / r),
         )
         # docs/models.md 3.3, section II (free span)
-        q = _HALF_PI - phi
+        q = HALF_PI - phi
         w2 = K * ((1.0 + sb2) * s + q * c - 2.0 * math.sin(self.beta) - B)
         sec2 = (
             w2,
@@ -141,7 +140,7 @@ class _DiscShape(_SectionedLaw):
         return sec1, sec2
 
 
-@record(frozen=True)
+@dataclass(frozen=True, slots=True)
 class Disc(_DiscShape):
     """Disc generator with wrap half-angle beta (docs/models.md 3.3), two waves.
 
@@ -165,7 +164,7 @@ class Disc(_DiscShape):
     _sign: ClassVar[float] = 1.0
 
 
-@record(frozen=True)
+@dataclass(frozen=True, slots=True)
 class ExternalRing(_DiscShape):
     """External-deformation ring generator (docs/models.md 3.5): the disc law with the opposite sign.
 
@@ -197,7 +196,7 @@ class ExternalRing(_DiscShape):
 # four-force law
 
 
-@record(frozen=True)
+@dataclass(frozen=True, slots=True)
 class FourForce(_SectionedLaw):
     """Cam shaped as a ring deformed by four radial forces at +-beta, pi+-beta (docs/models.md 3.4).
 
@@ -228,13 +227,13 @@ class FourForce(_SectionedLaw):
     _D: float = field(init=False, repr=False, compare=False)
 
     def __post_init__(self):
-        w0, r_m = _check_w0_rm(self.w0, self.r_m)
-        beta = _check_beta(self.beta, self.name)
-        if _FF_BETA_LO < beta < _FF_BETA_HI:
+        w0, r_m = check_w0_rm(self.w0, self.r_m)
+        beta = check_beta(self.beta, self.name)
+        if FF_BETA_LO < beta < FF_BETA_HI:
             raise DesignError(
                 "generator.beta_deg",
-                f"must not lie in ({math.degrees(_FF_BETA_LO):.2f}, "
-                f"{math.degrees(_FF_BETA_HI):.2f}) "
+                f"must not lie in ({math.degrees(FF_BETA_LO):.2f}, "
+                f"{math.degrees(FF_BETA_HI):.2f}) "
                 f"degrees for law 'four_force', got {math.degrees(beta):.10g}: there the ring's "
                 "largest radius leaves the major axis or its smallest the minor axis, and "
                 "D = 8/cos(beta) - pi(pi - 2 beta + 2 tan(beta)) vanishes at 43.89 deg "

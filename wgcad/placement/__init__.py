@@ -19,6 +19,7 @@ from .law import (
     tooth_pose,
     transform,
 )
+from .sliding import material_shift, sliding_rate
 
 __all__ = [
     "tooth_angles",
@@ -31,4 +32,6 @@ __all__ = [
     "place_flex_teeth",
     "deformed_curve",
     "join_teeth",
+    "sliding_rate",
+    "material_shift",
 ]

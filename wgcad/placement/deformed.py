@@ -10,11 +10,14 @@ and everything is drawn in the flexspline's frame.
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import numpy as np
+import shapely
 
 from ..errors import GeometryError
 from ..kinematics import gear_ratios
-from ..records import record
+from .imperfect import cam_offset, flex_poses, rigid_poses
 from .law import deformed_curve, join_teeth, place_flex_teeth, tooth_angles, transform
 
 __all__ = ["DeformedState", "deformed_state", "generator_frame", "rim_samples", "rotate"]
@@ -46,7 +49,7 @@ def rim_samples(drive, tol: float) -> np.ndarray:
     return np.linspace(0.0, 2 * np.pi, n, endpoint=False)
 
 
-@record(frozen=True)
+@dataclass(frozen=True, slots=True)
 class DeformedState:
     """Outlines (mm, the fixed member's frame) of the drive at one generator angle."""
 
@@ -71,15 +74,11 @@ def deformed_state(drive, phi_abs: float, tol: float, z: float | None = None, im
     neutral line move with the cam offset (docs/models.md 6.2). Raises
     GeometryError when the placed teeth's outline crosses itself.
     """
-    import shapely
-
     phi_h, frame = generator_frame(drive, phi_abs)
     d = drive.design.drive
     _, phi = tooth_angles(d.z_flex, d.z_rigid, phi_h)
     law = drive.law_at(z) if (z is not None and drive.coned) else drive.law
     if imp is not None:
-        from .imperfect import cam_offset, flex_poses, rigid_poses
-
         teeth = transform(drive.flex.period, *flex_poses(drive, imp, phi_h, z=z))
         rigid_outline = join_teeth(transform(drive.rigid.period, *rigid_poses(drive, imp)))
         offset = cam_offset(imp, phi_h, phi_h / gear_ratios(d.z_flex, d.z_rigid)["u_hg"])

@@ -27,12 +27,14 @@ docs/models.md 6.1, 6.2):
 
 from __future__ import annotations
 
+import dataclasses
+from dataclasses import dataclass
+from fractions import Fraction
 from math import pi, radians
 
 import numpy as np
 
 from ..kinematics import gear_ratios
-from ..records import record
 from .law import pose_from_displacements, tooth_pose
 
 __all__ = [
@@ -71,7 +73,7 @@ SPEC_KEYS = {
 }
 
 
-@record(frozen=True)
+@dataclass(frozen=True, slots=True)
 class Imperfections:
     """The errors of :class:`~wgcad.design.imperfections.ImperfectionsSpec` in mm and rad.
 
@@ -117,9 +119,7 @@ class Imperfections:
         )
 
     def replace(self, **changes) -> Imperfections:
-        from dataclasses import replace
-
-        return replace(self, **changes)
+        return dataclasses.replace(self, **changes)
 
     @property
     def gear_errors(self) -> bool:
@@ -185,8 +185,6 @@ def full_cycle_turns(z_flex: int, z_rigid: int) -> int:
     back together after ``p`` generator turns when ``|u_hg| = p / q``
     (``q`` flexspline turns): 100 for 200/202 teeth.
     """
-    from fractions import Fraction
-
     return Fraction(abs(z_flex), abs(z_rigid - z_flex)).numerator
 
 

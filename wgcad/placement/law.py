@@ -257,7 +257,7 @@ def _trim_back_step(part: np.ndarray, nxt: np.ndarray) -> np.ndarray:
 
     Where neighbouring root lands overlap without crossing (they run
     sub-micrometre apart), joining them straight stepped back along the
-    root by 0.06-1 um (issue 13): the outline now leaves ``part`` at its
+    root by 0.06-1 um: the outline now leaves ``part`` at its
     last vertex that ``nxt`` lies ahead of.
     """
     while len(part) > 2:

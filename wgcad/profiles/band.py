@@ -1,4 +1,4 @@
-"""Polylines of exact pieces that deviate from the curve by at most a tolerance on either side (a symmetric chord band, issue 8).
+"""Polylines of exact pieces that deviate from the curve by at most a tolerance on either side (a symmetric chord band).
 
 Chords through points of a curve all lie on its concave side: a tooth drawn
 that way is systematically thinner (convex flanks) or its space narrower.
@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from .. import constants
 from .sampling import chord_deviation, sample_curve
 
 __all__ = ["band_points", "band_outline", "band_deviation", "gear_band_outline"]
@@ -109,8 +110,6 @@ def gear_band_outline(gear, tol: float | None = None, offset: float = 0.0) -> np
     docs/models.md 13.4; consecutive pitches are then joined by a chord of
     ``2 offset sin(pi/z)`` at the middle of the root).
     """
-    from .. import constants
-
     tol = gear.tol if tol is None else float(tol)
     one = band_outline(gear.pieces, tol)
     step = np.hypot(*np.diff(np.vstack([one, one[:1]]), axis=0).T)

@@ -53,7 +53,7 @@ def roll_angle_at_radius(r: float, rho: float, radius, epi: bool):
         cosphi = -cosphi
     # at the pitch circle and at the reach (r +- 2 rho) the roll angle is 0 or pi
     # exactly; arccos of a cosine rounded 1e-16 off +-1 is 1.5e-8 rad off, which
-    # left a 0.06 nm sliver of root arc on every tooth (issue 13). Within 1e-13
+    # left a 0.06 nm sliver of root arc on every tooth. Within 1e-13
     # of +-1 the curve is tangent to that circle: snapping moves it < 1e-13 mm.
     cosphi = np.where(np.abs(cosphi) > 1.0 - 1e-13, np.sign(cosphi), cosphi)
     return np.arccos(np.clip(cosphi, -1.0, 1.0))

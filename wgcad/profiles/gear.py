@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from dataclasses import field
+from dataclasses import dataclass, field
 from math import pi
 
 import numpy as np
@@ -10,10 +10,10 @@ import numpy as np
 from .. import constants
 from ..errors import DesignError
 from ..plane import signed_area
-from ..records import record
 from . import cycloid as cy
 from . import involute as iv
 from . import pieces as pc
+from .double_arc import double_arc_half_period, half_angle_at
 from .sampling import arc_points, polar, sample_curve
 
 __all__ = ["ToothSpec", "Gear", "make_gear", "rotate", "largest_fillet_coef"]
@@ -26,7 +26,7 @@ def rotate(points: np.ndarray, angle: float) -> np.ndarray:
     return np.stack([c * pts[..., 0] - s * pts[..., 1], s * pts[..., 0] + c * pts[..., 1]], axis=-1)
 
 
-@record(frozen=True)
+@dataclass(frozen=True, slots=True)
 class ToothSpec:
     """Everything that fixes one gear's teeth. Lengths mm, angles rad.
 
@@ -58,7 +58,7 @@ class ToothSpec:
     tangent_length: float = 0.0
 
 
-@record(frozen=True)
+@dataclass(frozen=True, slots=True)
 class Gear:
     """One gear's teeth, undeformed. Read-only arrays; lengths mm, angles rad.
 
@@ -101,6 +101,11 @@ class Gear:
     #: ``resample(tol)``: this gear's exact pieces sampled at another chord tolerance, where the pieces are not the
     #: spec's alone (a conjugate gear's flank comes from an envelope: :meth:`sampled_at`)
     resample: object = field(default=None, repr=False, compare=False)
+    #: a conjugate gear's envelope residual, mm: the largest distance of the flank's exact points from the envelope
+    #: condition (Newton's), and the largest gap between the chords joining them and the envelope (None: not an
+    #: envelope)
+    envelope_residual_mm: float | None = None
+    envelope_sagitta_mm: float | None = None
 
     def sampled_at(self, tol: float) -> Gear | None:
         """The same exact curves sampled at chord tolerance ``tol``; None where the spec rebuilds them
@@ -126,8 +131,6 @@ class Gear:
         sp = self.spec
         radius = np.asarray(radius, dtype=float)
         if sp.form == "double_arc":  # exact: where the circle of each radius meets the flank's arcs and tangent
-            from .double_arc import half_angle_at
-
             return half_angle_at(self, radius)
         if sp.form == "conjugate":  # the flank as built (docs/models.md 13): its polyline, angle against radius
             hp = self.half_period
@@ -138,7 +141,7 @@ class Gear:
             o = np.argsort(rf)
             return np.interp(radius, rf[o], af[o])
         if sp.form == "involute":
-            psi_b = _involute_base_angle(sp)
+            psi_b = involute_base_angle(sp)
             h = iv.half_angle_at(psi_b, self.r_base, radius)
             return (pi / sp.z - h) if sp.internal else h
         return cy.exact_half_angle(self.r, self.rho, radius, sp.internal) - _thin_angle(sp, self.r)
@@ -164,7 +167,7 @@ class Gear:
         depth = 0.5 * self.spec.module if depth is None else depth
         # beyond the period's own deepest point too: a conjugate space can run deeper than the nominal root circle
         # (a rigid gear's envelope with its shift left out: 2.3 mm on D1 conjugate), and a closure inside the period
-        # made the polygon cross itself (an internal error in the audit, issue 21's fuzz)
+        # made the polygon cross itself (an internal error in the audit, found by the fuzzer)
         r = np.hypot(self.period[:, 0], self.period[:, 1])
         r_body = max(self.r_f, float(r.max())) + depth if self.spec.internal else min(self.r_f, float(r.min())) - depth
         a = pi / self.spec.z
@@ -185,7 +188,7 @@ def _thin_angle(sp: ToothSpec, r: float) -> float:
     return sp.thinning / (2.0 * r)
 
 
-def _involute_base_angle(sp: ToothSpec) -> float:
+def involute_base_angle(sp: ToothSpec) -> float:
     """``s/(2r) + inv(alpha)`` (external tooth) or ``e/(2r) + inv(alpha)`` (internal space), docs/models.md 2.1."""
     r = sp.module * sp.z / 2.0
     nominal = sp.module * (pi / 2.0 + 2.0 * sp.shift * np.tan(sp.alpha))
@@ -251,8 +254,6 @@ def make_gear(sp: ToothSpec, tol: float = constants.CHORD_TOL) -> Gear:
     if sp.form == "involute":
         half, tip_thk, r_base, hp = _involute_half_period(sp, r, r_a, r_f, tol, tip_field)
     elif sp.form == "double_arc":
-        from .double_arc import double_arc_half_period
-
         half, tip_thk, r_base, hp, flank_radii = double_arc_half_period(sp, r, r_a, r_f, tol, tip_field)
     else:
         half, tip_thk, r_base, hp = _cycloid_half_period(sp, r, r_a, r_f, tol, tip_field, fix)
@@ -283,7 +284,7 @@ def _fillet_fits(sp: ToothSpec, rho: float) -> bool:
     r = sp.module * sp.z / 2.0
     r_a, r_f = tooth_radii(sp)
     r_b = r * np.cos(sp.alpha)
-    base = _involute_base_angle(sp)
+    base = involute_base_angle(sp)
     gamma2 = pi / sp.z
     margin = constants.ROOT_SPACE_MIN_COEF * sp.module / r_f
     if sp.internal:
@@ -363,7 +364,7 @@ def _involute_half_period(sp: ToothSpec, r, r_a, r_f, tol, tip_field):
     gamma2 = pi / sp.z
     r_b = r * np.cos(sp.alpha)
     rho = sp.fillet_coef * sp.module
-    base = _involute_base_angle(sp)
+    base = involute_base_angle(sp)
     if not sp.internal:
         # undercut by a standard rack: x < h_a* - z sin^2(alpha)/2
         x_min = sp.addendum_coef - sp.z * np.sin(sp.alpha) ** 2 / 2.0

@@ -46,14 +46,16 @@ numerical routines check the closed forms in the tests.
 
 from __future__ import annotations
 
+from dataclasses import replace
 from math import pi
 
 import numpy as np
 
+from ..errors import DesignError
 from ..roots import brentq
 from . import cycloid as cy
 from . import involute as iv
-from .gear import Gear, _involute_base_angle, rotate
+from .gear import Gear, involute_base_angle, make_gear, rotate
 
 __all__ = [
     "flank_zone",
@@ -103,7 +105,7 @@ def flank_zone(gear: Gear) -> tuple[float, float]:
         return (gear.r_a, float(on.max())) if sp.internal else (float(on.min()), gear.r_a)
     r_b = gear.r_base
     rho = sp.fillet_coef * sp.module
-    base = _involute_base_angle(sp)
+    base = involute_base_angle(sp)
     if sp.internal:
         end = gear.r_f
         if rho > 0:
@@ -131,7 +133,7 @@ def thickness_at(gear: Gear, radius: float) -> dict:
 def span_closed_form(gear: Gear, k: int) -> tuple[float, float]:
     """``(W_k, contact radius)`` of external involute teeth, mm (module docstring)."""
     sp = gear.spec
-    psi_b = _involute_base_angle(sp)
+    psi_b = involute_base_angle(sp)
     w = gear.r_base * (2.0 * psi_b + (k - 1) * 2.0 * pi / sp.z)
     return float(w), float(np.hypot(gear.r_base, 0.5 * w))
 
@@ -217,7 +219,7 @@ def _inv_inverse(y: float) -> float:
 def pins_closed_form(gear: Gear, d_pin: float) -> dict:
     """Pin centre radius and the dimension over (external) / between (internal) two pins, involute teeth, mm."""
     sp = gear.spec
-    base = _involute_base_angle(sp)
+    base = involute_base_angle(sp)
     r_b = gear.r_base
     y = base - d_pin / (2 * r_b) if sp.internal else base + d_pin / (2 * r_b) - pi / sp.z
     a_m = _inv_inverse(y)
@@ -230,7 +232,7 @@ def pin_diameter_for_contact(gear: Gear, radius: float) -> float:
     """Pin diameter that touches involute flanks at ``radius`` (module docstring), mm."""
     sp = gear.spec
     r_b = gear.r_base
-    base = _involute_base_angle(sp)
+    base = involute_base_angle(sp)
     t = np.sqrt((radius / r_b) ** 2 - 1.0)
     if sp.internal:
         return float(2 * r_b * (t - np.tan(t - base)))
@@ -409,10 +411,6 @@ def workshop_figures(gear: Gear, measure_diameter: float | None = None, pin_diam
 
 def _thicker(gear: Gear, ds: float) -> Gear:
     """The same gear with every tooth ``ds`` thicker at the pitch circle (``thinning`` less by ``ds``)."""
-    from dataclasses import replace
-
-    from .gear import make_gear
-
     return make_gear(replace(gear.spec, thinning=gear.spec.thinning - ds), gear.tol)
 
 
@@ -457,7 +455,6 @@ def _per_thickness_form(gear: Gear, figure, at: float) -> float | None:
     5 % the figure is not smooth in the thickness (a pin whose seat jumps
     between features of a cycloidal space) and no sensitivity is given.
     """
-    from ..errors import DesignError
 
     def side(ds):
         try:

@@ -30,11 +30,11 @@ turned by ``rot`` about the origin: ``point = R(rot) diag(1, flip) base(t)``.
 
 from __future__ import annotations
 
+from dataclasses import dataclass
 from functools import lru_cache
 
 import numpy as np
-
-from ..records import record
+from numpy.polynomial.legendre import leggauss
 
 __all__ = [
     "Piece",
@@ -58,20 +58,15 @@ def _rot(v: np.ndarray, a: float) -> np.ndarray:
 
 @lru_cache(maxsize=8)
 def gauss_legendre(n: int) -> tuple[np.ndarray, np.ndarray]:
-    """Gauss-Legendre nodes and weights on [-1, 1], ``(n,)`` each, read-only (Golub-Welsch: the eigenvalues of the
-    Legendre recurrence's Jacobi matrix and the squared first components of its eigenvectors; ``numpy.polynomial``
-    would load nine modules for this, ~2 ms of every start)."""
-    k = np.arange(1, n)
-    off = k / np.sqrt(4.0 * k * k - 1.0)
-    x, v = np.linalg.eigh(np.diag(off, -1) + np.diag(off, 1))
-    w = 2.0 * v[0] ** 2
-    x, w = 0.5 * (x - x[::-1]), 0.5 * (w + w[::-1])  # the rule is symmetric: its mirror halves the rounding
+    """Gauss-Legendre nodes and weights on [-1, 1], ``(n,)`` each, read-only: numpy's ``leggauss``, kept per ``n``
+    (every arc length asks for the same few rules)."""
+    x, w = leggauss(n)
     x.setflags(write=False)
     w.setflags(write=False)
     return x, w
 
 
-@record(frozen=True)
+@dataclass(frozen=True, slots=True)
 class Piece:
     """One analytic piece of an outline (module docstring). Lengths mm, angles rad.
 

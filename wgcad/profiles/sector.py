@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from dataclasses import field, replace
+from dataclasses import dataclass, field, replace
 from math import pi
 
 import numpy as np
@@ -10,7 +10,6 @@ import numpy as np
 from .. import constants
 from ..design.sectors import SectorsSpec, sector_pitch_z
 from ..errors import DesignError
-from ..records import record
 from . import pieces as pc
 from .band import band_points
 from .gear import Gear, ToothSpec, make_gear, rotate
@@ -24,7 +23,7 @@ __all__ = ["SectorLayout", "sector_layout", "full_height", "TeethByHeight", "sec
 MIN_HEIGHT_COEF = 0.05
 
 
-@record(frozen=True)
+@dataclass(frozen=True, slots=True)
 class SectorLayout:
     """Where every tooth of a sectored rigid gear sits. Angles rad, counter-clockwise.
 
@@ -112,7 +111,7 @@ def full_height(rigid: Gear) -> float:
     return float(abs(rigid.r_f - rigid.r_a))
 
 
-@record
+@dataclass(slots=True)
 class TeethByHeight:
     """Rigid teeth of one tooth form at any height, built by :func:`make_gear` with a tip-radius override and cached.
 

@@ -12,7 +12,7 @@ limit *above* that torque, which the datasheet says.
 from __future__ import annotations
 
 import time
-from dataclasses import field
+from dataclasses import dataclass, field
 from math import pi
 
 import numpy as np
@@ -23,9 +23,9 @@ from wgcad.elastic.mesh import entry_gaps
 from wgcad.errors import DesignError, ModelError
 from wgcad.units import UM_PER_MM
 
-from ..records import record
 from .fatigue import strength
 from .flexspline import state_stresses, stress_setup
+from .friction import friction_rows
 from .life import bearing_life
 from .notch import root_concentration
 from .ratcheting import engagement_depth
@@ -35,8 +35,8 @@ __all__ = ["Level", "Limit", "Datasheet", "rate_drive", "ratcheting_torque", "CR
 
 #: the criteria, in the order the datasheet lists them: name -> what it asks
 CRITERIA = {
-    "fatigue": "Goodman safety of the flexspline (tooth roots, cup wall, diaphragm if [parts] gives it) at least "
-    "[load] fatigue_safety_min",
+    "fatigue": "Goodman safety of the flexspline (tooth roots, cup wall, the diaphragm the part set exports) at "
+    "least [load] fatigue_safety_min",
     "yield": "peak von Mises stress of the flexspline below the yield strength",
     "bearing_life": "wave-generator bearing L10 at [load] input_speed_rpm at least [load] required_life_h",
     "entry_gap": "no tip interference at tooth entry (the loaded entry gap stays open)",
@@ -47,7 +47,7 @@ _BISECTIONS = 5
 _DOUBLINGS = 9
 
 
-@record(frozen=True)
+@dataclass(frozen=True, slots=True)
 class Level:
     """The figures of one solved torque (internal units: N m, mm, MPa, rad, h)."""
 
@@ -73,18 +73,20 @@ class Level:
         }
 
 
-@record(frozen=True)
+@dataclass(frozen=True, slots=True)
 class Limit:
     """The torque at which one criterion stops being met (N m); ``above``: met up to ``torque_nm``, where the model
-    stopped, so the limit lies beyond; ``note`` why the model stopped or how the figure was found."""
+    stopped, so the limit lies beyond; ``note`` why the model stopped or how the figure was found; ``bracket``
+    the bisection's last ``(met, failed)`` torques (N m) the interpolated limit lies between, or None."""
 
     criterion: str
     torque_nm: float
     above: bool
     note: str = ""
+    bracket: tuple | None = None
 
 
-@record
+@dataclass(slots=True)
 class Datasheet:
     """The whole rating of one drive (internal units; ``report.rating`` words it)."""
 
@@ -100,12 +102,17 @@ class Datasheet:
     fit: object
     curve: list
     lost_motion: float
-    backlash: float
+    #: twice the wind-up fit's intercept (``fit.theta0``, both ways), rad: not the audit's backlash
+    windup_offset: float
     natural_frequency_hz: float | None
     ratcheting: dict
     notes: list
     timing: dict
     speed_rpm: float = 0.0
+    #: the friction rows (:class:`~wgcad.rating.friction.FrictionRows`; None without a rated torque)
+    friction: object = None
+    #: the part set's warnings on parts the datasheet rates (a diaphragm below the fatigue criterion)
+    warnings: tuple = ()
 
 
 def _level(sheet_ctx, T: float, warm, offset) -> Level:
@@ -131,7 +138,7 @@ def _level(sheet_ctx, T: float, warm, offset) -> Level:
     )
 
 
-@record(frozen=True)
+@dataclass(frozen=True, slots=True)
 class _Stop:
     """Why a search stopped: ``static`` when a ball reached the bearing's static limit (the model refuses the
     load), else no convergence or the search's own end."""
@@ -189,7 +196,8 @@ def _limits(ctx, levels, ld, offset, ratchet_T, static: Limit) -> dict:
         if lv_hi is not None:
             m_hi = float(lv_hi.margins(ld)[name])
         T = lo.torque_nm if m_hi is None or m_hi >= m_lo else lo.torque_nm + (hi - lo.torque_nm) * m_lo / (m_lo - m_hi)
-        out[name] = Limit(name, float(T), False, f"bisected to {hi - lo.torque_nm:.3g} N m, then interpolated")
+        note = f"bisected to {hi - lo.torque_nm:.3g} N m, then interpolated"
+        out[name] = Limit(name, float(T), False, note, (float(lo.torque_nm), float(hi)))
     r_T, r_above, r_note = ratchet_T
     out["ratcheting"] = Limit("ratcheting", r_T / ld.ratcheting_safety_min, r_above, r_note)
     out["bearing_static"] = static
@@ -261,32 +269,35 @@ def _ratcheting(ctx, levels, static: Limit, offset, stop_T: float = float("inf")
 
 
 def _wind_up(ctx, first: Level, rated_T: float, offset, progress):
-    """The wind-up at 14 torques up to the rated one, its three-segment fit, the lost motion and the rated level."""
+    """The wind-up at 14 torques up to the rated one, its three-segment fit, the lost motion, the rated level and the
+    curve's states (the unloaded one first)."""
     model = ctx[0]
     curve_T = [0.01 * rated_T, 0.04 * rated_T] + [rated_T * j / 12.0 for j in range(1, 13)]
-    curve, warm = [], first.state
+    curve, warm, states = [], first.state, [first.state]
     if progress:
         progress(0.8, "wind-up curve")
     for j, T in enumerate(sorted(curve_T)):
         st = solve_load(model, T, offset[0], offset[1], warm=warm)
         warm = st
+        states.append(st)
         curve.append((T, st.wind_up))
         if progress:
             progress(0.8 + 0.2 * (j + 1) / len(curve_T), "wind-up curve")
     rated = _level(ctx, rated_T, warm, offset)
     Ts = np.array([c[0] for c in curve])
     th = np.array([c[1] for c in curve])
-    return fit_three_segments(Ts, th), curve, 2.0 * float(np.interp(0.04 * rated_T, Ts, th)), rated
+    return fit_three_segments(Ts, th), curve, 2.0 * float(np.interp(0.04 * rated_T, Ts, th)), rated, states
 
 
 def _context(drive, sections: int, speed: float):
     """What every level of one drive needs: model, stress set-up, bearing, its pitch diameter, speed, ratio; and the
     root's concentration."""
     d = drive.design
-    model = build_model(drive, sections)
     st_ = strength(d.material, d.flexspline.rim_thickness, d.drive.face_width)
     kt = root_concentration(drive.flex, drive.flex_rim_radius)
     setup = stress_setup(drive, kt.kt, st_)
+    p = setup.plate  # the part set's diaphragm: the model tilts on the plate the datasheet rates
+    model = build_model(drive, sections, plate=None if p is None else (p.r_i, p.r_o, p.h))
     br = d.bearing
     dm = 2.0 * (drive.flex_rim_radius - br.outer_ring_thickness_mm) - br.ball_diameter_mm
     return (model, setup, br, dm, speed, float(model.scene.ratios["u_hg"])), kt
@@ -337,23 +348,22 @@ def rate_drive(drive, speed_rpm: float | None = None, sections: int = 3, progres
     t_limits = time.perf_counter() - t0 - t_setup
 
     # the wind-up curve up to the rated torque, for the catalogue's stiffness segments and the lost motion
+    friction = None
     if rated_T > 0:
-        fit, curve, lm, rated = _wind_up(ctx, first, rated_T, offset, progress)
+        fit, curve, lm, rated, curve_states = _wind_up(ctx, first, rated_T, offset, progress)
+        # efficiency over the catalogue's range: every state solved up to the rated torque
+        below = [lv.state for lv in levels if lv.torque_nm < rated_T]
+        friction = friction_rows(model, ctx[3], speed, below + curve_states[1:], curve_states, rated.state)
     else:  # a criterion fails at no load: no torque to rate, nothing to fit
         fit, curve, lm, rated = None, [], None, first
     notes = []
     if setup.t_cup is None:
         notes.append("the cup wall: the design has no cup ([generator] cone_length)")
-    if setup.plate is not None and not setup.plate_given:
-        notes.append(
-            "the diaphragm in the rating: [parts] does not give its thickness and bolt circle, so its stresses are "
-            "shown for the derived sizes (wgcad parts) and left out of the rated torque"
-        )
     if setup.plate is not None:
         p = setup.plate
         notes.append(
             f"the diaphragm's joints: taken rigid (clamped at the bolt circle, r = {p.r_i:.1f} mm; joined to the wall "
-            f"at {p.r_o:.1f} mm, [parts] sizes), no stress concentration at either; the bolt holes; the wall's own "
+            f"at {p.r_o:.1f} mm, {p.h:g} mm thick: the part set's sizes, wgcad parts), no stress concentration at either; the bolt holes; the wall's own "
             "bending near the joint; the output flange"
         )
     else:
@@ -378,10 +388,12 @@ def rate_drive(drive, speed_rpm: float | None = None, sections: int = 3, progres
         fit=fit,
         curve=curve,
         lost_motion=lm,
-        backlash=None if fit is None else 2.0 * fit.theta0,
+        windup_offset=None if fit is None else 2.0 * fit.theta0,
         natural_frequency_hz=fn,
         ratcheting=ratchet,
         notes=notes,
         timing={"setup_s": t_setup, "limits_s": t_limits, "total_s": time.perf_counter() - t0},
         speed_rpm=speed,
+        friction=friction,
+        warnings=tuple(setup.plate_warnings),
     )

@@ -16,9 +16,9 @@ and translation of the rim) are left to the supports.
 
 from __future__ import annotations
 
-import numpy as np
+from dataclasses import dataclass
 
-from ..records import record
+import numpy as np
 
 __all__ = ["Diaphragm", "edge_stress_factors", "diaphragm_stress"]
 
@@ -26,7 +26,7 @@ _SAMPLES = 720
 _HARMONICS = 40
 
 
-@record(frozen=True)
+@dataclass(frozen=True, slots=True)
 class Diaphragm:
     """The plate: clamped at ``r_i``, joined to the wall at ``r_o`` (mm), ``h`` thick; the wall pivots ``arm`` (mm,
     ``l - z_h``) from the generator's centre section."""
@@ -70,3 +70,38 @@ def diaphragm_stress(centre_law, plate: Diaphragm, E: float, nu: float) -> tuple
         ki, ko = edge_stress_factors(n, plate, E, nu)
         hub[n], wall[n] = ki * c[n], ko * c[n]
     return psi, np.fft.irfft(hub, _SAMPLES), np.fft.irfft(wall, _SAMPLES)
+
+
+#: the sizing's steps, mm: the workshop's thickness step (as [parts]' derived sizes) and the step the bolt circle's
+#: outer limit moves inward by
+H_STEP = 0.05
+R_STEP = 0.5
+
+
+@dataclass(frozen=True, slots=True)
+class PlateCheck:
+    """Goodman's safety of a plate at its hub and at the wall (the smaller binds), under ``torque_nm``."""
+
+    plate: Diaphragm
+    hub: float
+    wall: float
+    torque_nm: float
+
+    @property
+    def safety(self) -> float:
+        return min(self.hub, self.wall)
+
+
+def plate_safety(centre_law, plate: Diaphragm, E: float, nu: float, torque_nm: float, st) -> PlateCheck:
+    """Goodman's safety (:func:`wgcad.rating.fatigue.goodman_safety`) of ``plate`` at its hub and wall: the bending
+    cycle of :func:`diaphragm_stress` for ``centre_law`` with the torque's shear ``T / (2 pi r^2 h)``, the figures the
+    datasheet's diaphragm rows give."""
+    from .fatigue import goodman_safety
+    from .rim import RimCycle, torque_shear
+
+    psi, hub, wall = diaphragm_stress(centre_law, plate, E, nu)
+    out = []
+    for r, sigma in ((plate.r_i, hub), (plate.r_o, wall)):
+        c = RimCycle(psi, sigma)
+        out.append(goodman_safety(c.amplitude, c.mean, torque_shear(torque_nm, r, plate.h), st))
+    return PlateCheck(plate, out[0], out[1], float(torque_nm))

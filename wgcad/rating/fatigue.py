@@ -12,12 +12,11 @@ sensitivity of Neuber ``q = 1 / (1 + sqrt(a/r))`` with Kuhn and Hardraht's
 
 from __future__ import annotations
 
+from dataclasses import dataclass
 from math import sqrt
 from statistics import NormalDist
 
 from wgcad.errors import DesignError
-
-from ..records import record
 
 __all__ = ["Strength", "strength", "goodman_safety", "SURFACE_FACTORS"]
 
@@ -32,7 +31,7 @@ _KPSI_PER_MPA = 1.0 / 6.894757
 _MM_PER_IN = 25.4
 
 
-@record(frozen=True)
+@dataclass(frozen=True, slots=True)
 class Strength:
     """The flexspline material's strengths and fatigue factors (MPa, dimensionless)."""
 

@@ -2,13 +2,17 @@
 
 from __future__ import annotations
 
+from dataclasses import dataclass
 from math import pi, sqrt
+from pathlib import Path
 
 import numpy as np
 
-from ..records import record
+from wgcad.design.parts import PartsSpec, load_parts
+
 from .diaphragm import Diaphragm, diaphragm_stress
 from .fatigue import Strength, goodman_safety
+from .plate_sizing import plate_of, sized_parts
 from .rim import RimCycle, curvature_change, torque_shear
 
 __all__ = ["StressSetup", "stress_setup", "SectionStress", "state_stresses", "tooth_stress_factor"]
@@ -25,7 +29,7 @@ def tooth_stress_factor(s_f: float, h_f: float, rho_f: float) -> float:
     return (1.2 + 0.13 * L) * qs ** (1.0 / (1.21 + 2.3 / L))
 
 
-@record(frozen=True)
+@dataclass(frozen=True, slots=True)
 class StressSetup:
     """What the stresses of every state share: geometry, the root's concentration, the material (mm, MPa)."""
 
@@ -47,25 +51,27 @@ class StressSetup:
     plate: Diaphragm | None = None
     w0_centre: float = 0.0
     plate_z: float = 0.0
-    #: whether the design's [parts] gives the diaphragm (thickness and bolt circle): only then it enters the rating
+    #: whether the design's [parts] gives the diaphragm (thickness and bolt circle); rated either way (the part set
+    #: sizes what [parts] leaves out, :mod:`wgcad.rating.plate_sizing`)
     plate_given: bool = False
+    #: the part set's warnings on the diaphragm (sizes given, or the best admissible, below the criterion)
+    plate_warnings: tuple = ()
 
 
-def _plate(drive, t_cup: float) -> Diaphragm:
-    """The diaphragm from ``[parts]`` (its defaults when the design file has none): clamped at the cup's bolt circle
-    (an assumption the datasheet states: inside it the output flange holds the plate), joined to the wall's
-    mid-surface."""
-    from pathlib import Path
-
-    from wgcad.design.parts import PartsSpec, load_parts, part_sizes
-
+def part_set_sizes(drive):
+    """The part set's sizes of ``drive`` (:func:`wgcad.rating.plate_sizing.sized_parts`) from its file's ``[parts]``
+    (the derived defaults when the design is in memory)."""
     d = drive.design
-    spec = load_parts(d.source) if Path(d.source).is_file() else PartsSpec()
-    v = part_sizes(spec, drive)
-    r_o = drive.flex_rim_radius + 0.5 * t_cup
-    r_i = 0.5 * v.cup_bolt_circle_diameter
+    spec = load_parts(d.source) if d.source and Path(d.source).is_file() else PartsSpec()
+    return spec, sized_parts(spec, drive)
+
+
+def _plate(drive) -> tuple[Diaphragm, bool, tuple]:
+    """The diaphragm the part set exports (clamped at the cup's bolt circle, an assumption the datasheet states),
+    whether the design file gives its sizes, and the part set's warnings on it."""
+    spec, sizes = part_set_sizes(drive)
     given = spec.diaphragm_thickness is not None and spec.cup_bolt_circle_diameter is not None
-    return Diaphragm(r_i, r_o, v.diaphragm_thickness, d.generator.cone_length - d.generator.generator_z), given
+    return plate_of(drive, sizes.values), given, tuple(n for n in sizes.notes if n.startswith("diaphragm"))
 
 
 def stress_setup(drive, kt: float, strength: Strength) -> StressSetup:
@@ -76,7 +82,7 @@ def stress_setup(drive, kt: float, strength: Strength) -> StressSetup:
     q = strength.notch_sensitivity(rho_f)
     t_cup = (d.material.cup_wall_thickness_mm or h1) if drive.coned else None
     outside = flex.r_f > drive.flex_rim_radius
-    plate = _plate(drive, t_cup) if t_cup is not None and outside else None
+    plate = _plate(drive) if t_cup is not None and outside else None
     return StressSetup(
         E=d.material.youngs_modulus_gpa * 1e3,
         h1=h1,
@@ -96,10 +102,11 @@ def stress_setup(drive, kt: float, strength: Strength) -> StressSetup:
         w0_centre=drive.law.w0,
         plate_z=d.generator.cone_length if drive.coned else 0.0,
         plate_given=bool(plate and plate[1]),
+        plate_warnings=plate[2] if plate else (),
     )
 
 
-@record(frozen=True)
+@dataclass(frozen=True, slots=True)
 class SectionStress(RimCycle):
     """One place of the flexspline over a turn of the generator (MPa): its cycle (:class:`RimCycle`: ``psi``,
     ``sigma``, the surface stress at each angle from the major axis), and
@@ -116,6 +123,9 @@ class SectionStress(RimCycle):
     shear: float = 0.0
     safety: float = float("inf")
     yield_safety: float = float("inf")
+    #: the largest nominal bending stress over the turn, MPa: the plain rim's ``E y dkappa`` without the root's
+    #: concentration or the teeth's own bending (for a cosine law ``1.5 E h w0 / r^2``, docs/models.md 10.1)
+    nominal: float = 0.0
 
 
 def _tooth_bending(setup: StressSetup, state, section: int, law) -> tuple[np.ndarray, np.ndarray]:
@@ -134,12 +144,13 @@ def _tooth_bending(setup: StressSetup, state, section: int, law) -> tuple[np.nda
     return phi, y_s * 6.0 * F * h_f / (b * setup.s_f**2)
 
 
-def _section(where, z, psi, sigma, shear, st: Strength, rated: bool = True) -> SectionStress:
+def _section(where, z, psi, sigma, shear, st: Strength, rated: bool = True, nominal=None) -> SectionStress:
     cyc = RimCycle(psi, sigma)
     vm = sqrt(float(np.abs(sigma).max()) ** 2 + 3.0 * shear**2)
     safety = goodman_safety(cyc.amplitude, cyc.mean, shear, st)
+    nom = float(np.abs(sigma if nominal is None else nominal).max())
     return SectionStress(
-        psi, sigma, where=where, z=z, rated=rated, shear=shear, safety=safety, yield_safety=st.yield_ / vm
+        psi, sigma, where=where, z=z, rated=rated, shear=shear, safety=safety, yield_safety=st.yield_ / vm, nominal=nom
     )
 
 
@@ -152,10 +163,11 @@ def state_stresses(setup: StressSetup, state) -> list[SectionStress]:
     for i, law in enumerate(state.laws):
         phi_t, s_t = _tooth_bending(setup, state, i, law)
         psi = np.concatenate([base, np.mod(phi_t, 2 * pi)])
-        sigma = setup.kf * setup.E * setup.y_root * curvature_change(law, psi)
+        plain = setup.E * setup.y_root * curvature_change(law, psi)
+        sigma = setup.kf * plain
         sigma[len(base) :] += s_t
         order = np.argsort(psi, kind="stable")
-        out.append(_section("root", float(m.zs[i]), psi[order], sigma[order], tau_rim, setup.strength))
+        out.append(_section("root", float(m.zs[i]), psi[order], sigma[order], tau_rim, setup.strength, True, plain))
     if setup.t_cup is not None:
         law = state.laws[-1]  # the section at the rim's inner end, where the cup wall starts
         y = np.sign(setup.y_root) * 0.5 * setup.t_cup
@@ -167,5 +179,5 @@ def state_stresses(setup: StressSetup, state) -> list[SectionStress]:
         psi, hub, wall = diaphragm_stress(state.laws[0].with_w0(setup.w0_centre), p, setup.E, setup.nu)
         for where, r, sigma in (("diaphragm_hub", p.r_i, hub), ("diaphragm_wall", p.r_o, wall)):
             tau = torque_shear(state.torque_nm, r, p.h)
-            out.append(_section(where, setup.plate_z, psi, sigma, tau, setup.strength, setup.plate_given))
+            out.append(_section(where, setup.plate_z, psi, sigma, tau, setup.strength))
     return out

@@ -19,9 +19,9 @@ speed relative to the flexspline.
 
 from __future__ import annotations
 
-import numpy as np
+from dataclasses import dataclass
 
-from ..records import record
+import numpy as np
 
 __all__ = ["B_M", "raceway_ratings", "BearingLife", "bearing_life"]
 
@@ -39,7 +39,7 @@ def raceway_ratings(ball_d: float, pitch_d: float, balls: int, f_inner: float, f
     return float(qi), float(qo)
 
 
-@record(frozen=True)
+@dataclass(frozen=True, slots=True)
 class BearingLife:
     """L10 of the flexible bearing.
 

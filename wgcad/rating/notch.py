@@ -15,16 +15,16 @@ of scikit-fem on a mesh of its own.
 
 from __future__ import annotations
 
+from dataclasses import dataclass
 from math import pi
 
 import numpy as np
-
-from ..records import record
+import shapely
 
 __all__ = ["RootConcentration", "root_concentration"]
 
 
-@record(frozen=True)
+@dataclass(frozen=True, slots=True)
 class RootConcentration:
     """The tooth root's stress concentration in rim bending.
 
@@ -126,7 +126,6 @@ def _thin_polyline(pts: np.ndarray, size, corners) -> np.ndarray:
 def _interior(poly, size, h_max: float, boundary: np.ndarray) -> np.ndarray:
     """Graded interior points: offset rows of spacing ``h_max / 2^L`` kept where the local size asks for that level,
     away from the boundary."""
-    import shapely
     from scipy.spatial import cKDTree
 
     x0, y0, x1, y1 = poly.bounds
@@ -154,7 +153,6 @@ def _interior(poly, size, h_max: float, boundary: np.ndarray) -> np.ndarray:
 
 
 def _mesh(pts_outline: np.ndarray, size, h_max: float, corners):
-    import shapely
     from scipy.spatial import Delaunay
 
     boundary = _resample(_thin_polyline(pts_outline, size, corners), size)

@@ -10,11 +10,10 @@ form). A surface at distance ``y`` from the neutral line then carries
 
 from __future__ import annotations
 
+from dataclasses import dataclass
 from math import pi
 
 import numpy as np
-
-from ..records import record
 
 __all__ = ["curvature_change", "RimCycle", "rim_cycle", "torque_shear", "sampled_curvature_change"]
 
@@ -57,7 +56,7 @@ def sampled_curvature_change(law, phi, exact: bool = False) -> np.ndarray:
     return kappa - 1.0 / law.r_m
 
 
-@record(frozen=True)
+@dataclass(frozen=True, slots=True)
 class RimCycle:
     """The bending stress one fibre of a section sees over a turn of the wave generator, MPa.
 

@@ -2,21 +2,21 @@
 
 from __future__ import annotations
 
+from dataclasses import dataclass
 from math import pi, sqrt
 
 import numpy as np
 
-from ..records import record
-
 __all__ = ["ThreeSegmentFit", "fit_three_segments", "natural_frequency_hz"]
 
 
-@record(frozen=True)
+@dataclass(frozen=True, slots=True)
 class ThreeSegmentFit:
     """``theta(T) = theta0 + T/K1`` up to ``T1``, then slope ``1/K2`` to ``T2``, then ``1/K3`` (N m, rad, N m/rad).
 
-    ``theta0`` is the free play taken up before the teeth carry load (the
-    drive's backlash on one side); ``max_error``/``rms_error`` the fit's
+    ``theta0`` is the fit's intercept, the wind-up offset on one side (the
+    free play the fit extrapolates to zero torque, not the audit's no-load
+    backlash, docs/glossary.md); ``max_error``/``rms_error`` the fit's
     residuals over the points, rad.
     """
 

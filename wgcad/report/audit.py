@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..arrays import median
+from wgcad import constants
 
 __all__ = ["audit_json", "audit_summary", "worst_json", "entry_json", "backlash_at_json", "settings_json"]
 
@@ -118,8 +118,6 @@ def backlash_at_json(f) -> dict:
 
 def _accuracy(run) -> dict:
     """The settings entries that say how exact an audit's figures are."""
-    from wgcad import constants
-
     return {
         "chord_tol_um": round(1e3 * run.chord_tol, 6),
         "refined": run.refined,
@@ -140,7 +138,7 @@ def settings_json(run) -> dict:
     out = {
         "engine": "2d",
         "angles": int(A),
-        "angle_step_deg": round(float(np.rad2deg(median(np.diff(run.angles)))), 6) if A > 1 else None,
+        "angle_step_deg": round(float(np.rad2deg(np.median(np.diff(run.angles)))), 6) if A > 1 else None,
         "sections_z_mm": [None if z is None else round(z, 6) for z in run.sections],
         "sections_note": (
             "identical sections (no coning): one computed"
@@ -274,12 +272,12 @@ def _entry_lines(res: dict, e: dict) -> list[str]:
         else "at the tip crossing (no pinch: the smallest gap of the entry)"
     )
     lines = [
-        f"  entry gap Delta [S1]: {res['entry_gap_um']:.3f} um by the {e['edge']} edge ({e['location']}) at tooth angle "
+        f"  entry gap Delta [S1]: {res['entry_gap_um']:.3f} um by the {e['edge']} flank ({e['location']}) at tooth angle "
         f"{e['tooth_angle_deg']:+.3f} deg{sec}, {what}" + ("  TIP-TO-TIP RISK" if e["tip_to_tip_risk"] else "")
     ]
     csec = "" if e["crossing_section_z_mm"] is None else f", section z = {e['crossing_section_z_mm']:g} mm"
     lines.append(
-        f"  tip crossing: {e['crossing_um']:.3f} um by the {e['crossing_edge']} edge at tooth angle "
+        f"  tip crossing: {e['crossing_um']:.3f} um by the {e['crossing_edge']} flank at tooth angle "
         f"{e['crossing_tooth_angle_deg']:+.3f} deg{csec} (flexspline tip circle meeting the rigid tip circle)"
         + (
             f"; tooth {e['tooth']} at generator angle {e['generator_angle_deg']:.3f} deg, the smallest of "
@@ -295,7 +293,7 @@ def _entry_lines(res: dict, e: dict) -> list[str]:
     else:
         psec = "" if e["pinch_section_z_mm"] is None else f", section z = {e['pinch_section_z_mm']:g} mm"
         lines.append(
-            f"  entry pinch: {e['pinch_um']:.3f} um by the {e['pinch_edge']} edge at tooth angle "
+            f"  entry pinch: {e['pinch_um']:.3f} um by the {e['pinch_edge']} flank at tooth angle "
             f"{e['pinch_tooth_angle_deg']:+.3f} deg{psec}, {e['pinch_location']}"
             + (
                 f"; tooth {e['pinch_tooth']} at generator angle {e['pinch_generator_angle_deg']:.3f} deg"

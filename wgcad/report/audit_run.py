@@ -7,16 +7,20 @@ from :func:`audit_document` without the CLI.
 
 from __future__ import annotations
 
-from ..audit import RunSettings, run_audit
-from ..records import record
+from dataclasses import dataclass
+
+from ..audit import RunSettings, audit_settings, run_audit
+from ..placement.imperfect import Imperfections
+from ..regression import baseline_figures, compare, make_baseline
 from .audit import audit_json
 from .notes import not_modelled
+from .sections import balanced_taper, section_rows
 
-__all__ = ["AuditRun", "audit_document", "baseline_document", "imperfect_not_checked"]
+__all__ = ["AuditReport", "audit_document", "baseline_document", "imperfect_not_checked"]
 
 
-@record
-class AuditRun:
+@dataclass(slots=True)
+class AuditReport:
     """An audit with its document: ``doc`` is the JSON of ``wgcad audit --json``; ``drifts`` the baseline's (or None)."""
 
     drive: object
@@ -59,7 +63,7 @@ def audit_document(
     progress=None,
     on_stage=None,
     by_section: bool = False,
-) -> AuditRun:
+) -> AuditReport:
     """Audit a design and shape the document ``wgcad audit --json`` writes.
 
     Parameters
@@ -71,7 +75,7 @@ def audit_document(
         again in 3D with python-fcl (``doc["fcl"]``).
     baseline : dict, optional
         A baseline (:func:`wgcad.regression.load_baseline`): its figures are
-        compared (``doc["baseline"]``, ``AuditRun.drifts``).
+        compared (``doc["baseline"]``, ``AuditReport.drifts``).
     plot : bool
         Pictures will be drawn: the notes say what they show of an imperfect drive.
     progress : callable, optional
@@ -96,9 +100,6 @@ def audit_document(
                 "--by-section: the sections of the imperfect drive (it audits the perfect one only)"
             )
         else:
-            from ..audit import audit_settings
-            from .sections import balanced_taper, section_rows
-
             if on_stage is not None:
                 on_stage("section by section")
             settings = audit_settings(drive, rs)
@@ -112,8 +113,6 @@ def audit_document(
 
         imp = None
         if imperfect:
-            from ..placement.imperfect import Imperfections
-
             imp = Imperfections.from_spec(drive.design.imperfections)
         doc["fcl"] = check3d_document(verify_worst(drive, result, imp=imp))
         doc["settings"]["engine"] = (
@@ -121,18 +120,14 @@ def audit_document(
         )
     drifts = None
     if baseline is not None:
-        from ..regression import baseline_figures, compare
-
         drifts = compare(baseline, baseline_figures(drive, doc))
         doc["baseline"] = {"path": str(baseline_path), "drifts": [d.__dict__ for d in drifts]}
-    return AuditRun(drive, result, doc, drifts)
+    return AuditReport(drive, result, doc, drifts)
 
 
-def baseline_document(run: AuditRun, settings, design_source: str) -> dict:
+def baseline_document(run: AuditReport, settings, design_source: str) -> dict:
     """The geometry regression baseline of the audit ``run`` (what ``wgcad audit --write-baseline`` writes): its
     figures with the run settings a later comparison must repeat (:class:`wgcad.audit.RunSettings` ``settings``)."""
-    from ..regression import make_baseline
-
     kept = ("step_deg", "sections", "chord_tol_um", "interference_tol_um")
     return make_baseline(
         str(design_source), {k: v for k, v in settings.as_dict().items() if k in kept}, run.drive, run.doc

@@ -8,7 +8,10 @@ from math import pi
 import numpy as np
 
 from wgcad.constants import INTERFERENCE_TOL
+from wgcad.design import load_design
+from wgcad.drive import build_drive
 from wgcad.elastic.cam import cam_excess
+from wgcad.elastic.model import build_model
 from wgcad.elastic.sweep import LoadLevel, LoadSweep, law_departure, torque_sweep, wave_of
 from wgcad.errors import DesignError
 
@@ -174,10 +177,6 @@ def load_run(path, torques, e_um=None, e_deg=None, sections: int = 3, progress=N
     """The load audit of the design file ``path`` at ``torques`` (N m) with the cam offset ``e_um`` at ``e_deg``
     (default: the design's ``[load]``, else 0): the drive and the document (:func:`load_document`, with the design's
     name and file)."""
-    from wgcad.design import load_design
-    from wgcad.drive import build_drive
-    from wgcad.elastic.model import build_model
-
     drive = build_drive(load_design(path))
     if drive.design.imperfections.any:
         # the load audit models perfect parts: silently dropping the errors would report another drive

@@ -7,6 +7,8 @@ import numpy as np
 from wgcad.rating.datasheet import CRITERIA
 from wgcad.units import ARCMIN_PER_RAD, UM_PER_MM
 
+from .friction import friction_document, friction_lines
+
 __all__ = ["rating_document", "rating_lines"]
 
 
@@ -20,6 +22,7 @@ def _stress(s) -> dict:
     return {
         "where": s.where,
         "section_z_mm": _r(s.z, 3),
+        "nominal_bending_mpa": _r(s.nominal),
         "max_mpa": _r(s.sigma.max()),
         "min_mpa": _r(s.sigma.min()),
         "amplitude_mpa": _r(s.amplitude),
@@ -62,6 +65,7 @@ def rating_document(ds, design_path: str) -> dict:
                 "asks": CRITERIA[k],
                 "limit_torque_nm": _r(v.torque_nm, 1),
                 "limit_is_above": v.above,
+                "limit_bracket_nm": None if v.bracket is None else [_r(t, 1) for t in v.bracket],
                 "note": v.note,
             }
             for k, v in ds.limits.items()
@@ -76,6 +80,15 @@ def rating_document(ds, design_path: str) -> dict:
             "root_kt_at_radius_mm": _r(ds.kt.radius, 4),
             "notch_sensitivity": _r(ds.setup.q, 3),
             "root_kf": _r(ds.setup.kf, 3),
+            # the plate rated: the part set's diaphragm (wgcad parts exports these sizes)
+            "diaphragm_mm": None
+            if ds.setup.plate is None
+            else {
+                "bolt_circle_diameter": _r(2.0 * ds.setup.plate.r_i, 4),
+                "wall_radius": _r(ds.setup.plate.r_o, 4),
+                "thickness": _r(ds.setup.plate.h, 4),
+                "from_parts": ds.setup.plate_given,
+            },
             "fillet_radius_mm": _r(ds.setup.rho_f, 4),
             "ultimate_mpa": st.ultimate,
             "yield_mpa": _r(st.yield_),
@@ -110,7 +123,8 @@ def rating_document(ds, design_path: str) -> dict:
             "fit_rms_error_arcmin": _r(ARCMIN_PER_RAD * fit.rms_error, 4),
             "curve": [{"torque_nm": _r(T, 2), "wind_up_arcmin": _r(ARCMIN_PER_RAD * th, 4)} for T, th in ds.curve],
         },
-        "backlash_arcmin": None if ds.backlash is None else _r(ARCMIN_PER_RAD * ds.backlash, 3),
+        "windup_offset_arcmin": None if ds.windup_offset is None else _r(ARCMIN_PER_RAD * ds.windup_offset, 3),
+        "windup_offset_is": "twice the wind-up fit's intercept theta0 (both ways), not the audit's no-load backlash",
         "lost_motion_arcmin": None if ds.lost_motion is None else _r(ARCMIN_PER_RAD * ds.lost_motion, 3),
         "lost_motion_at_nm": _r(0.04 * ds.rated_torque_nm, 2),
         "natural_frequency_hz": _r(ds.natural_frequency_hz, 2),
@@ -121,14 +135,21 @@ def rating_document(ds, design_path: str) -> dict:
             else {**v, "torque_nm": _r(v["torque_nm"], 1)}
             for k, v in ds.ratcheting.items()
         },
+        "friction": friction_document(ds),
         "levels": [_level(lv) for lv in ds.levels],
         "not_checked": ds.notes,
+        "warnings": list(ds.warnings),
         "timing_s": {k: _r(v, 3) for k, v in ds.timing.items()},
     }
 
 
 def _limit_text(lim) -> str:
-    return f"{'> ' if lim.above else '  '}{lim.torque_nm:8.0f}"
+    """The limit with its resolution: a bisected one between the last torque met and the first failed."""
+    text = f"{'> ' if lim.above else '  '}{lim.torque_nm:8.0f}"
+    if lim.bracket is not None:
+        lo, hi = lim.bracket
+        text += f" (in {lo:.0f} .. {hi:.0f}, bisected to {hi - lo:.3g} N m, then interpolated)"
+    return text
 
 
 def rating_lines(ds) -> list[str]:
@@ -154,6 +175,10 @@ def rating_lines(ds) -> list[str]:
     )
     if st.assumed:
         out.append(f"    assumed: {'; '.join(st.assumed)}")
+    out.append(
+        f"    stresses: nominal = the plain rim's largest bending stress E y dkappa; the range = the notch stress "
+        f"(K_f {ds.setup.kf:.2f} x the rim's at the roots, plus the teeth's own bending)"
+    )
     for label, lv in (("at no load", ds.levels[0]), (f"at {ds.rated_torque_nm:.0f} N m", ds.rated)):
         out.append(f"    {label}:")
         for s in lv.stresses:
@@ -165,7 +190,7 @@ def rating_lines(ds) -> list[str]:
             }[s.where]
             where = f"{where} z {s.z:g} mm"
             out.append(
-                f"      {where:<28} {s.sigma.min():7.0f} .. {s.sigma.max():5.0f} MPa (largest tension at "
+                f"      {where:<28} nominal {s.nominal:4.0f}, {s.sigma.min():7.0f} .. {s.sigma.max():5.0f} MPa (largest tension at "
                 f"{np.rad2deg(s.peak_at):6.1f} deg), shear {s.shear:5.1f} MPa: Goodman safety {s.safety:.2f}, yield {s.yield_safety:.2f}"
                 + ("" if s.rated else "  (not rated: derived sizes)")
             )
@@ -177,7 +202,7 @@ def rating_lines(ds) -> list[str]:
     )
     fit = ds.fit
     if fit is None:
-        out.append("  stiffness, backlash, lost motion: not computed (no rated torque to load the drive to)")
+        out.append("  stiffness, wind-up offset, lost motion: not computed (no rated torque to load the drive to)")
     else:
         out.append(
             f"  stiffness (wind-up from the elastic model, {len(ds.curve)} torques to the rated one; fit within "
@@ -185,9 +210,11 @@ def rating_lines(ds) -> list[str]:
             f"K1 {fit.k1:.3g}, K2 {fit.k2:.3g}, K3 {fit.k3:.3g} N m/rad"
         )
         out.append(
-            f"  backlash (free play, both ways) {ARCMIN_PER_RAD * ds.backlash:.2f} arcmin; lost motion at +-4 % of the "
+            f"  wind-up offset (the stiffness fit's intercept, both ways; not the audit's backlash) "
+            f"{ARCMIN_PER_RAD * ds.windup_offset:.2f} arcmin; lost motion at +-4 % of the "
             f"rated torque ({0.04 * ds.rated_torque_nm:.0f} N m) {ARCMIN_PER_RAD * ds.lost_motion:.2f} arcmin"
         )
+    out += friction_lines(ds)
     fn = ds.natural_frequency_hz
     out.append(
         f"  first torsional natural frequency {fn:.1f} Hz (K1, output inertia {ld.output_inertia_kg_m2:g} kg m^2)"
@@ -203,6 +230,8 @@ def rating_lines(ds) -> list[str]:
         out.append(f"    without the offset: {'above ' if r0['above'] else ''}{r0['torque_nm']:.0f} N m; {r0['note']}")
     elif r["offset_um"] == 0:
         out.append("    with a cam offset: not computed (none given: [load] cam_offset_um or --cam-offset-um)")
+    for n in ds.warnings:
+        out.append(f"  WARNING: {n}")
     for n in ds.notes:
         out.append(f"  NOT CHECKED: {n}")
     out.append(f"  {ds.timing['total_s']:.1f} s")

@@ -15,6 +15,7 @@ from dataclasses import replace
 import numpy as np
 
 from ..clearance.engine import audit
+from ..roots import brentq
 
 __all__ = ["section_rows", "section_lines", "balanced_taper"]
 
@@ -78,8 +79,6 @@ def balanced_taper(drive, settings) -> dict | None:
     audited on the exact curves. None when the drive is not a coned internal-deformation cup or no taper
     within four times the depth-keeping one balances the ends.
     """
-    from ..roots import brentq
-
     g = drive.design.generator
     if not drive.coned or drive.external:
         return None

@@ -2,13 +2,14 @@
 
 from __future__ import annotations
 
+import json
 import math
 import re
 
 from ..synthesis.evaluate import STAGES
 from ..synthesis.requirements import OBJECTIVES
 
-__all__ = ["search_json", "summary_lines", "design_text", "trial_rows"]
+__all__ = ["search_json", "summary_lines", "design_name", "design_text", "trial_rows"]
 
 
 def _r(x, nd=4):
@@ -168,7 +169,21 @@ def design_text(base_text: str, res, ev, label: str = "best") -> str:
             value,
             f"chosen by wgcad design in [{fk.low:g}, {fk.high:g}]; " + _held(held.get(fk.name), why),
         )
+    # its own name, so its audits and pages are not labelled as the base design's
+    base = ((req.base_data or {}).get("drive") or {}).get("name") or req.base.stem
+    trial = next((i for i, e in enumerate(res.evaluations) if e is ev), None)
+    name = design_name(base, label, trial)
+    text = _set_key(
+        text, "drive", "name", json.dumps(name), f"named by wgcad design; the base design's: {json.dumps(base)}"
+    )
     return "\n".join(head) + text
+
+
+def design_name(base: str, label: str, trial: int | None) -> str:
+    """A chosen design's ``[drive] name``: the base's, what the search made of it and the trial (the CSV's row);
+    the base's cut short where the whole would pass the schema's 200 characters."""
+    tail = f" - design {label}" + ("" if trial is None else f", trial {trial}")
+    return base[: 200 - len(tail)] + tail
 
 
 def trial_rows(res) -> tuple[list, list]:

@@ -3,13 +3,13 @@
 from __future__ import annotations
 
 import time
-from dataclasses import field
+from dataclasses import dataclass, field
 
 import numpy as np
 
 from ..profiles.sector import MIN_HEIGHT_COEF, SectorLayout, TeethByHeight
-from ..records import record
-from .scene import DEFAULT_CULL, DEFAULT_STEP_DEG, SectoredScene, sweep_angles
+from .motion import motion_law
+from .scene import DEFAULT_CULL, DEFAULT_STEP_DEG, SectoredScene, facing_flex_tooth, sweep_angles
 
 __all__ = [
     "ClosedFormHeights",
@@ -22,7 +22,7 @@ __all__ = [
 ]
 
 
-@record(frozen=True)
+@dataclass(frozen=True, slots=True)
 class ClosedFormHeights:
     """Heights by ``h_i = r_fix - (r_cr + w(phi_i) + h_s)``, at most the full height (docs/models.md 2.3, [S5]).
 
@@ -43,6 +43,13 @@ class ClosedFormHeights:
         none), full tooth height (mm).
     rule : str
         How the generator angle is chosen, in words.
+    partner : (N,) int
+        The flexspline tooth that faces each tooth at its generator angle: whose centre line stands nearest it
+        (-1: none).
+    partner_phi : (N,) float
+        That flexspline tooth's own angle from the major axis, rad (``phi`` is the tooth's, where ``w`` is taken).
+    formula : (N,) float
+        The formula's height before the cap at the full height, mm (NaN where no angle is assigned).
     """
 
     heights: np.ndarray
@@ -58,6 +65,9 @@ class ClosedFormHeights:
     rule: str
     elapsed_s: float = 0.0
     iterations: int = 0
+    partner: np.ndarray = field(default=None, repr=False)
+    formula: np.ndarray = field(default=None, repr=False)
+    partner_phi: np.ndarray = field(default=None, repr=False)
 
 
 def assigned_angles(layout: SectorLayout) -> tuple[np.ndarray, np.ndarray]:
@@ -100,12 +110,15 @@ def register_angles(scene: SectoredScene, step_deg: float = DEFAULT_STEP_DEG, cu
         no flexspline tip ever faces the tooth). Every tooth is examined:
         the teeth of a transmission sector next to a joint can be out of
         register too.
+    flex : (N,) int
+        The facing flexspline tooth (-1: none).
     """
     lay = scene.layout
     pairs = scene.pairs(sweep_angles(step_deg), cull)
     face = scene.facing(pairs)
     phi_h = np.full(lay.n_teeth, np.nan)
     phi = np.full(lay.n_teeth, np.nan)
+    flex = np.full(lay.n_teeth, -1)
     ap = np.abs(pairs.phi)
     for i in np.unique(pairs.rigid[face]):
         mine = np.nonzero(face & (pairs.rigid == i))[0]
@@ -113,7 +126,8 @@ def register_angles(scene: SectoredScene, step_deg: float = DEFAULT_STEP_DEG, cu
             j = mine[np.argmin(ap[mine])]
             phi_h[i] = pairs.phi_h[pairs.angle[j]]
             phi[i] = pairs.phi[j]
-    return phi_h, phi
+            flex[i] = pairs.flex[j]
+    return phi_h, phi, flex
 
 
 def closed_form_heights(
@@ -136,19 +150,30 @@ def closed_form_heights(
         w = np.full(layout.n_teeth, np.nan)
         ok = np.isfinite(phi)
         w[ok] = drive.law.state(phi[ok]).w
-        out = np.full(layout.n_teeth, H)
+        raw = np.full(layout.n_teeth, np.nan)
         # docs/models.md 2.3: h_i = r_fix - r_ari, r_ari = r_cr + w(phi_h) + h_s; never above the full height
-        out[ok] = np.minimum(H, r_fix - (r_cr + w[ok] + h_s))
-        return out, w
+        raw[ok] = r_fix - (r_cr + w[ok] + h_s)
+        out = np.full(layout.n_teeth, H)
+        out[ok] = np.minimum(H, raw[ok])
+        return out, w, raw
 
     if assign == "boundary":
         phi_h, phi = assigned_angles(layout)
-        h, w = formula(phi)
+        h, w, raw = formula(phi)
         rule = "major axis on the sector boundary nearest the tooth (phi_i = the tooth's distance to it)"
         iterations = 0
+        partner = np.full(layout.n_teeth, -1)
+        partner_phi = np.full(layout.n_teeth, np.nan)
+        motion = motion_law(layout, drive.design.drive.z_flex)
+        for b in np.unique(phi_h[np.isfinite(phi_h)]):
+            sel = np.nonzero(phi_h == b)[0]
+            partner[sel], partner_phi[sel] = facing_flex_tooth(
+                drive.law, drive.r_m, motion, drive.design.drive.z_flex, b, layout.centres[sel]
+            )
     elif assign == "register":
-        phi_h, phi = register_angles(SectoredScene(drive, layout, teeth, h), step_deg)
-        h, w = formula(phi)
+        phi_h, phi, partner = register_angles(SectoredScene(drive, layout, teeth, h), step_deg)
+        partner_phi = phi
+        h, w, raw = formula(phi)
         iterations = 1
         rule = (
             f"smallest |phi| (from the nearer wave end) over a {step_deg:g} deg sweep of half a turn with the motion "
@@ -158,14 +183,29 @@ def closed_form_heights(
         raise ValueError(f"assign must be 'register' or 'boundary', got {assign!r}")
     g = drive.design.generator
     beta = float(np.deg2rad(g.beta_deg)) if g.beta_deg is not None else float("nan")
-    for a in (h, phi_h, phi, w):
+    for a in (h, phi_h, phi, w, partner, raw, partner_phi):
         a.setflags(write=False)
     return ClosedFormHeights(
-        h, phi_h, phi, w, r_fix, r_cr, h_s, float(drive.law.w0), beta, H, rule, time.perf_counter() - t0, iterations
+        h,
+        phi_h,
+        phi,
+        w,
+        r_fix,
+        r_cr,
+        h_s,
+        float(drive.law.w0),
+        beta,
+        H,
+        rule,
+        time.perf_counter() - t0,
+        iterations,
+        partner,
+        raw,
+        partner_phi,
     )
 
 
-@record(frozen=True)
+@dataclass(frozen=True, slots=True)
 class SimulatedHeights:
     """Heights found by sweeping the generator (largest that keeps ``tip_clearance`` where tips face).
 
@@ -181,6 +221,8 @@ class SimulatedHeights:
         The flexspline tooth's angle from the major axis there, rad.
     unreachable : (N,) bool
         Even the lowest tooth (``MIN_HEIGHT_COEF`` m) misses the clearance.
+    worst_flex : (N,) int
+        The flexspline tooth of the sample that limits each tooth (-1: full height).
     """
 
     heights: np.ndarray
@@ -192,6 +234,7 @@ class SimulatedHeights:
     tol: float
     counts: dict = field(default_factory=dict)
     elapsed_s: float = 0.0
+    worst_flex: np.ndarray = field(default=None, repr=False)
 
 
 def _bisect_heights(pairs, lo: dict, hi: dict, violations, tip_clearance: float, tol: float) -> None:
@@ -255,6 +298,7 @@ def simulated_heights(
     heights = np.full(N, H)
     worst_phi_h = np.full(N, np.nan)
     worst_phi = np.full(N, np.nan)
+    worst_flex = np.full(N, -1)
     unreachable = np.zeros(N, dtype=bool)
     evals = 0
 
@@ -289,8 +333,9 @@ def simulated_heights(
             j = idx[mine][np.argmin(c_end[mine])]
             worst_phi_h[i] = pairs.phi_h[pairs.angle[j]]
             worst_phi[i] = pairs.phi[j]
+            worst_flex[i] = pairs.flex[j]
     teeth_at_risk = bad
-    for a in (heights, worst_phi_h, worst_phi, unreachable):
+    for a in (heights, worst_phi_h, worst_phi, unreachable, worst_flex):
         a.setflags(write=False)
     return SimulatedHeights(
         heights,
@@ -307,6 +352,7 @@ def simulated_heights(
             "teeth_lowered": int(len(teeth_at_risk)),
         },
         time.perf_counter() - t0,
+        worst_flex,
     )
 
 

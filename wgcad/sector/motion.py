@@ -2,12 +2,12 @@
 
 from __future__ import annotations
 
+from dataclasses import dataclass
 from math import pi
 
 import numpy as np
 
 from ..profiles.sector import SectorLayout
-from ..records import record
 
 __all__ = ["MotionLaw", "Phase", "motion_law"]
 
@@ -15,7 +15,7 @@ __all__ = ["MotionLaw", "Phase", "motion_law"]
 _RATIO_TOL = 1e-9
 
 
-@record(frozen=True)
+@dataclass(frozen=True, slots=True)
 class Phase:
     """One linear piece (or run of equal pieces) of the motion law. Angles rad.
 
@@ -34,7 +34,7 @@ class Phase:
         return self.end - self.start
 
 
-@record(frozen=True)
+@dataclass(frozen=True, slots=True)
 class MotionLaw:
     """Flexspline rotation ``phi_g`` (rigid gear fixed) against generator angle ``phi_h``.
 

@@ -21,7 +21,7 @@ Which shortcuts of docs/models.md 7 still hold:
 
 from __future__ import annotations
 
-from dataclasses import field
+from dataclasses import dataclass, field
 from math import pi
 
 import numpy as np
@@ -31,7 +31,6 @@ from ..clearance.distance import Template, signed_clearance
 from ..placement import tooth_pose, transform
 from ..profiles.sampling import polar
 from ..profiles.sector import SectorLayout, TeethByHeight
-from ..records import record
 from .motion import MotionLaw, motion_law
 
 __all__ = [
@@ -41,6 +40,8 @@ __all__ = [
     "SectorSpot",
     "sectored_audit",
     "sweep_angles",
+    "flex_state",
+    "facing_flex_tooth",
     "DEFAULT_STEP_DEG",
     "DEFAULT_CULL",
 ]
@@ -60,6 +61,29 @@ DEFAULT_CULL = 0.05
 
 def _wrap(a):
     return (np.asarray(a) + pi) % (2.0 * pi) - pi
+
+
+def flex_state(law, r_m: float, motion: MotionLaw, z_g: int, phi_h):
+    """Poses of every flexspline tooth at generator angles ``phi_h (A,)`` with the motion law: rot ``(A, z)``, shift
+    ``(A, z, 2)`` (rigid frame) and each tooth's material angle from the major axis ``(A, z)`` (docs/models.md 3.1)."""
+    phi_h = np.atleast_1d(np.asarray(phi_h, dtype=float))
+    g = motion(phi_h)
+    mat = 2.0 * pi * np.arange(z_g)[None, :] / z_g + g[:, None]
+    phi = _wrap(mat - phi_h[:, None])
+    fa = np.broadcast_to(phi_h[:, None], phi.shape)
+    rot, shift = tooth_pose(law, phi.ravel(), r_m, frame_angle=fa.ravel())
+    A, z = phi.shape
+    return rot.reshape(A, z), shift.reshape(A, z, 2), phi
+
+
+def facing_flex_tooth(law, r_m: float, motion: MotionLaw, z_g: int, phi_h: float, centres) -> tuple:
+    """The flexspline tooth whose centre line stands nearest each rigid tooth centre ``centres`` (rad) at the generator
+    angle ``phi_h``, and that tooth's material angle from the major axis: ``(index (K,), angle (K,))``."""
+    rot, shift, phi = flex_state(law, r_m, motion, z_g, np.array([phi_h]))
+    rot, shift, phi = rot[0], shift[0], phi[0]
+    ang = np.arctan2(shift[:, 1] + r_m * np.sin(rot), shift[:, 0] + r_m * np.cos(rot))
+    k = np.argmin(np.abs(_wrap(np.asarray(centres)[:, None] - ang[None, :])), axis=1)
+    return k, phi[k]
 
 
 def sweep_angles(step_deg: float = DEFAULT_STEP_DEG) -> np.ndarray:
@@ -122,14 +146,7 @@ class SectoredScene:
 
     def flex_state(self, phi_h: np.ndarray):
         """Poses of every flexspline tooth at generator angles ``phi_h (A,)``: rot ``(A, z)``, shift ``(A, z, 2)``, phi ``(A, z)``."""
-        phi_h = np.atleast_1d(np.asarray(phi_h, dtype=float))
-        g = self.motion(phi_h)
-        mat = 2.0 * pi * np.arange(self.z_g)[None, :] / self.z_g + g[:, None]
-        phi = _wrap(mat - phi_h[:, None])
-        fa = np.broadcast_to(phi_h[:, None], phi.shape)
-        rot, shift = tooth_pose(self.law, phi.ravel(), self.r_m, frame_angle=fa.ravel())
-        A, z = phi.shape
-        return rot.reshape(A, z), shift.reshape(A, z, 2), phi
+        return flex_state(self.law, self.r_m, self.motion, self.z_g, phi_h)
 
     def pairs(self, phi_h: np.ndarray, cull: float = DEFAULT_CULL, teeth=None) -> SweepPairs:
         """Flexspline-rigid tooth pairs worth measuring over the generator angles ``phi_h``.
@@ -223,7 +240,7 @@ class SectoredScene:
         return out
 
 
-@record(frozen=True)
+@dataclass(frozen=True, slots=True)
 class SweepPairs:
     """Tooth pairs of a sweep: generator-angle index, flexspline tooth, rigid tooth, the flexspline tooth's pose and angle from the major axis."""
 
@@ -244,7 +261,7 @@ class SweepPairs:
         return len(self.rigid)
 
 
-@record
+@dataclass(slots=True)
 class SectoredAudit:
     """Findings of a sectored sweep (lengths mm, angles rad; :func:`wgcad.report.sector.sectored_audit_document`
     rounds and converts them).
@@ -266,13 +283,23 @@ class SectoredAudit:
     settings: dict
     elapsed_s: float = 0.0
     per_tooth_tip: np.ndarray = field(default=None, repr=False)
+    #: every rigid tooth's smallest clearance over the cycle (any pair, mm; inf: never measured), the generator angle
+    #: (rad) and the flexspline tooth of that sample (-1: none)
+    per_tooth_min: np.ndarray = field(default=None, repr=False)
+    per_tooth_generator_angle: np.ndarray = field(default=None, repr=False)
+    per_tooth_flex: np.ndarray = field(default=None, repr=False)
 
     @property
     def has_tip_to_tip(self) -> bool:
         return len(self.tip_to_tip) > 0
 
+    @property
+    def interferes(self) -> bool:
+        """Tip-to-tip contact or flank interference left anywhere in the cycle: the drive does not run."""
+        return self.has_tip_to_tip or self.flank_interference
 
-@record
+
+@dataclass(slots=True)
 class SectorSpot:
     """Where a sectored sweep found a figure: the pair's clearance (mm), the generator angle (rad), the flexspline tooth
     and its angle from the major axis (rad), the rigid tooth, its sector (index, kind, place in it), its angle from the
@@ -343,6 +370,12 @@ def sectored_audit(
     kt = int(fk[np.argmin(c[fk])]) if fk.size else None
     nf = np.nonzero(~face)[0]
     min_flank = float(c[nf].min()) if nf.size else float("inf")
+    N = scene.layout.n_teeth
+    order = np.lexsort((c, pairs.rigid))  # by tooth, then clearance: each tooth's first row is its smallest
+    first = order[np.unique(pairs.rigid[order], return_index=True)[1]] if len(c) else np.zeros(0, dtype=int)
+    t_min, t_ang, t_flex = np.full(N, np.inf), np.full(N, np.nan), np.full(N, -1)
+    ri = pairs.rigid[first]
+    t_min[ri], t_ang[ri], t_flex[ri] = c[first], pairs.phi_h[pairs.angle[first]], pairs.flex[first]
     return SectoredAudit(
         min_clearance=float(c[k]) if k is not None else float("inf"),
         worst=_where(scene, pairs, k, c[k]) if k is not None else None,
@@ -362,4 +395,7 @@ def sectored_audit(
         },
         elapsed_s=time.perf_counter() - t0,
         per_tooth_tip=tip_min,
+        per_tooth_min=t_min,
+        per_tooth_generator_angle=t_ang,
+        per_tooth_flex=t_flex,
     )

@@ -25,14 +25,14 @@ import math
 import os
 import statistics
 import time
-from dataclasses import field
+from dataclasses import dataclass, field
 
 from ..errors import WgcadError
-from ..records import record
+from ..extras import require
 from .store import Store
 from .tasks import columns_of, noop, run_batch
 
-__all__ = ["RunInfo", "ClusterError", "run_sweep", "plan_batch", "local_cluster"]
+__all__ = ["RunInfo", "ClusterError", "run_sweep", "plan_batch", "local_cluster", "close_cluster"]
 
 
 class ClusterError(WgcadError, RuntimeError):
@@ -51,7 +51,7 @@ TASKS_PER_WORKER = 4
 TASK_MIN_S = 1.0
 
 
-@record
+@dataclass
 class RunInfo:
     """What a run did: samples computed and skipped (already stored), grain, timings."""
 
@@ -69,6 +69,8 @@ class RunInfo:
     stopped_early: bool = False
     executor: str = ""
     notes: list = field(default_factory=list)
+    #: per worker process (pid), its resident memory (MB) after the first and after the latest of its tasks
+    worker_rss_mb: dict = field(default_factory=dict)
 
 
 def plan_batch(sample_s: float, overhead_s: float, remaining: int, workers: int) -> int:
@@ -86,7 +88,10 @@ def _ranges(gaps, batch: int):
 
 
 def local_cluster(workers: int):
-    """A Dask LocalCluster of ``workers`` single-threaded processes on loopback, no dashboard."""
+    """A Dask LocalCluster of ``workers`` single-threaded processes on loopback, no dashboard, and its log kept off
+    the command's stderr up to errors (logging.CRITICAL): a failed task reaches the run as its future's exception,
+    and what Dask logs at ERROR is its own shutdown races (a worker closing while its heartbeat is in flight logs
+    "Failed to communicate with scheduler during heartbeat" with two tracebacks)."""
     from distributed import LocalCluster
 
     return LocalCluster(
@@ -95,8 +100,31 @@ def local_cluster(workers: int):
         processes=True,
         host="127.0.0.1",
         dashboard_address=None,
-        silence_logs=40,
+        silence_logs=50,
     )
+
+
+#: how long a worker of an interrupted run is given to stop before it is killed, s (the nanny's close timeout)
+_ABANDON_TIMEOUT_S = 0.5
+
+
+def close_cluster(cluster, interrupted: bool = False) -> None:
+    """Close a cluster of :func:`local_cluster`. After an interruption (Ctrl-C, SIGTERM) the tasks still running are
+    abandoned, so every worker process is stopped at once (each nanny closed with a short timeout, all together):
+    a plain close first asks each busy worker to finish its task and waits up to 4 s for it (the nanny's 5 s
+    timeout x 0.8) before killing it."""
+    if interrupted:
+        import asyncio
+
+        async def stop_workers():
+            nannies = list(cluster.workers.values())
+            await asyncio.gather(*(w.close(timeout=_ABANDON_TIMEOUT_S) for w in nannies), return_exceptions=True)
+
+        try:
+            cluster.sync(stop_workers)
+        except Exception:  # noqa: BLE001 (the plain close below still runs; the interruption is what matters)
+            pass
+    cluster.close()
 
 
 def run_sweep(
@@ -127,6 +155,8 @@ def run_sweep(
     max_chunks : int, optional
         Stop after writing this many chunks (what a killed run leaves; tests).
     """
+    if client is None and not (workers == 0 and scheduler is None):
+        require("sweep")  # before anything is stored
     payload = spec.payload()
     store = Store(out, payload["fingerprint"], columns_of(payload), spec.total, fmt=fmt, name=spec.name).open()
     gaps = store.missing()
@@ -145,6 +175,8 @@ def run_sweep(
         info.chunks_written += 1
         info.worker_s += res["compute_s"]
         info.worker_cpu_s += res.get("cpu_s", 0.0)
+        if "rss_mb" in res:
+            info.worker_rss_mb.setdefault(res["pid"], [res["rss_mb"], 0.0])[1] = res["rss_mb"]
         tick(f"{info.skipped + info.computed}/{spec.total} samples")
         return max_chunks is not None and info.chunks_written >= max_chunks
 
@@ -163,6 +195,7 @@ def run_sweep(
         info.wall_s = time.perf_counter() - t0
         return info
     cluster = own = None
+    interrupted = False
     try:
         client, own, cluster = _connect(client, scheduler, workers, info)
         info.workers = max(1, len(client.scheduler_info(n_workers=-1)["workers"]))
@@ -178,12 +211,15 @@ def run_sweep(
             batch = plan_batch(info.sample_s, info.overhead_s, sum(b - a for a, b in gaps), info.workers)
         info.batch = batch
         _collect(client, pf, gaps, batch, info, stored, spec.total)
+    except KeyboardInterrupt:  # Ctrl-C, or SIGTERM / SIGHUP as the CLI raises them
+        interrupted = True
+        raise
     finally:
         info.wall_s = time.perf_counter() - t0
         if own is not None:
             own.close()
         if cluster is not None:
-            cluster.close()
+            close_cluster(cluster, interrupted)
     return info
 
 
@@ -278,4 +314,6 @@ def _timed_batch(payload, start, stop):
         "cpu_s": time.process_time() - c0,
         "sample_s": ts,
         "built": 0,
+        "pid": r["pid"],
+        "rss_mb": r["rss_mb"],
     }

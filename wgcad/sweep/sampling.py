@@ -15,6 +15,8 @@ import copy
 
 import numpy as np
 
+from ..errors import OutputError
+
 __all__ = ["split_index", "sample_values", "sample_design_data", "envelope_amplitudes_um", "chunk_check"]
 
 
@@ -78,8 +80,6 @@ def chunk_check(payload: dict):
     """A check for :meth:`wgcad.sweep.store.Store.read`: a chunk's parameter columns must be the values this spec
     draws for its samples (bit for bit), so a chunk of another spec (another seed, distribution or grid) left in
     the folder is named and refused instead of entering the yield."""
-    from ..errors import OutputError
-
     names = [p.name for p in payload["parameters"]]
 
     def check(a: int, b: int, cols: dict) -> None:

@@ -34,12 +34,15 @@ from __future__ import annotations
 import hashlib
 import json
 import tomllib
-from dataclasses import fields
+from dataclasses import dataclass, fields
 from pathlib import Path
 
+from ..design.files import parse_toml, read_design_text
+from ..design.rules import key_meta
+from ..design.schema import TABLES, base_type, parse_design
 from ..errors import DesignError, InputFileError, close_matches
 from ..numbers import read_float, show_value
-from ..records import record
+from .figures import check_figures
 
 __all__ = ["Parameter", "SweepSpec", "parse_spec", "load_spec", "MAX_SAMPLES", "DISTRIBUTIONS"]
 
@@ -59,7 +62,7 @@ _PARAM_KEYS = {
 }
 
 
-@record(frozen=True)
+@dataclass(frozen=True)
 class Parameter:
     """One varied design key: ``table.key`` and how it varies.
 
@@ -93,7 +96,7 @@ class Parameter:
         return max(float(v) for v in self.values)
 
 
-@record(frozen=True)
+@dataclass(frozen=True)
 class SweepSpec:
     """A validated sweep specification."""
 
@@ -183,9 +186,6 @@ def _whole(where: str, v, lo: int, hi: int) -> int:
 
 def _field_types() -> dict:
     """``{table: {key: (base type, choices)}}`` of every design key (from the design schema)."""
-    from ..design.rules import key_meta
-    from ..design.schema import TABLES, base_type
-
     out = {}
     for t, cls in TABLES.items():
         if hasattr(cls, "from_table"):  # tables with lists (sectors) cannot be swept key by key
@@ -287,9 +287,6 @@ def parse_spec(
     ``design_data`` (the base design as a TOML dict) is read from ``sweep.design``
     (relative to ``base_dir``) when not given.
     """
-    from ..design.schema import parse_design
-    from .figures import check_figures
-
     if not isinstance(data, dict):
         raise DesignError("<file>", "must be a TOML document with tables")
     _unknown("", data, _TOP)
@@ -357,7 +354,6 @@ def _base_design(dpath, base_dir: Path | None, design_data: dict | None) -> tupl
         raise DesignError("sweep.design", f"must be the path of a design file, got {dpath!r}")
     if design_data is not None:
         return dpath, design_data
-    from ..design.files import read_design_text
 
     p = Path(dpath)
     if not p.is_absolute() and base_dir is not None:
@@ -425,8 +421,6 @@ def load_spec(path) -> SweepSpec:
     DesignError
         A rule of the spec or of the base design is broken.
     """
-    from ..design.files import parse_toml, read_design_text
-
     p = Path(path)
     try:
         text = read_design_text(p)

@@ -14,6 +14,7 @@ grain may differ between runs (ranges, not fixed numbers, name the files).
 
 from __future__ import annotations
 
+import contextlib
 import csv
 import io
 import json
@@ -21,10 +22,16 @@ import os
 import re
 from pathlib import Path
 
-from ..errors import InputFileError, OutputError
+import numpy as np
+
+from ..atomic import atomic_write, ensure_writable_dir, remove_stale_temps
+from ..errors import FolderBusyError, InputFileError, OutputError
 from ..userfiles import read_user_text
 
-__all__ = ["Store", "have_pyarrow"]
+__all__ = ["Store", "have_pyarrow", "hold_folder", "LOCK_NAME"]
+
+#: the lock file of a results folder (a sweep's or a design study's), held while a run writes there
+LOCK_NAME = ".wgcad.lock"
 
 #: a sweep record is a few hundred bytes
 _MAX_META_BYTES = 1 << 20
@@ -38,6 +45,79 @@ def have_pyarrow() -> bool:
     except ImportError:
         return False
     return True
+
+
+@contextlib.contextmanager
+def hold_folder(folder):
+    """Hold the results folder ``folder`` (created if missing) for the run inside the ``with``: an exclusive
+    ``fcntl.flock`` on its :data:`LOCK_NAME` file, which records the holder's pid.
+
+    The kernel drops the lock when its process ends, however it ends, so a killed run leaves no stale lock: the
+    next run takes the folder over. A folder another live run holds is refused at once
+    (:class:`~wgcad.errors.FolderBusyError`, naming its pid), before anything is written. On the way out the lock
+    file goes, and so does a folder this call created that stayed empty. Where ``fcntl`` is missing (Windows) the
+    folder is not locked.
+    """
+    folder = Path(folder)
+    made = [p for p in (folder, *folder.parents) if not p.exists()]
+    ensure_writable_dir(folder)
+    try:
+        import fcntl
+    except ImportError:  # pragma: no cover (no flock on Windows)
+        fcntl = None
+    path = folder / LOCK_NAME
+    fd = None
+    try:
+        try:
+            fd = _lock(path, folder) if fcntl is not None else None
+        except FolderBusyError:
+            raise
+        except OSError as e:  # a folder, link or unwritable file in the lock file's place, a full disk
+            raise OutputError(f"{path}: cannot take the results folder's lock ({e.strerror or e})") from None
+        yield folder
+    finally:
+        if fd is not None:
+            with contextlib.suppress(OSError):
+                os.unlink(path)  # before the lock is dropped: a waiting run then finds no file, or its own
+            os.close(fd)
+        for p in made:
+            with contextlib.suppress(OSError):
+                p.rmdir()  # only an empty folder this run made
+
+
+def _lock(path: Path, folder: Path) -> int:
+    """The open, locked lock file ``path`` with this process's pid in it (:func:`hold_folder`)."""
+    import fcntl
+
+    while True:
+        fd = os.open(path, os.O_RDWR | os.O_CREAT | os.O_NOFOLLOW, 0o644)
+        try:
+            fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except BlockingIOError:
+            holder = os.read(fd, 32).decode("ascii", "replace").strip()
+            os.close(fd)
+            who = f"pid {holder}" if holder.isdigit() else "another process"
+            raise FolderBusyError(
+                f"{folder}: another wgcad run ({who}) is writing there and holds {LOCK_NAME}; wait for it to end or "
+                "choose another --out"
+            ) from None
+        except BaseException:
+            os.close(fd)
+            raise
+        # the holder that released the lock just before removed its file: lock the file now in place, not that one
+        try:
+            same = os.path.samestat(os.fstat(fd), os.stat(path, follow_symlinks=False))
+        except FileNotFoundError:
+            same = False
+        if same:
+            try:
+                os.ftruncate(fd, 0)
+                os.write(fd, f"{os.getpid()}\n".encode())
+            except BaseException:
+                os.close(fd)
+                raise
+            return fd
+        os.close(fd)
 
 
 class Store:
@@ -64,8 +144,6 @@ class Store:
     # -- the folder ----------------------------------------------------------
     def open(self) -> Store:
         """Create the folder (or check that it holds this spec's results) and write ``sweep.json``."""
-        from ..atomic import atomic_write, ensure_writable_dir, remove_stale_temps
-
         meta = self.folder / "sweep.json"
         if meta.exists() or meta.is_symlink():
             try:
@@ -81,7 +159,7 @@ class Store:
                 )
             if old.get("format") != self.fmt:
                 raise OutputError(f"{self.folder}: its chunks are {old.get('format')}, this run would write {self.fmt}")
-        elif self.folder.exists() and any(self.folder.iterdir()):
+        elif self.folder.exists() and any(p.name != LOCK_NAME for p in self.folder.iterdir()):
             raise OutputError(f"{self.folder}: not empty and not a sweep folder (no sweep.json); choose another --out")
         ensure_writable_dir(self.chunks)
         remove_stale_temps(self.chunks)  # temporaries of a killed run
@@ -143,8 +221,6 @@ class Store:
     # -- writing -------------------------------------------------------------
     def write(self, a: int, b: int, columns: dict) -> Path:
         """Write samples ``[a, b)`` atomically; returns the chunk's path."""
-        from ..atomic import atomic_write
-
         p = self.path(a, b)
         atomic_write(p, self._encode(columns))
         return p
@@ -188,8 +264,6 @@ class Store:
         ``check(a, b, columns)`` may check more (the sweep's parameters: a chunk of another spec) and raises
         :class:`OutputError` naming the chunk.
         """
-        import numpy as np
-
         parts = []
         for a, b in self.done_ranges():
             p = self.path(a, b)
@@ -219,8 +293,6 @@ class Store:
 
     def _decode(self, path: Path) -> dict:
         """One chunk: column -> numpy array (object arrays for text)."""
-        import numpy as np
-
         if self.fmt == "parquet":
             import pyarrow as pa
             import pyarrow.parquet as pq

@@ -16,11 +16,22 @@ per limited figure the rank correlation with the figure itself.
 from __future__ import annotations
 
 import collections
+import itertools
 import math
 
 import numpy as np
 
-__all__ = ["clopper_pearson", "wilson", "passes", "summarize", "format_summary"]
+__all__ = [
+    "MIN_FAILING_TO_RANK",
+    "clopper_pearson",
+    "failing_samples",
+    "few_failing_note",
+    "format_summary",
+    "passes",
+    "summarize",
+    "weakest_figure",
+    "wilson",
+]
 
 
 def clopper_pearson(k: int, n: int, conf: float = 0.95) -> tuple[float, float]:
@@ -270,7 +281,7 @@ def format_summary(s: dict, info=None) -> str:
     if info is not None:
         lines.append(
             f"  this run: {info.computed} samples computed, {info.skipped} already stored; {info.executor}; "
-            f"{info.batch} samples per task"
+            f"{info.batch} sample{'' if info.batch == 1 else 's'} per task"
             + (
                 f" (measured: {1e3 * info.sample_s:.0f} ms per sample, Dask round trip {1e3 * info.overhead_s:.1f} ms)"
                 if info.sample_s
@@ -282,8 +293,8 @@ def format_summary(s: dict, info=None) -> str:
     for r in s["reasons"][:4]:
         lines.append(f"  not computed ({r['samples']}): {r['reason']}")
     if s.get("kind") == "grid" and s["grid"] is not None:
-        # a design study: every grid point as a row (issue 23: it printed mean, sd, percentiles and a 54-100 %
-        # "confidence interval" of six designs chosen on a grid)
+        # a design study: every grid point as a row (mean, sd, percentiles and a "confidence interval" of designs
+        # chosen on a grid mean nothing)
         return "\n".join(lines + _grid_table(s))
     for f, st in s["figures"].items():
         if st.get("n"):
@@ -320,7 +331,17 @@ def format_summary(s: dict, info=None) -> str:
         lines.append(f"  YIELD not defined: no sample's models held ({c['done']} stored: see the reasons above)")
     if s["sensitivity"]:
         top = [r for r in s["sensitivity"] if r["failure"] is not None][:5]
-        if top:
+        n_fail = failing_samples(s)
+        if top and n_fail < MIN_FAILING_TO_RANK:
+            f = weakest_figure(s)
+            by_fig = sorted(
+                (r for r in s["sensitivity"] if r["figures"].get(f) is not None), key=lambda r: -abs(r["figures"][f])
+            )[:5]
+            lines.append(
+                f"  parameters driving failures: not ranked, {few_failing_note(s)}; rank correlation with {f} instead: "
+                + ", ".join(f"{r['parameter']} {r['figures'][f]:+.2f}" for r in by_fig)
+            )
+        elif top:
             lines.append(
                 "  parameters driving failures (rank correlation with failing): "
                 + ", ".join(f"{r['parameter']} {r['failure']:+.2f}" for r in top)
@@ -328,10 +349,32 @@ def format_summary(s: dict, info=None) -> str:
     return "\n".join(lines)
 
 
+#: fewest failing samples from which the parameters are ranked by their correlation with failing: below it one or
+#: two samples decide the order (D2's 40-sample sweep ranked eight parameters from its one failure)
+MIN_FAILING_TO_RANK = 5
+
+
+def failing_samples(s: dict) -> int:
+    """Samples whose models held but which fail a limit (0 without limits)."""
+    y = s.get("yield")
+    return 0 if not y or not y.get("of") else int(y["of"] - y["pass"])
+
+
+def few_failing_note(s: dict) -> str:
+    """Why the parameters are not ranked by failing: how many failed, of how many, and the least the ranking needs."""
+    n = failing_samples(s)
+    of = (s.get("yield") or {}).get("of", 0)
+    return f"{n} failing sample{'' if n == 1 else 's'} of {of} (at least {MIN_FAILING_TO_RANK} needed)"
+
+
+def weakest_figure(s: dict) -> str:
+    """The limited figure the fewest samples meet (the one whose margin the parameters are ranked by)."""
+    lims = s["limits"]
+    return min(lims, key=lambda k: lims[k]["fraction"] if lims[k]["fraction"] is not None else 1.0)
+
+
 def _grid_table(s: dict) -> list[str]:
     """The grid points of a design study, one row each: the parameters, every recorded figure, and the verdict."""
-    import itertools
-
     g = s["grid"]
     names, values, shape = g["parameters"], g["values"], tuple(g["shape"])
     figs = list(g["surfaces"])

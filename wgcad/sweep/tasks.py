@@ -16,9 +16,12 @@ sample gives the same bits on any worker (tests/test_sweep_dask.py).
 
 from __future__ import annotations
 
+import ctypes
+import ctypes.util
 import hashlib
 import json
 import math
+import os
 import threading
 import time
 from collections import OrderedDict
@@ -27,7 +30,13 @@ import numpy as np
 
 from wgcad.units import ARCMIN_PER_RAD, ARCSEC_PER_RAD, UM_PER_MM
 
+from ..accuracy import ke as K
+from ..clearance.engine import AuditSettings, audit
+from ..design.imperfections import ImperfectionsSpec
+from ..design.schema import parse_design
+from ..drive import build_drive
 from ..errors import DesignError, ModelError, WgcadError
+from ..placement.imperfect import Imperfections
 from .figures import parse_figure
 from .sampling import envelope_amplitudes_um, sample_design_data, sample_values
 
@@ -82,8 +91,8 @@ def _allocator() -> None:
 
     The nanny spawns workers with ``MALLOC_TRIM_THRESHOLD_=65536``; setting
     it turns off glibc's adaptive mmap threshold, so every array above 128 kB
-    is a fresh mmap whose pages fault in anew: D2's KE took 0.44 s instead of
-    0.24 s per sample, most of it in the kernel, and two such workers on two
+    is a fresh mmap whose pages fault in anew: D2's KE ran almost twice as
+    slow per sample, most of it in the kernel, and two such workers on two
     cores ran at a third of their speed (README, sweeps). Large thresholds
     keep the arrays of a sample in the heap for the next; the memory a worker
     holds stays that of its largest sample. glibc only; elsewhere a no-op.
@@ -92,9 +101,6 @@ def _allocator() -> None:
         return
     _ALLOCATOR["set"] = True
     try:
-        import ctypes
-        import ctypes.util
-
         name = ctypes.util.find_library("c")
         libc = ctypes.CDLL(name) if name else None
         if libc is not None and hasattr(libc, "mallopt"):
@@ -125,22 +131,14 @@ def _geometry_key(data: dict) -> str:
 
 
 def _base(payload):
-    from ..design.schema import parse_design
-
     return _cached("base", payload["fingerprint"], lambda: parse_design(payload["design"]))
 
 
 def _drive(data, design):
-    from ..drive import build_drive
-
     return _cached("drive", _geometry_key(data), lambda: build_drive(design))
 
 
 def _ke(payload, data, design, drive) -> dict:
-    from ..accuracy import ke as K
-    from ..design.imperfections import ImperfectionsSpec
-    from ..placement.imperfect import Imperfections
-
     imp = Imperfections.from_spec(design.imperfections)
     # the table is built for the sweep's largest amplitudes (module docstring of sampling) and the
     # sample's own cam-borne offset (exact in the table); a sample beyond them gets its own table
@@ -179,8 +177,6 @@ def _audit(payload, data, drive) -> dict:
 
 
 def _audit_run(payload, drive) -> dict:
-    from ..clearance.engine import AuditSettings, audit
-
     n = int(round(360.0 / payload["audit_step_deg"]))
     bw = drive.design.drive.face_width
     secs = np.unique(np.concatenate([drive.sections(payload["audit_sections"]), [0.0, bw]]))  # as wgcad audit
@@ -192,12 +188,14 @@ def _audit_run(payload, drive) -> dict:
     }
 
 
+def _model_key(data: dict) -> str:
+    # what the elastic model depends on: every table but [imperfections] (the geometry, [material], [bearing],
+    # [load]'s ball phase and tooth compliance, [parts]' diaphragm, [supports]' stiffnesses)
+    return _h({k: v for k, v in data.items() if k != "imperfections"})
+
+
 def _load(payload, data, design, drive, torques) -> dict:
-    # the load model sees the geometry and [material], [bearing], [load]: not [imperfections]
-    key = _h(
-        [data.get(k) for k in ("drive", "tooth", "flexspline", "rigid", "generator", "material", "bearing", "load")]
-        + [payload["load_sections"], sorted(torques)]
-    )
+    key = _h([_model_key(data), payload["load_sections"], sorted(torques)])
     return dict(_cached("load", key, lambda: _load_run(payload, data, design, drive, torques)))
 
 
@@ -205,7 +203,7 @@ def _load_run(payload, data, design, drive, torques) -> dict:
     from ..elastic.model import build_model
     from ..elastic.sweep import torque_sweep
 
-    key = _h([_geometry_key(data), payload["load_sections"]])
+    key = _h([_model_key(data), payload["load_sections"]])
     model = _cached("model", key, lambda: build_model(drive, payload["load_sections"]))
     ld = design.load
     res = torque_sweep(model, sorted(torques), ld.cam_offset_um, ld.cam_offset_deg)
@@ -233,8 +231,6 @@ def run_sample(payload: dict, i: int) -> dict:
     solver does not converge); ``error``: any other exception, with its type
     and message (a bug to report). None of them stops the sweep.
     """
-    from ..design.schema import parse_design
-
     values = sample_values(payload, i)
     row = {"sample": int(i)}
     g, r = divmod(int(i), payload["samples"])
@@ -279,7 +275,8 @@ def run_batch(payload: dict, start: int, stop: int) -> dict:
         ``columns`` (name -> list), ``start``, ``stop``, ``compute_s``
         (seconds in this task), ``cpu_s`` (this process's CPU seconds in it: less
         than ``compute_s`` when the cores are shared), ``built`` (shared objects
-        this task had to build).
+        this task had to build), ``pid`` and ``rss_mb`` (the process and its
+        resident memory at the task's end: whether a long run's workers grow).
     """
     _allocator()
     t0, c0 = time.perf_counter(), time.process_time()
@@ -293,4 +290,13 @@ def run_batch(payload: dict, start: int, stop: int) -> dict:
         "compute_s": time.perf_counter() - t0,
         "cpu_s": time.process_time() - c0,
         "built": _STATS["built"] - b0,
+        "pid": os.getpid(),
+        "rss_mb": _rss_mb(),
     }
+
+
+def _rss_mb() -> float:
+    """This process's resident memory now, MB (psutil comes with Dask's distributed)."""
+    import psutil
+
+    return psutil.Process().memory_info().rss / 2**20

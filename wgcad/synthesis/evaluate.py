@@ -20,16 +20,21 @@ candidate leaves the later constraints unknown (None). Internal units (mm, N m, 
 
 from __future__ import annotations
 
+import copy
 import math
 import time
-from dataclasses import field
+from dataclasses import dataclass, field
 
 import numpy as np
 
+from ..clearance.engine import audit
+from ..clearance.search import AuditSettings
 from ..design import Design
 from ..design.schema import with_changes
+from ..drive import build_drive
 from ..errors import DesignError, ModelError
-from ..records import record
+from ..sweep.tasks import run_batch
+from .requirements import ke_spec
 
 __all__ = ["Evaluation", "evaluate", "apply", "STAGES"]
 
@@ -41,7 +46,7 @@ RATED = ("fatigue", "yield", "bearing_life")
 PEAK = ("entry_gap", "ratcheting", "bearing_static", "yield")
 
 
-@record
+@dataclass(slots=True)
 class Evaluation:
     """The judgement of one candidate: the free keys' values, each constraint's margin (>= 0: met; None: not reached),
     the objectives' values where they were computed, the stage it stopped at and why."""
@@ -91,8 +96,6 @@ def evaluate(base: Design, free, values: dict, req) -> Evaluation:
 
 
 def _run(base, free, ev: Evaluation, req) -> None:
-    from ..drive import build_drive
-
     if req.ratio is not None:  # from the tooth counts alone, before any rule is checked
         dr = base.drive
         z_f = int(round(ev.values.get("drive.z_flex", dr.z_flex)))
@@ -142,9 +145,6 @@ def _run(base, free, ev: Evaluation, req) -> None:
 
 
 def _audit(drive, ev: Evaluation, req) -> bool:
-    from ..clearance.engine import audit
-    from ..clearance.search import AuditSettings
-
     zs = [0.0, 0.5 * drive.design.drive.face_width, drive.design.drive.face_width] if drive.coned else [0.0]
     res = audit(drive, AuditSettings(angles=np.deg2rad(np.arange(720) * 0.5), sections=np.array(zs)))
     c_um = 1e3 * res.min_clearance
@@ -170,8 +170,6 @@ def _audit(drive, ev: Evaluation, req) -> bool:
 
 def candidate_data(base_data: dict, free, values: dict) -> dict:
     """The base design's TOML data with the free keys set (what a sweep of the candidate starts from)."""
-    import copy
-
     data = copy.deepcopy(base_data)
     for fk in free:
         v = values[fk.name]
@@ -180,9 +178,6 @@ def candidate_data(base_data: dict, free, values: dict) -> dict:
 
 
 def _ke_budget(free, ev: Evaluation, req) -> bool:
-    from ..sweep.tasks import run_batch
-    from .requirements import ke_spec
-
     spec = ke_spec(
         req.tolerances,
         candidate_data(req.base_data, free, ev.values),
@@ -235,6 +230,12 @@ def _rating(drive, ev: Evaluation, req) -> bool:
         ev.objectives["lost_motion"] = lm
         # inside [lo, hi]: the margin is the distance to the nearer end over the range's width
         ev.margins["lost motion"] = -1.0 if lm is None else min(lm - lo, hi - lm) / (hi - lo)
+    fr = sheet.friction
+    if fr is not None:
+        ev.objectives["efficiency"] = float(fr.rated.efficiency())
+    if req.min_efficiency is not None:
+        eta = None if fr is None else float(fr.rated.efficiency())
+        ev.margins["efficiency"] = -1.0 if eta is None else eta / req.min_efficiency - 1.0
     if req.entry_gap_closes_below_nm is not None:
         # an upper bound on a limit: the gap must close (tip interference at entry) below the torque given; a gap
         # still open where the model stopped ('above') is not shown to close at all: violated

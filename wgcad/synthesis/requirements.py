@@ -15,6 +15,7 @@ A requirements file names a base design (every key the search leaves alone is th
     max_backlash_arcmin = 3.0         # no-load audit
     min_clearance_um = 0.0            # no-load audit: no interference
     entry_gap_closes_below_nm = 3000  # the loaded entry gap closes below this torque (a source's observation)
+    min_efficiency = 0.7              # efficiency at the rated torque and [load] input_speed_rpm (wgcad rating)
     cam_offset_um = 40.0              # the cam offset the drive is rated with (default the base's [load])
     objective = "rated_torque"        # what ranks the feasible drives (one, or two for a Pareto front)
     trials = 40
@@ -30,13 +31,14 @@ Bad input is a :class:`~wgcad.errors.DesignError` naming ``requirements.<key>`` 
 from __future__ import annotations
 
 import math
-from dataclasses import fields
+from dataclasses import dataclass, fields
 from pathlib import Path
 
-from ..design.files import parse_toml
+from ..design.files import MAX_DESIGN_BYTES, load_design, parse_toml, read_design_text
 from ..design.schema import Design
 from ..errors import DesignError
-from ..records import record
+from ..sweep.spec import parse_spec
+from ..userfiles import read_user_text
 
 __all__ = ["FreeKey", "Requirements", "OBJECTIVES", "load_requirements", "parse_requirements"]
 
@@ -47,6 +49,10 @@ OBJECTIVES = {
     "outside_diameter": ("min", "the rigid gear's body diameter, mm"),
     "backlash": ("min", "no-load backlash, arcmin (wgcad audit)"),
     "min_clearance": ("max", "the no-load audit's smallest clearance, um"),
+    "efficiency": (
+        "max",
+        "efficiency at the rated torque and [load] input_speed_rpm (wgcad rating, docs/models.md 10.8)",
+    ),
 }
 
 _KEYS = {
@@ -61,6 +67,7 @@ _KEYS = {
     "lost_motion_arcmin": list,
     "min_clearance_um": float,
     "entry_gap_closes_below_nm": float,
+    "min_efficiency": float,
     "cam_offset_um": float,
     "ke_max_arcsec": float,
     "ke_yield_min": float,
@@ -71,7 +78,7 @@ _KEYS = {
 }
 
 
-@record(frozen=True)
+@dataclass(frozen=True, slots=True)
 class FreeKey:
     """A design key the search chooses: ``table.key`` in ``[low, high]`` (``integer``: whole numbers)."""
 
@@ -86,7 +93,7 @@ class FreeKey:
         return f"{self.table}.{self.key}"
 
 
-@record(frozen=True)
+@dataclass(frozen=True, slots=True)
 class Requirements:
     """A parsed requirements file (lengths mm, torques N m; None: not required)."""
 
@@ -105,6 +112,8 @@ class Requirements:
     lost_motion_arcmin: tuple | None = None
     min_clearance_um: float | None = 0.0
     entry_gap_closes_below_nm: float | None = None
+    #: the datasheet's efficiency at the rated torque and input speed must reach this share
+    min_efficiency: float | None = None
     cam_offset_um: float | None = None
     #: the KE budget under tolerances: the largest KE (peak to peak over a flexspline turn, arcsec) that a share
     #: ``ke_yield_min`` of ``ke_samples`` drives drawn from ``tolerances`` may not exceed
@@ -127,7 +136,8 @@ class Requirements:
             or self.peak_torque_nm is not None
             or self.entry_gap_closes_below_nm is not None
             or self.lost_motion_arcmin is not None
-            or any(o in ("rated_torque", "stiffness") for o in self.objectives)
+            or self.min_efficiency is not None
+            or any(o in ("rated_torque", "stiffness", "efficiency") for o in self.objectives)
         )
 
 
@@ -202,8 +212,6 @@ def _ke_budget(req: dict, tolerances, base_data: dict, base_path: Path) -> dict:
 
 def ke_spec(tolerances: dict, design_data: dict, samples: int, seed: int, ke_max: float, source: str):
     """The sweep spec of a candidate's KE budget: ``samples`` drives drawn from ``tolerances``, KE recorded."""
-    from ..sweep.spec import parse_spec
-
     data = {
         "sweep": {"name": "KE budget", "design": source, "samples": samples, "seed": seed},
         "figures": {"record": ["ke_pp_arcsec"]},
@@ -215,8 +223,6 @@ def ke_spec(tolerances: dict, design_data: dict, samples: int, seed: int, ke_max
 
 def parse_requirements(data: dict, path: Path) -> Requirements:
     """Check a requirements file's tables (see the module docstring) and load its base design."""
-    from ..design.files import load_design
-
     unknown = set(data) - {"requirements", "free", "tolerances"}
     if unknown:
         raise DesignError(
@@ -232,7 +238,6 @@ def parse_requirements(data: dict, path: Path) -> Requirements:
         raise DesignError("requirements.base", "the design file the search starts from (a path relative to this file)")
     base_path = (path.parent / req["base"]).resolve()
     base = load_design(base_path)
-    from ..design.files import read_design_text
 
     base_data = parse_toml(read_design_text(base_path), base_path, "design file")
     vals = {}
@@ -250,6 +255,11 @@ def parse_requirements(data: dict, path: Path) -> Requirements:
             if not v > 0:
                 raise DesignError(f"requirements.{k}", f"must be > 0, got {v:g}")
             vals[k] = v
+    if "min_efficiency" in req:
+        v = _number("requirements.min_efficiency", req["min_efficiency"], float)
+        if not 0 < v < 1:
+            raise DesignError("requirements.min_efficiency", f"must be a share in (0, 1), got {v:g}")
+        vals["min_efficiency"] = v
     if "min_clearance_um" in req:
         vals["min_clearance_um"] = _number("requirements.min_clearance_um", req["min_clearance_um"], float)
     if "lost_motion_arcmin" in req:
@@ -299,9 +309,6 @@ def parse_requirements(data: dict, path: Path) -> Requirements:
 
 def load_requirements(path) -> Requirements:
     """Read and check a requirements file (regular file, size-limited like a design file)."""
-    from ..design.files import MAX_DESIGN_BYTES
-    from ..userfiles import read_user_text
-
     path = Path(path)
     text = read_user_text(path, "requirements file", MAX_DESIGN_BYTES, "TOML")
     return parse_requirements(parse_toml(text, path, "requirements file"), path)

@@ -16,12 +16,13 @@ from __future__ import annotations
 
 import math
 import time
-from dataclasses import field
+from dataclasses import dataclass, field
 from itertools import product
 
 from ..design import load_design
 from ..errors import WgcadError
-from ..records import record
+from ..extras import require
+from ..sweep.runner import close_cluster, local_cluster
 from .evaluate import PEAK, RATED, STAGES, Evaluation, evaluate
 from .requirements import OBJECTIVES, Requirements
 
@@ -54,7 +55,7 @@ def constraint_names(req: Requirements) -> list[str]:
     return names
 
 
-@record
+@dataclass(slots=True)
 class SearchResult:
     """Every candidate judged (resumed ones included), the feasible ones ranked, and how the search ran."""
 
@@ -176,8 +177,8 @@ def _tell(study, trial, ev: Evaluation, req: Requirements, names: list) -> None:
 
 
 def _client(workers: int, scheduler):
-    """``(client, cluster, description)``: None for one worker in this process."""
-    if scheduler is None and workers <= 1:
+    """``(client, cluster, description)``: None for ``workers`` 0, in this process (the rule of ``sweep`` too)."""
+    if scheduler is None and workers == 0:
         return None, None, "this process"
     from distributed import Client
 
@@ -186,19 +187,21 @@ def _client(workers: int, scheduler):
             return Client(scheduler, timeout="20s"), None, f"Dask scheduler {scheduler}"
         except (OSError, TimeoutError) as e:
             raise WgcadError(f"--scheduler {scheduler}: cannot reach the Dask scheduler ({e})") from None
-    from ..sweep.runner import local_cluster
 
     cluster = local_cluster(workers)
     return Client(cluster), cluster, f"Dask LocalCluster, {workers} processes on loopback"
 
 
 def run_search(
-    req: Requirements, out_dir=None, workers: int = 1, scheduler=None, progress=None, explain: bool = True
+    req: Requirements, out_dir=None, workers: int = 0, scheduler=None, progress=None, explain: bool = True
 ) -> SearchResult:
     """Search the free keys of ``req`` (module docstring); ``progress(done, total)`` after every candidate.
 
     ``explain``: judge the best candidate's neighbours too, to say what holds each chosen key
     (:func:`_what_holds`: two more candidates per key, not counted in the budget)."""
+    require("design")
+    if scheduler is not None or workers >= 1:
+        require("sweep", what="--workers" if scheduler is None else "--scheduler")
     import optuna
 
     optuna.logging.set_verbosity(optuna.logging.WARNING)
@@ -233,8 +236,9 @@ def run_search(
         if client is None:
             return [evaluate(base, req.free, c, req) for c in cands]
         n = len(cands)
-        return client.gather(client.map(evaluate, [base] * n, [req.free] * n, cands, [req] * n, pure=False))
+        return _results(client, client.map(evaluate, [base] * n, [req.free] * n, cands, [req] * n, pure=False))
 
+    interrupted = False
     try:
         while len(evaluations) < budget:
             n = min(max(1, workers), budget - len(evaluations))
@@ -246,11 +250,14 @@ def run_search(
                     progress(len(evaluations), budget)
         ranked, front = _rank(req, [ev for ev in evaluations if ev.feasible])
         held = _what_holds(req, ranked[0], judge) if ranked and explain else {}
+    except KeyboardInterrupt:  # Ctrl-C, or SIGTERM / SIGHUP as the CLI raises them
+        interrupted = True
+        raise
     finally:
         if client is not None:
             client.close()
         if cluster is not None:
-            cluster.close()
+            close_cluster(cluster, interrupted)
     return SearchResult(
         req=req,
         evaluations=evaluations,
@@ -263,6 +270,26 @@ def run_search(
         resumed=resumed,
         held=held,
     )
+
+
+def _results(client, futures: list) -> list:
+    """The futures' results in their order, each taken as it finishes (as a sweep's chunks are,
+    :func:`wgcad.sweep.runner._collect`); on an interruption (Ctrl-C, SIGTERM) or a failed task the futures still
+    pending are cancelled before the exception goes on. ``Client.gather`` instead leaves its waiting coroutines on
+    the client's event loop, and closing the client then logs each one's traceback ("Task exception was never
+    retrieved")."""
+    from distributed import as_completed
+
+    index = {f.key: k for k, f in enumerate(futures)}
+    out = [None] * len(futures)
+    try:
+        for f in as_completed(futures):
+            out[index[f.key]] = f.result()
+    except BaseException:
+        for f in futures:
+            f.cancel()
+        raise
+    return out
 
 
 def _what_holds(req: Requirements, best: Evaluation, judge) -> dict:

@@ -1,14 +1,18 @@
-"""The part set of a drive: cup flexspline, wave-generator plug, rigid gear with flange, deformed assembly; each as DXF layers, a B-rep solid and a mesh.
+"""The part set of a drive: cup flexspline, wave-generator plug, rigid gear with flange, deformed assembly; each as DXF layers and one recipe its solid and mesh derive from.
 
 A :class:`Part` holds what every exporter needs: its 2D drawing
-(:class:`~wgcad.export.dxf.DxfLayer` list, top view, mm), a recipe for its
-OpenCASCADE solid (built only when STEP is asked for: OCP is imported
-lazily) and for its mesh (manifold3d), and the volume expected from its 2D
-areas so every export can be checked against it.
+(:class:`~wgcad.export.dxf.DxfLayer` list, top view, mm), its recipe
+(:mod:`~wgcad.export.parts.recipe`: loops of the exact curves swept into
+walls, closed by caps), from which the OpenCASCADE solid (build123d, built
+only when STEP or an object is asked for) and the mesh both derive, and the
+volume expected from its 2D areas so every export can be checked against it.
 """
 
 from __future__ import annotations
 
+from wgcad.sector.built import built_gear
+
+from . import assembly, bodies
 from .part import Part
 
 __all__ = ["Part", "build_parts"]
@@ -32,16 +36,12 @@ def build_parts(drive, sizes, style: str = "arcs", tol: float | None = None, gen
     -------
     list of Part
     """
-    from . import assembly, bodies
-
     tol = drive.tol if tol is None else tol
     sectored = None
     if drive.design.sectors.active:
-        # a sectored design's rigid gear is the sectored one, teeth at the heights the design builds (issue 23:
+        # a sectored design's rigid gear is the sectored one, teeth at the heights the design builds (once:
         # the part set wrote the plain gear of z_rigid teeth without a word)
-        from wgcad.sector.run import run_sector
-
-        sectored = run_sector(drive.design, audits=False)
+        sectored = built_gear(drive.design, drive=drive)
     out = [
         bodies.flexspline(drive, sizes, style, tol),
         bodies.plug(drive, sizes, tol),

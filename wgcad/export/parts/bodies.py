@@ -5,19 +5,21 @@ from __future__ import annotations
 import math
 
 import numpy as np
+import shapely
 
 from wgcad.errors import DesignError
-from wgcad.export.arcs import fit_gear, path_area
+from wgcad.export.arcs import fit_closed_curve, fit_gear, path_area
 from wgcad.export.dxf import DxfLayer
 from wgcad.export.gear_data import data_lines, gear_data
+from wgcad.placement import deformed_curve
 from wgcad.plane import signed_area
 from wgcad.profiles.band import gear_band_outline
 
-from . import breps
 from .part import Part
-from .solids import bolt_circle, circle_points, holes_m, loft_m, n_segments, prism_m, revolve_m, to_mesh
+from .recipe import Body, Cap, Wall, circle_loop, path_loop, polygon_loop, prism
+from .solids import bolt_circle
 
-__all__ = ["flexspline", "plug", "rigid", "plug_outline", "data_layer"]
+__all__ = ["flexspline", "plug", "rigid", "plug_outline", "plug_arcs", "data_layer"]
 
 PI = math.pi
 
@@ -42,6 +44,7 @@ def data_layer(
             "full_height_mm": full,
             "tooth_heights_mm": [round(float(h), 6) for h in built],
             "tooth_sector_kinds": kind_of,
+            "layout": _sector_table(lay),
         }
         # the plain gear's tooth count and its span or pin dimension are not this gear's: its teeth have other
         # heights and pitches by sector (a pin dimension over lowered teeth checks nothing)
@@ -53,17 +56,46 @@ def data_layer(
         lines.insert(2, f"SECTORED: {lay.n_teeth} teeth in sectors ({sectored['mode']} heights; full {full:.4f} mm)")
         lowered = np.nonzero(built < full - 1e-6)[0]
         lines.insert(3, f"lowered teeth: {len(lowered)} of {lay.n_teeth} (every height in the part set's JSON)")
+        # the base gear's tip circle is the full teeth's only: a lowered tooth's tip stands at the root less its height
+        k = next(i for i, line in enumerate(lines) if line.startswith("tip diameter ="))
+        lines[k] = lines[k].replace("tip diameter =", "tip diameter (full teeth) =")
+        if lowered.size:
+            d = 2.0 * (gear.r_f - built[lowered])
+            lines.insert(k + 1, f"tip diameters, lowered teeth = {d.min():.4f} .. {d.max():.4f} mm")
         for kind in dict.fromkeys(kind_of):
             sel = np.array([k == kind for k in kind_of])
-            lines.insert(4, f"  {kind} teeth: heights {built[sel].min():.4f} .. {built[sel].max():.4f} mm")
+            rows = [r for r in data["sectors"]["layout"] if r["kind"] == kind]
+            counts = sorted({r["teeth"] for r in rows})
+            pitch = sorted({r["pitch_deg"] for r in rows})
+            lines.insert(
+                4,
+                f"  {kind}: {len(rows)} x {'/'.join(map(str, counts))} teeth at "
+                f"{'/'.join(f'{q:.4f}' for q in pitch)} deg pitch, heights {built[sel].min():.4f} .. "
+                f"{built[sel].max():.4f} mm",
+            )
     texts = tuple((x, y - 1.6 * height * k, height, line) for k, line in enumerate(lines))
     return DxfLayer("GEAR_DATA", texts=texts, color=7), data, lines
 
 
+def _sector_table(lay) -> list:
+    """Each sector of the layout as the drawing states it: kind, teeth, angular pitch (the sectors' pitches differ,
+    so the base gear's tooth count says nothing of them) and where it starts, degrees counter-clockwise."""
+    rows = []
+    for s, kind in enumerate(lay.kinds):
+        sel = lay.sector == s
+        rows.append(
+            {
+                "kind": str(kind),
+                "teeth": int(sel.sum()),
+                "pitch_deg": round(float(np.rad2deg(lay.pitch[sel][0])), 6),
+                "start_deg": round(float(np.rad2deg(lay.bounds[s])), 6),
+            }
+        )
+    return rows
+
+
 def _band(gear):
     """The toothed outline as polyline: a symmetric band around the exact curves (docs/models.md, appendix A)."""
-    from wgcad.profiles.band import gear_band_outline
-
     return gear_band_outline(gear)
 
 
@@ -84,8 +116,6 @@ def _pappus(rz) -> float:
 
 def flexspline(drive, sizes, style: str, tol: float) -> Part:
     """The cup flexspline (internal deformation) or the internally toothed flexible ring (external)."""
-    from wgcad.export import step as S
-
     g = drive.flex
     d = drive.design
     bw = d.drive.face_width
@@ -104,19 +134,9 @@ def flexspline(drive, sizes, style: str, tol: float) -> Part:
         layers.append(DxfLayer("FLEXSPLINE_OUTER", circles=((0.0, 0.0, R),), color=5))
         layers.append(gl)
         vol = (PI * R * R - area) * bw
-
-        def solid():
-            return S.prism(S.circle_wire(R), [S.wire_from_path(path.vertices, path.bulges)], bw)
-
-        def mesh():
-            return to_mesh(prism_m(circle_points(R, tol), [band], 0.0, bw))
-
-        def brep():
-            teeth, _ = breps.teeth_loop(path, material_left=False)
-            return breps.ring(breps.circle_loop(0.0, 0.0, R), [teeth], 0.0, bw)
-
+        body = prism(circle_loop(R, tol, "rim"), [path_loop(path, band, "teeth")], 0.0, bw)
         info["kind"] = "toothed flexible ring (external deformation: no cup)"
-        return Part("flexspline", layers, solid, mesh, vol, ((-R, -R, 0.0), (R, R, bw)), info, make_brep=brep)
+        return Part("flexspline", layers, {"flexspline": (body,)}, vol, ((-R, -R, 0.0), (R, R, bw)), info)
     L, ts, td = sizes.cup_length, sizes.shell_thickness, sizes.diaphragm_thickness
     r_bore = 0.5 * sizes.hub_bore_diameter
     holes = bolt_circle(sizes.cup_bolt_circle_diameter, sizes.cup_bolt_count, sizes.cup_bolt_hole_diameter)
@@ -130,27 +150,61 @@ def flexspline(drive, sizes, style: str, tol: float) -> Part:
         gl,
     ]
     if drive.face_taper:
-        return _modified_cup(drive, sizes, tol, (layers, info), rz, holes, shell)
+        return _modified_cup(drive, sizes, tol, (layers, info), holes, shell)
     vol = (area - PI * r_rim**2) * bw + shell
-
-    def solid():
-        # holes first, in the small shell: booleans cost grows with the faces involved
-        ring = S.prism(S.wire_from_path(path.vertices, path.bulges), [S.circle_wire(r_rim)], bw)
-        return S.fuse(ring, S.drill(S.revolve_profile(rz), holes, L - td, L), touching=True)
-
-    def mesh():
-        ring = prism_m(band, [circle_points(r_rim, tol)], 0.0, bw)
-        n = n_segments(r_rim + ts, tol)
-        return to_mesh(ring + (revolve_m(rz, n) - holes_m(holes, L - td, L, tol)))
-
-    def brep():
-        teeth, radii = breps.teeth_loop(path)
-        return breps.cup(teeth, radii, r_rim, ts, L, td, r_bore, holes, bw)
-
+    body = _cup(drive, sizes, tol, Wall(path_loop(path, band, "teeth"), 0.0, bw, True), holes)
     info.update(_cup_info(sizes, r_bore))
-    return Part(
-        "flexspline", layers, solid, mesh, vol, ((-tip_r, -tip_r, 0.0), (tip_r, tip_r, L)), info, make_brep=brep
+    return Part("flexspline", layers, {"flexspline": (body,)}, vol, ((-tip_r, -tip_r, 0.0), (tip_r, tip_r, L)), info)
+
+
+#: how far apart the faces of a part must stay where its recipe joins them (mm), far above the kernel's 1e-7 mm
+MARGIN = 1e-3
+
+
+def _cup(drive, sizes, tol: float, teeth: Wall, holes) -> Body:
+    """The cup flexspline's body: the toothed ring (``teeth``, bore ``r_rim``, ``0 <= z <= bw``) with the cup on it
+    (shell ``r_rim .. r_rim + ts`` up to ``z = L``, diaphragm ``L - td .. L`` with the hub bore and bolt holes).
+
+    One bore face runs from the ring's open end to the diaphragm; the ring's top face is the annulus between the
+    teeth and the shell.
+    """
+    bw = drive.design.drive.face_width
+    r_rim, L = drive.flex_rim_radius, sizes.cup_length
+    ts, td, r_bore = sizes.shell_thickness, sizes.diaphragm_thickness, 0.5 * sizes.hub_bore_diameter
+    roots = min(float(np.hypot(*w.polygon.T).min()) for w in (teeth.loop, teeth.top or teeth.loop))
+    if not roots > r_rim + ts + MARGIN:
+        raise DesignError("parts.shell_thickness", f"{ts:g} mm reaches the tooth roots (radius {roots:.4f} mm)")
+    _holes_fit(holes, r_bore, r_rim, "parts.cup_bolt_circle_diameter")
+    walls = (
+        teeth,
+        Wall(circle_loop(r_rim, tol, "bore"), 0.0, L - td, False),
+        Wall(circle_loop(r_rim + ts, tol, "shell"), bw, L, True),
+        Wall(circle_loop(r_bore, tol, "hub_bore"), L - td, L, False),
+        *(Wall(circle_loop(0.5 * d, tol, "bolt_holes", x, y), L - td, L, False) for x, y, d in holes),
     )
+    bolts = tuple((i, False) for i in range(4, len(walls)))
+    return Body(
+        walls,
+        (
+            Cap(0.0, False, ((0, True), (1, False)), "end"),
+            Cap(bw, True, ((0, True), (2, False)), "rim_end"),
+            Cap(L, True, ((2, True), (3, False), *bolts), "diaphragm"),
+            Cap(L - td, False, ((1, True), (3, False), *bolts), "diaphragm_inside"),
+        ),
+    )
+
+
+def _holes_fit(holes, r_in: float, r_out: float, field: str) -> None:
+    """Bolt holes ``(cx, cy, d)`` strictly inside the annulus ``r_in < r < r_out`` and clear of each other, or a
+    :class:`DesignError` on ``field`` (the sizes' own rules keep them so: this guards the faces the recipe joins)."""
+    if not holes:
+        return
+    h = np.asarray(holes, dtype=float)
+    rc, r = np.hypot(h[:, 0], h[:, 1]), 0.5 * h[:, 2]
+    gap = np.hypot(*(h[:, None, :2] - h[None, :, :2]).transpose(2, 0, 1)) - (r[:, None] + r[None, :])
+    np.fill_diagonal(gap, np.inf)
+    if np.any(rc - r <= r_in + MARGIN) or np.any(rc + r >= r_out - MARGIN) or not np.all(gap > MARGIN):
+        raise DesignError(field, f"the bolt holes leave the annulus {2 * r_in:.4f} .. {2 * r_out:.4f} mm or touch")
 
 
 def face_modification(drive) -> dict:
@@ -188,7 +242,7 @@ def _cup_info(sizes, r_bore: float) -> dict:
     }
 
 
-def _modified_cup(drive, sizes, tol: float, drawn: tuple, rz, holes, shell: float) -> Part:
+def _modified_cup(drive, sizes, tol: float, drawn: tuple, holes, shell: float) -> Part:
     """The cup flexspline whose teeth are offset along the face (docs/models.md 13.4): the toothed ring lofted.
 
     The offset is linear in z and moves each tooth rigidly, so every point of the outline moves on a straight
@@ -196,8 +250,6 @@ def _modified_cup(drive, sizes, tol: float, drawn: tuple, rz, holes, shell: floa
     between corresponding arcs; mesh: the band outlines joined vertex to vertex). The drawing shows the
     reference section, where the offset is zero, and says how the teeth move from it.
     """
-    from wgcad.export import step as S
-
     g = drive.flex
     bw = drive.design.drive.face_width
     layers, info = drawn
@@ -207,34 +259,13 @@ def _modified_cup(drive, sizes, tol: float, drawn: tuple, rz, holes, shell: floa
     # the section's area is quadratic in the offset, the offset linear in z: Simpson's rule is exact
     areas = [abs(path_area(fit_gear(g, tol, drive.tooth_offset(z)))) for z in (0.0, 0.5 * bw, bw)]
     vol = bw * (areas[0] + 4 * areas[1] + areas[2]) / 6.0 - PI * r_rim**2 * bw + shell
-
-    def solid():
-        wires = [S.wire_from_path(p.vertices, p.bulges, z) for p, z in zip((fit_gear(g, tol, o) for o in offs), ends)]
-        ring = S.cut(S.loft(wires), S.cylinder(r_rim, -1.0, bw + 1.0))
-        return S.fuse(ring, S.drill(S.revolve_profile(rz), holes, L - sizes.diaphragm_thickness, L), touching=True)
-
-    def mesh():
-        bands = [gear_band_outline(g, offset=o) for o in offs]
-        n = n_segments(r_rim + sizes.shell_thickness, tol)
-        # the bore cut by a solid of revolution with the shell's own segments: where the ring meets the
-        # shell their vertices are then the same numbers (a bore polygon of its own leaves 2e-9 mm slivers)
-        bore = revolve_m(np.array([[0.0, -1.0], [r_rim, -1.0], [r_rim, bw + 1.0], [0.0, bw + 1.0]]), n)
-        ring = loft_m(bands[0], bands[1], 0.0, bw) - bore
-        return to_mesh(ring + (revolve_m(rz, n) - holes_m(holes, L - sizes.diaphragm_thickness, L, tol)))
-
-    def brep():
-        (l0, r0), (l1, r1) = (breps.teeth_loop(fit_gear(g, tol, o)) for o in offs)
-        teeth_r = np.concatenate([r0, r1])
-        td = sizes.diaphragm_thickness
-        r_bore = 0.5 * sizes.hub_bore_diameter
-        return breps.cup((l0, l1), teeth_r, r_rim, sizes.shell_thickness, L, td, r_bore, holes, bw)
-
+    # the sections at both ends: the same arcs and band vertices moved, so they correspond one to one
+    l0, l1 = (path_loop(fit_gear(g, tol, o), gear_band_outline(g, offset=o), "teeth") for o in offs)
+    body = _cup(drive, sizes, tol, Wall(l0, 0.0, bw, True, top=l1), holes)
     info.update(_cup_info(sizes, 0.5 * sizes.hub_bore_diameter))
     info["face_modification"] = face_modification(drive)
     tip_r = float(np.hypot(*g.outline.T).max()) + max(0.0, *offs)
-    return Part(
-        "flexspline", layers, solid, mesh, vol, ((-tip_r, -tip_r, 0.0), (tip_r, tip_r, L)), info, make_brep=brep
-    )
+    return Part("flexspline", layers, {"flexspline": (body,)}, vol, ((-tip_r, -tip_r, 0.0), (tip_r, tip_r, L)), info)
 
 
 def plug_outline(drive, sizes, n: int | None = None) -> dict:
@@ -253,8 +284,6 @@ def plug_outline(drive, sizes, n: int | None = None) -> dict:
         ``outline (n, 2)``, ``neutral (n, 2)``, ``offset_mm`` (signed, from
         the neutral line), ``z_mm`` (generator section), ``phi (n,)``.
     """
-    from wgcad.placement import deformed_curve
-
     d = drive.design
     bw = d.drive.face_width
     z_g = d.generator.generator_z if d.generator.generator_z is not None else 0.5 * bw
@@ -279,8 +308,6 @@ def plug_outline(drive, sizes, n: int | None = None) -> dict:
 
 def _chord_sagitta(law, r_m: float, off: float, n: int) -> float:
     """Largest distance of the offset curve from its ``n`` equal-angle chords, at the chords' middle angles, mm."""
-    from wgcad.placement import deformed_curve
-
     ph = np.linspace(0.0, 2 * np.pi, n, endpoint=False)
     a = deformed_curve(law, r_m, off, ph)
     ab = np.roll(a, -1, axis=0) - a
@@ -288,12 +315,9 @@ def _chord_sagitta(law, r_m: float, off: float, n: int) -> float:
     return float(np.max(np.abs(ab[:, 0] * m[:, 1] - ab[:, 1] * m[:, 0]) / np.hypot(ab[:, 0], ab[:, 1])))
 
 
-def _plug_arcs(drive, po: dict, tol: float):
-    """The plug's (generator ring's) outline as tangent arcs within ``tol`` (issue 23: 1440 straight segments in the
+def plug_arcs(drive, po: dict, tol: float):
+    """The plug's (generator ring's) outline as tangent arcs within ``tol`` (once: 1440 straight segments in the
     DXF where the README promised arcs): the same offset of the law's neutral line, fitted against the law itself."""
-    from wgcad.export.arcs import fit_closed_curve
-    from wgcad.placement import deformed_curve
-
     law = drive.law_at(po["z_mm"]) if drive.coned else drive.law
     return fit_closed_curve(lambda t: deformed_curve(law, drive.r_m, po["offset_mm"], t), tol)
 
@@ -330,10 +354,6 @@ def _min_curvature_radius(pts: np.ndarray) -> float:
 
 def plug(drive, sizes, tol: float) -> Part:
     """The wave-generator plug (internal deformation) or generator ring (external), with its bearing seat outline."""
-    import shapely
-
-    from wgcad.export import step as S
-
     po = plug_outline(drive, sizes)
     outline, off = po["outline"], po["offset_mm"]
     width = sizes.bearing_width
@@ -360,7 +380,10 @@ def plug(drive, sizes, tol: float) -> Part:
         "plug_major_diameter_mm": 2 * float(radii.max()),
         "plug_minor_diameter_mm": 2 * float(radii.min()),
     }
-    area = abs(shapely.Polygon(outline).area)
+    # the tangent arcs the drawing has, within the chord tolerance of the law's curve: the solid's outline too (planes
+    # and cylinders, whose volume OpenCASCADE integrates exactly; a B-spline face's it integrates to ~1e-4 only)
+    arcs = plug_arcs(drive, po, tol)
+    area = abs(path_area(arcs))
     perim = float(np.sum(np.hypot(*(np.roll(outline, -1, axis=0) - outline).T)))
     if not drive.external:
         bore_d = (
@@ -376,90 +399,60 @@ def plug(drive, sizes, tol: float) -> Part:
         vol = (area - PI * r_b**2) * width
         info["plug_bore_diameter_mm"] = bore_d
         layers = [
-            DxfLayer("PLUG", paths=(_plug_arcs(drive, po, tol),), color=2),
+            DxfLayer("PLUG", paths=(arcs,), color=2),
             DxfLayer("PLUG_BORE", circles=((0.0, 0.0, r_b),), color=2),
             DxfLayer("NEUTRAL_LINE", outlines=(po["neutral"],), color=3, construction=True),
             _plug_data(drive, sizes, info, "plug", radii, tol),
         ]
         name = "plug"
-
-        def solid():
-            return S.prism(S.bspline_wire(outline), [S.circle_wire(r_b)], width, z0)
-
-        def brep():
-            return breps.plug(outline, r_b, z0, z1)
-
-        def mesh():
-            return to_mesh(prism_m(outline, [circle_points(r_b, tol)], z0, z1))
-
+        body = prism(path_loop(arcs, outline, "seat"), [circle_loop(r_b, tol, "bore")], z0, z1)
         rmax = float(radii.max())
     else:
         R_out = float(radii.max()) + max(2.0, sizes.bearing_thickness)
         vol = (PI * R_out**2 - area) * width
         info["ring_outer_diameter_mm"] = 2 * R_out
         layers = [
-            DxfLayer("GENERATOR_RING", paths=(_plug_arcs(drive, po, tol),), circles=((0.0, 0.0, R_out),), color=2),
+            DxfLayer("GENERATOR_RING", paths=(arcs,), circles=((0.0, 0.0, R_out),), color=2),
             DxfLayer("NEUTRAL_LINE", outlines=(po["neutral"],), color=3, construction=True),
             _plug_data(drive, sizes, info, "generator ring", radii, tol),
         ]
         name = "generator_ring"
-
-        def solid():
-            return S.prism(S.circle_wire(R_out), [S.bspline_wire(outline)], width, z0)
-
-        def brep():
-            return breps.generator_ring(outline, R_out, z0, z1)
-
-        def mesh():
-            return to_mesh(prism_m(circle_points(R_out, tol), [outline], z0, z1))
-
+        body = prism(circle_loop(R_out, tol, "rim"), [path_loop(arcs, outline, "seat")], z0, z1)
         rmax = R_out
-    info["volume_tol_mm3"] = tol * perim * width  # outline known to the chord tolerance along its whole length
+    info["volume_tol_mm3"] = tol * perim * width  # the arcs known to the chord tolerance along the whole outline
     info["plug_outline"] = outline
     info["neutral_line"] = po["neutral"]
-    return Part(name, layers, solid, mesh, vol, ((-rmax, -rmax, z0), (rmax, rmax, z1)), info, make_brep=brep)
+    return Part(name, layers, {name: (body,)}, vol, ((-rmax, -rmax, z0), (rmax, rmax, z1)), info)
 
 
 def _rigid_teeth(drive, style: str, tol: float, sectored: dict | None) -> tuple:
-    """The rigid gear's toothed outline: ``(arc path or None, band, area, STEP wire builder, DXF layer builder)``,
-    of the design's gear or of the sectored one."""
-    from wgcad.export import step as S
-
+    """The rigid gear's toothed outline: ``(loop, area, DXF layer builder)``, of the design's gear or of the sectored
+    one (its outline the polygon of its band)."""
     g = drive.rigid
     if sectored is None:
         path = fit_gear(g, tol)
         band = _band(g)
         return (
-            path,
-            band,
+            path_loop(path, band, "teeth"),
             abs(path_area(path)),
-            lambda: S.wire_from_path(path.vertices, path.bulges),
             lambda: _teeth_layer("RIGID", g, path, style, 1, band),
         )
     if drive.external:
         raise DesignError("sectors", "a sectored rigid gear is built for internal deformation only")
     band = np.asarray(sectored["outline"], dtype=float)
-    return (
-        None,
-        band,
-        abs(signed_area(band)),
-        lambda: S.wire_from_polygon(band),
-        lambda: DxfLayer("RIGID", outlines=(band,), color=1),
-    )
+    return polygon_loop(band, "teeth"), abs(signed_area(band)), lambda: DxfLayer("RIGID", outlines=(band,), color=1)
 
 
 def rigid(drive, sizes, style: str, tol: float, sectored: dict | None = None) -> Part:
     """The rigid gear: internal teeth in a ring with a bolted mounting flange (internal deformation) or external teeth on a bolted hub.
 
-    ``sectored`` (:func:`wgcad.sector.run.run_sector` with ``audits=False``):
+    ``sectored`` (:func:`wgcad.sector.built.built_gear`):
     the sectored rigid gear of a design with ``[sectors]``, its teeth at the
     heights built, its outline the symmetric chord band of its curves.
     """
-    from wgcad.export import step as S
-
     g = drive.rigid
     bw = drive.design.drive.face_width
-    path, band, area, teeth_wire, teeth_layer = _rigid_teeth(drive, style, tol, sectored)
+    teeth, area, teeth_layer = _rigid_teeth(drive, style, tol, sectored)
     R = drive.rigid_rim_radius
     dh = sizes.flange_bolt_hole_diameter
     holes = bolt_circle(
@@ -489,27 +482,7 @@ def rigid(drive, sizes, style: str, tol: float, sectored: dict | None = None) ->
         if sectored is not None:
             kind = f"sectored rigid gear with mounting flange ({sectored['mode']} tooth heights)"
         info.update({"kind": kind, "flange_outer_diameter_mm": 2 * Rf, "flange_thickness_mm": tf})
-
-        def solid():
-            # the whole gear at flange size, then the flange's excess cut away below it: a fuse of two
-            # prisms would share every tooth face (coincident faces are the slow case of OCCT booleans)
-            teeth = teeth_wire()
-            body = S.prism(S.circle_wire(Rf), [teeth] + [S.circle_wire(0.5 * h, x, y) for x, y, h in holes], bw)
-            if tf >= bw:
-                return body
-            return S.cut(body, S.prism(S.circle_wire(Rf + 1.0), [S.circle_wire(R)], bw - tf + 1.0, -1.0))
-
-        def brep():
-            teeth, radii = breps.teeth_loop(path, None if path is not None else band, material_left=False)
-            return breps.flanged(teeth, radii, R, Rf, holes, bw, tf)
-
-        def mesh():
-            plate = prism_m(
-                circle_points(Rf, tol), [band] + [circle_points(0.5 * h, tol, x, y) for x, y, h in holes], bw - tf, bw
-            )
-            if tf >= bw:
-                return to_mesh(plate)
-            return to_mesh(prism_m(circle_points(R, tol), [band], 0.0, bw - tf) + plate)
+        body = _flanged(teeth, R, Rf, [circle_loop(0.5 * h, tol, "bolt_holes", x, y) for x, y, h in holes], bw, tf, tol)
     else:
         tip_r = float(np.hypot(*g.outline.T).max())
         vol = (area - PI * R * R - hole_area) * bw
@@ -521,24 +494,37 @@ def rigid(drive, sizes, style: str, tol: float, sectored: dict | None = None) ->
             gl,
         ]
         info["kind"] = "rigid gear (external teeth) with bolted hub"
-
-        def solid():
-            return S.prism(
-                S.wire_from_path(path.vertices, path.bulges),
-                [S.circle_wire(R)] + [S.circle_wire(0.5 * h, x, y) for x, y, h in holes],
-                bw,
-            )
-
-        def mesh():
-            return to_mesh(
-                prism_m(
-                    band, [circle_points(R, tol)] + [circle_points(0.5 * h, tol, x, y) for x, y, h in holes], 0.0, bw
-                )
-            )
-
-        def brep():
-            teeth, _ = breps.teeth_loop(path)
-            return breps.ring(teeth, [breps.circle_loop(0.0, 0.0, R, False), *breps.hole_loops(holes)], 0.0, bw)
-
+        bolts = [circle_loop(0.5 * h, tol, "bolt_holes", x, y) for x, y, h in holes]
+        body = prism(teeth, [circle_loop(R, tol, "bore"), *bolts], 0.0, bw)
     info["gear_data"] = data
-    return Part("rigid", layers, solid, mesh, vol, ((-tip_r, -tip_r, 0.0), (tip_r, tip_r, bw)), info, make_brep=brep)
+    return Part("rigid", layers, {"rigid": (body,)}, vol, ((-tip_r, -tip_r, 0.0), (tip_r, tip_r, bw)), info)
+
+
+def _flanged(teeth, R: float, Rf: float, bolts: list, bw: float, tf: float, tol: float) -> Body:
+    """The internal rigid gear's body: teeth inside a ring of radius ``R`` over ``0 <= z <= bw - tf`` and the flange
+    of radius ``Rf`` with its bolt holes over ``bw - tf <= z <= bw``; one tooth face runs the whole width."""
+    reach = float(np.hypot(*teeth.polygon.T).max())
+    if not reach < min(R, Rf) - MARGIN:
+        raise DesignError("parts.flange_outer_diameter", f"the teeth reach radius {reach:.4f} mm, the rim {R:.4f} mm")
+    flange = circle_loop(Rf, tol, "flange")
+    if tf >= bw:
+        return prism(flange, [teeth, *bolts], 0.0, bw)
+    if not Rf > R + MARGIN:
+        raise DesignError("parts.flange_outer_diameter", f"{2 * Rf:g} mm must exceed the rim's {2 * R:.4f} mm")
+    _holes_fit([(*b.vertices[0], 2 * b.radius) for b in bolts], R, Rf, "parts.flange_bolt_circle_diameter")
+    zs = bw - tf
+    walls = (
+        Wall(teeth, 0.0, bw, False),
+        Wall(circle_loop(R, tol, "rim"), 0.0, zs, True),
+        Wall(flange, zs, bw, True),
+        *(Wall(b, zs, bw, False) for b in bolts),
+    )
+    holes = tuple((i, False) for i in range(3, len(walls)))
+    return Body(
+        walls,
+        (
+            Cap(0.0, False, ((1, True), (0, False)), "end"),
+            Cap(zs, False, ((2, True), (1, False), *holes), "flange_face"),
+            Cap(bw, True, ((2, True), (0, False), *holes), "end"),
+        ),
+    )

@@ -6,6 +6,8 @@ from pathlib import Path
 
 import numpy as np
 
+from wgcad import __version__
+
 from ..dxf import DxfLayer
 
 __all__ = ["TITLES", "drawing_extents", "title_layer"]
@@ -35,8 +37,6 @@ def drawing_extents(layers) -> tuple[float, float, float, float]:
 
 def title_layer(part_name: str, design, source, layers, tol: float) -> DxfLayer:
     """The ``TITLE`` text layer, below the drawing's extents (left-aligned with them)."""
-    from wgcad import __version__
-
     x0, y0, x1, y1 = drawing_extents(layers)
     heights = [t[2] for lay in layers for t in lay.texts]
     h = 1.25 * max(heights) if heights else max(0.5, round(0.012 * max(x1 - x0, y1 - y0), 1))

@@ -1,0 +1,188 @@
+"""Mutation testing of the core with mutmut: how many small wrong edits of a module its tests notice.
+
+mutmut (``pip install mutmut``; not a dependency of wgcad or of its tests) makes one mutant per small edit of a
+module (an operator flipped, a constant moved by one, a keyword dropped, an attribute's name changed) and runs the
+tests that cover the module against each; a mutant no test fails on *survived*: a behaviour of the code no test
+pins. Run from the repository root:
+
+    .venv/bin/python benchmarks/mutation.py                       # every module set below (hours on 2 cores)
+    .venv/bin/python benchmarks/mutation.py --only laws,ring      # some sets
+    .venv/bin/python benchmarks/mutation.py --module wgcad/laws/harmonic.py --tests tests/test_laws.py
+
+The checkout's working tree (uncommitted changes included) is copied to a temporary folder, mutmut runs there
+(its ``mutants/`` folder stays out of the checkout) with the set's modules and only the set's tests, within
+``--budget-min`` minutes a set, and the survivors are written with their diffs to
+``output/mutation/<set>.md`` (a Markdown report) and the counts to ``output/mutation/summary.json``. Survivors
+that change no behaviour (equivalent mutants) are listed in docs/mutation.md with the reason; the others are
+killed by tests that check behaviour.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import re
+import shutil
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parent.parent
+OUT = ROOT / "output" / "mutation"
+
+#: the module sets: name -> (modules to mutate, the tests that cover them)
+SETS = {
+    "laws": (
+        ["wgcad/laws/harmonic.py", "wgcad/laws/base.py", "wgcad/laws/coning.py"],
+        ["tests/test_laws.py", "tests/test_coning.py", "tests/test_law_checks.py"],
+    ),
+    "ring": (["wgcad/elastic/ring.py"], ["tests/test_elastic_ring.py", "tests/test_ring_checks.py"]),
+    "solve": (["wgcad/elastic/solve.py"], ["tests/test_elastic_solver.py", "tests/test_solver_checks.py"]),
+    "kinematics": (["wgcad/kinematics.py"], ["tests/test_kinematics.py", "tests/test_kinematics_checks.py"]),
+    "plane": (["wgcad/plane.py", "wgcad/units.py"], ["tests/test_placement.py", "tests/test_kinematics.py"]),
+}
+
+#: what is copied into the temporary folder (the tests read templates, docs and the README)
+COPY = ["wgcad", "tests", "templates", "docs", "examples", "freecad", "benchmarks", "README.md", "pyproject.toml"]
+
+
+def _mutmut() -> list[str]:
+    exe = Path(sys.executable).with_name("mutmut")
+    if not exe.exists():
+        sys.exit("benchmarks/mutation.py: mutmut is not installed here (pip install mutmut)")
+    return [str(exe)]
+
+
+def _config(modules, tests) -> str:
+    q = lambda xs: "[" + ", ".join(json.dumps(x) for x in xs) + "]"  # noqa: E731
+    return (
+        "\n[tool.mutmut]\n"
+        'source_paths = ["wgcad/"]\n'
+        f"only_mutate = {q(modules)}\n"
+        f"pytest_add_cli_args_test_selection = {q(tests)}\n"
+        f"also_copy = {q([c for c in COPY if c != 'wgcad'])}\n"
+    )
+
+
+def _copy(dst: Path) -> None:
+    ignore = shutil.ignore_patterns("__pycache__", "*.pyc", ".pytest_cache", "output", "_build", "mutants")
+    for name in COPY:
+        src = ROOT / name
+        if src.is_dir():
+            shutil.copytree(src, dst / name, ignore=ignore)
+        elif src.exists():
+            shutil.copy2(src, dst / name)
+
+
+_LINE = re.compile(r"^\s*(\S+): (\w[\w ]*)$")
+
+
+def run_set(name: str, modules, tests, children: int, budget_min: float) -> dict:
+    """Run mutmut on one set in a temporary copy; the counts, the survivors' diffs and the run time."""
+    mm = _mutmut()
+    with tempfile.TemporaryDirectory(prefix=f"wgcad-mut-{name}-") as tmp:
+        work = Path(tmp)
+        _copy(work)
+        with open(work / "pyproject.toml", "a", encoding="utf-8") as f:
+            f.write(_config(modules, tests))
+        env = {**os.environ, "OPENBLAS_NUM_THREADS": "1", "PYTHONWARNINGS": "ignore"}
+        t0 = time.perf_counter()
+        timed_out = False
+        try:
+            subprocess.run(
+                [*mm, "run", "--max-children", str(children)],
+                cwd=work,
+                env=env,
+                stdout=subprocess.DEVNULL,
+                stderr=subprocess.DEVNULL,
+                timeout=budget_min * 60.0,
+            )
+        except subprocess.TimeoutExpired:
+            timed_out = True
+        seconds = time.perf_counter() - t0
+        res = subprocess.run([*mm, "results", "--all", "true"], cwd=work, env=env, capture_output=True, text=True)
+        status = {}
+        for line in res.stdout.splitlines():
+            m = _LINE.match(line)
+            if m:
+                status[m.group(1)] = m.group(2)
+        survivors = []
+        for mutant, st in status.items():
+            if st in ("survived", "no tests", "timeout", "suspicious"):
+                diff = subprocess.run([*mm, "show", mutant], cwd=work, env=env, capture_output=True, text=True)
+                lines = [x for x in diff.stdout.splitlines() if x[:1] in "-+" and x[:3] not in ("---", "+++")]
+                survivors.append({"mutant": mutant, "status": st, "diff": lines})
+    counts = {}
+    for st in status.values():
+        counts[st] = counts.get(st, 0) + 1
+    total = len(status)
+    killed = counts.get("killed", 0)
+    return {
+        "set": name,
+        "modules": list(modules),
+        "tests": list(tests),
+        "mutants": total,
+        "counts": counts,
+        "score": round(killed / total, 4) if total else None,
+        "seconds": round(seconds, 1),
+        "budget_exhausted": timed_out,
+        "survivors": survivors,
+    }
+
+
+def _report(r: dict) -> str:
+    lines = [
+        f"# Mutation testing: {r['set']}",
+        "",
+        f"Modules: {', '.join(r['modules'])}; tests: {', '.join(r['tests'])}.",
+        f"{r['mutants']} mutants, {r['counts']}; score {r['score']} (killed / all) in {r['seconds']} s"
+        + (" (budget exhausted: not every mutant was run)" if r["budget_exhausted"] else "")
+        + ".",
+        "",
+    ]
+    for s in r["survivors"]:
+        lines += [f"## {s['mutant']} ({s['status']})", "", "```diff", *s["diff"], "```", ""]
+    return "\n".join(lines)
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--only", help="comma-separated set names: " + ", ".join(SETS))
+    ap.add_argument("--module", action="append", help="a module to mutate (with --tests: one ad-hoc set)")
+    ap.add_argument("--tests", action="append", help="a test file that covers --module")
+    ap.add_argument("--max-children", type=int, default=2, help="mutants run at once (default 2, one per core)")
+    ap.add_argument("--budget-min", type=float, default=60.0, help="minutes a set may take (default 60)")
+    args = ap.parse_args(argv)
+    if args.module:
+        if not args.tests:
+            ap.error("--module needs --tests (the tests that cover it)")
+        sets = {"adhoc": (args.module, args.tests)}
+    else:
+        names = args.only.split(",") if args.only else list(SETS)
+        unknown = [n for n in names if n not in SETS]
+        if unknown:
+            ap.error(f"--only: unknown set(s) {', '.join(unknown)}; the sets: {', '.join(SETS)}")
+        sets = {n: SETS[n] for n in names}
+    OUT.mkdir(parents=True, exist_ok=True)
+    summary_path = OUT / "summary.json"
+    summary = json.loads(summary_path.read_text()) if summary_path.exists() else {}
+    print("| set | mutants | killed | survived | other | score | s |\n|---|---|---|---|---|---|---|")
+    for name, (modules, tests) in sets.items():
+        r = run_set(name, modules, tests, args.max_children, args.budget_min)
+        (OUT / f"{name}.md").write_text(_report(r), encoding="utf-8")
+        summary[name] = {k: v for k, v in r.items() if k != "survivors"} | {"survived": len(r["survivors"])}
+        c = r["counts"]
+        other = r["mutants"] - c.get("killed", 0) - c.get("survived", 0)
+        print(
+            f"| {name} | {r['mutants']} | {c.get('killed', 0)} | {c.get('survived', 0)} | {other} | {r['score']} | {r['seconds']} |"
+        )
+        sys.stdout.flush()
+    summary_path.write_text(json.dumps(summary, indent=1), encoding="utf-8")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

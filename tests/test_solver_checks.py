@@ -1,0 +1,133 @@
+"""The contact solver (wgcad.elastic.solve) against closed forms and against every active set tried in turn.
+
+Written against the survivors of ``benchmarks/mutation.py --only solve``: the sprung freedoms (``A'F + k a = f``),
+the held body (no freedom), the empty active set, the tolerance on forces and the pivoting rule had no test of
+their own in tests/test_elastic_solver.py (tests/test_elastic_supports.py reaches them only through whole drives).
+"""
+
+from __future__ import annotations
+
+import itertools
+
+import numpy as np
+import pytest
+
+from wgcad.elastic.solve import ContactSolveError, solve_contact_qp, solve_supported
+
+
+def enumerated(M, q, A, f, k):
+    """The solution by trying every active set (small problems only): the one whose KKT system gives forces >= 0
+    on it and gaps >= 0 off it (unique: the QP is strictly convex)."""
+    m, r = A.shape
+    for n in range(m + 1):
+        for W in itertools.combinations(range(m), n):
+            W = list(W)
+            # [M_WW  -A_W] [F_W]   [-q_W]
+            # [A_W'   K  ] [ a ] = [ f  ]
+            top = np.hstack([M[np.ix_(W, W)], -A[W]])
+            bot = np.hstack([A[W].T, np.diag(k)])
+            lhs = np.vstack([top, bot])
+            rhs = np.concatenate([-q[W], f])
+            try:
+                x = np.linalg.solve(lhs, rhs)
+            except np.linalg.LinAlgError:
+                continue
+            F = np.zeros(m)
+            F[W] = x[:n]
+            a = x[n:]
+            gap = q + M @ F - A @ a
+            if np.all(F >= -1e-10) and np.all(np.delete(gap, W) >= -1e-10):
+                return F, a
+    raise AssertionError("no active set solves it")
+
+
+def test_one_contact_on_a_free_body_carries_the_load():
+    """A body pressed by P onto one contact of compliance c from an overlap g0 < 0: F = P, a = g0 + c P."""
+    c, g0, P = 2e-4, -0.01, 300.0
+    s = solve_contact_qp([[c]], [g0], [[1.0]], [P])
+    assert s.F[0] == pytest.approx(P, rel=1e-14) and s.a[0] == pytest.approx(g0 + c * P, rel=1e-12)
+    assert abs(s.gap[0]) < 1e-15 and s.equilibrium < 1e-14
+
+
+def test_one_contact_on_a_sprung_body_shares_the_load_with_the_spring():
+    """The same body on a spring k: F + k a = P and the gap closed, so F = (P - k g0) / (1 + k c)."""
+    c, g0, P, k = 2e-4, -0.01, 300.0, 5e4
+    s = solve_contact_qp([[c]], [g0], [[1.0]], [P], stiffness=[k])
+    F = (P - k * g0) / (1.0 + k * c)
+    assert s.F[0] == pytest.approx(F, rel=1e-13)
+    assert s.a[0] == pytest.approx((P - F) / k, rel=1e-12)
+
+
+def test_a_sprung_body_pulled_away_leaves_its_contacts_open():
+    """No contact loaded (the empty active set): the body moves by P / k on its spring, every gap opens by it."""
+    q = np.array([0.02, 0.05])
+    s = solve_contact_qp(np.diag([1e-4, 2e-4]), q, [[1.0], [1.0]], [-100.0], stiffness=[1e4])
+    np.testing.assert_array_equal(s.F, [0.0, 0.0])
+    assert s.a[0] == pytest.approx(-0.01, rel=1e-14)
+    np.testing.assert_allclose(s.gap, q + 0.01, rtol=1e-14)
+
+
+def test_a_held_body_presses_each_overlap_by_its_own_compliance():
+    """Every freedom held (no columns): each overlapping contact carries -g / c, the open one none."""
+    q = np.array([-0.01, 0.03, -0.004])
+    c = np.array([2e-4, 1e-4, 5e-4])
+    s = solve_contact_qp(np.diag(c), q, np.zeros((3, 0)), np.zeros(0))
+    np.testing.assert_allclose(s.F, [50.0, 0.0, 8.0], rtol=1e-13)
+    assert s.a.shape == (0,)
+    s2 = solve_supported(np.diag(c), q, np.ones((3, 1)), [123.0], [np.inf])
+    np.testing.assert_allclose(s2.F, s.F, rtol=1e-13)
+    np.testing.assert_array_equal(s2.a, [0.0])
+
+
+@pytest.mark.parametrize("seed", [*range(12), 193])  # 10: once refused, 193: once cycled
+def test_random_problems_equal_the_enumerated_active_sets(seed):
+    """Random small problems (SPD compliance, overlaps and gaps, two bodies free or sprung, cold and warm starts)
+    give the forces and displacements of the enumeration to 1e-9 relative."""
+    rng = np.random.default_rng(seed)
+    m = 7
+    B = rng.normal(size=(m, m))
+    M = (B @ B.T + m * np.eye(m)) * 1e-4
+    q = rng.uniform(-0.02, 0.03, m)
+    A = np.column_stack([np.ones(m), rng.uniform(-1, 1, m)])
+    f = np.array([rng.uniform(50, 500), rng.uniform(-50, 50)])
+    k = np.array([0.0, 0.0]) if seed % 2 == 0 else np.array([rng.uniform(1e3, 1e5), 0.0])
+    F_ref, a_ref = enumerated(M, q, A, f, k)
+    for active in (None, rng.random(m) < 0.5):
+        s = solve_contact_qp(M, q, A, f, active=active, stiffness=k)
+        scale = max(float(F_ref.max()), 1.0)
+        np.testing.assert_allclose(s.F, F_ref, rtol=0, atol=1e-9 * scale)
+        np.testing.assert_allclose(s.a, a_ref, rtol=1e-9, atol=1e-12)
+        assert s.F.min() >= 0.0 and s.gap.min() >= -1e-12
+        np.testing.assert_allclose(s.gap, q + M @ s.F - A @ s.a, rtol=0, atol=1e-14)
+        assert s.complementarity < 1e-9 and s.equilibrium < 1e-12
+
+
+def test_an_elastic_field_joins_the_compliance():
+    """``field=(U, W)`` solves as the compliance M + U W U' given whole."""
+    rng = np.random.default_rng(3)
+    m = 6
+    B = rng.normal(size=(m, m))
+    M = (B @ B.T + m * np.eye(m)) * 1e-4
+    U = rng.normal(size=(m, 2))
+    W = np.array([[2e-5, 5e-6], [5e-6, 1e-5]])
+    q = rng.uniform(-0.02, 0.02, m)
+    A = np.ones((m, 1))
+    a = solve_supported(M, q, A, [200.0], [0.0], field=(U, W))
+    b = solve_supported(M + U @ W @ U.T, q, A, [200.0], [0.0])
+    np.testing.assert_allclose(a.F, b.F, rtol=0, atol=1e-10 * b.F.max())
+
+
+def test_a_load_no_contact_can_carry_is_refused():
+    """A free freedom that no contact touches (its column all zero) cannot take a load: refused, not returned."""
+    with pytest.raises(ContactSolveError, match="no set of contacts can carry this torque"):
+        solve_contact_qp(np.diag([1e-4, 1e-4]), [-0.01, -0.01], [[1.0, 0.0], [1.0, 0.0]], [100.0, 5.0])
+
+
+def test_the_pivot_cap_is_reported():
+    """A cap too small for the problem ends in one line naming it, never a half-solved state."""
+    rng = np.random.default_rng(0)
+    m = 7
+    B = rng.normal(size=(m, m))
+    M = (B @ B.T + m * np.eye(m)) * 1e-4
+    with pytest.raises(ContactSolveError, match=r"no convergence in 1 pivots \(\d+ contacts still infeasible\)"):
+        solve_contact_qp(M, rng.uniform(-0.02, 0.0, m), np.ones((m, 1)), [-5000.0], max_iter=1)
