@@ -17,6 +17,7 @@ import shapely
 __all__ = ["ExactTooth", "point_signed_distance", "curv_h"]
 
 _SEED_GRID = 48  # samples per piece to seed the projection of a point
+_GRID_BLOCK = 1 << 20  # squared distances (8 MB) of points to grid points computed in one product
 
 
 class ExactTooth:
@@ -92,12 +93,16 @@ class ExactTooth:
                 self._g_c = self._dense_p.mean(axis=0)
                 self._g_rel = self._dense_p - self._g_c
                 self._g_n2 = (self._g_rel**2).sum(-1)
-            p = pts - self._g_c
-            dd = (p**2).sum(-1)[:, None] + self._g_n2[None, :] - 2.0 * (p @ self._g_rel.T)
-            dd = np.maximum(dd, 0.0).reshape(K, len(self._dense), self._dense_g)
-            g = dd.argmin(axis=2)
-            arg[:, self._dense] = g
-            d2[:, self._dense] = np.take_along_axis(dd, g[:, :, None], axis=2)[:, :, 0]
+            # in blocks of points, so the (points, grid) product stays near 8 MB however many points come at once
+            # (one block of a cycloidal tooth's refinement was 45 MB, the largest array of its audit)
+            step = max(1, _GRID_BLOCK // len(self._g_n2))
+            for a in range(0, K, step):
+                p = pts[a : a + step] - self._g_c
+                dd = (p**2).sum(-1)[:, None] + self._g_n2[None, :] - 2.0 * (p @ self._g_rel.T)
+                dd = np.maximum(dd, 0.0).reshape(len(p), len(self._dense), self._dense_g)
+                g = dd.argmin(axis=2)
+                arg[a : a + step, self._dense] = g
+                d2[a : a + step, self._dense] = np.take_along_axis(dd, g[:, :, None], axis=2)[:, :, 0]
         if self._trees:
             geoms = shapely.points(pts)
             for j, tree in self._trees:

@@ -42,23 +42,22 @@ DEFAULT_MAX_MEMORY_MB = 2048.0
 _VERTS_A = 16.0
 # (double_arc: arcs and a line, 30-40 vertices per pitch of a D1-sized tooth at 1 um, within the involute's bound)
 _VERTS_B = {"involute": 2.2, "cycloidal": 2.6, "double_arc": 2.2}
-# bytes, measured (peak RSS, D1 at several tolerances/steps): interpreter and
-# imports; per outline vertex written to DXF + STL (both gears, with the solids'
-# triangles); per audit sample (generator angle x tooth: angle arrays, folding,
-# sorting); per distinct tooth angle and section (search state); per vertex of a
-# tooth evaluated in one batch (placed copies, polygons, distances)
-# fitted to the peak RSS (VmHWM) of
-# `generate` on every template at 1 and 0.1 um, with and without STL, and of a default `audit`: 76-94 MB without
-# STL, 86-145 MB with it, 51-72 MB for the audits (each command loading only its own modules). The base is the interpreter and
-# the imports (~75 MB); the STL meshes' cost is taken per estimated outline vertex (an upper count, ~3x the
-# built one), so the estimate stays above the peak and within 2x of it (tests/test_design_budget.py)
-_BASE_B = 82e6
-_PER_EXPORT_VERTEX_B = 500.0
-# a conjugate gear's envelope of the mating tooth's motion (docs/models.md 13): D1's peaks 8-25 MB higher with it
-_CONJUGATE_B = 20e6
-_PER_SAMPLE_B = 64.0
-_PER_UNIQUE_SECTION_B = 40.0
-_PER_BATCH_VERTEX_B = 100.0
+# bytes: the interpreter and imports; per outline vertex written to DXF + STL (both gears, with the solids'
+# triangles); per audit sample (generator angle x tooth: angle arrays, folding, sorting); per distinct tooth angle
+# and section (search state); per vertex of a tooth evaluated in one batch (placed copies, polygons, distances).
+# Fitted to the peak RSS (VmHWM) of `generate` on every template at 1 um with and without STL and D4 at 0.1 um, and
+# of a default `audit` and D1's at 0.05 deg x 3 sections, on a 2-core Linux machine: 68-76 MB without STL, 79-101 MB
+# with it, 52-89 MB for the default audits, 154 MB for the fine one. The estimate is 1.17-1.81x those peaks: another
+# machine's peaks ran up to 8 % higher (its numpy and allocator), and the estimate must stay above them and within
+# 2x (tests/test_design_budget.py). The STL cost is taken per estimated outline vertex (an upper count).
+_BASE_B = 88e6
+_PER_EXPORT_VERTEX_B = 1000.0
+# a conjugate gear's envelope of the mating tooth's motion (docs/models.md 13): D1's peaks 4-14 MB higher with it
+_CONJUGATE_B = 10e6
+_PER_SAMPLE_B = 32.0
+_PER_UNIQUE_SECTION_B = 20.0
+_PER_BATCH_VERTEX_B = 50.0
+_PER_BOUND_VERTEX_B = 16.0
 # the branch-and-bound's coarse pass evaluates every 256th distinct tooth angle of
 # large sweeps and the finer passes only the few whose bound is below the minimum
 _BOUND_BATCH_DIVISOR = 256
@@ -158,7 +157,7 @@ def estimate_run(
         mem += (
             n_s * _PER_SAMPLE_B
             + n_u * secs * _PER_UNIQUE_SECTION_B
-            + n_u * 0.5 * p * 32.0  # radial bound: the tip half of every distinct tooth angle, placed, and temporaries
+            + n_u * 0.5 * p * _PER_BOUND_VERTEX_B  # radial bound: the tip half of every distinct tooth angle, placed
             + batch * p * _PER_BATCH_VERTEX_B
         )
     return RunEstimate(verts, int(n_out), int(samples), mem / 1e6)

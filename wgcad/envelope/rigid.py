@@ -79,10 +79,11 @@ def _tip_wall(drive, cf, side: int = 1, clearance: float = 0.0, last=None) -> np
     rot, shift = cf.motion.pose(t)
     rot, shift = _reaching(pts, rot, shift, r_last)
     r_all, a_all = [], []
-    for k in range(0, len(rot), 500):
-        c, s = np.cos(rot[k : k + 500])[:, None], np.sin(rot[k : k + 500])[:, None]
+    step = max(1, (1 << 19) // len(pts))  # poses a block: each (poses, points) array near 4 MB
+    for k in range(0, len(rot), step):
+        c, s = np.cos(rot[k : k + step])[:, None], np.sin(rot[k : k + step])[:, None]
         # turned and shifted by broadcasting (einsum's generic loop was most of this function's time)
-        sh = shift[k : k + 500]
+        sh = shift[k : k + step]
         X0 = c * pts[:, 0] + (-s) * pts[:, 1] + sh[:, 0, None]
         X1 = s * pts[:, 0] + c * pts[:, 1] + sh[:, 1, None]
         r = np.hypot(X0, X1)
