@@ -46,7 +46,7 @@ _TRIMESH = """
 def _stl(self, header):
     import trimesh
     return trimesh.Trimesh(self.vertices, self.faces, process=False).export(file_type="stl")
-wgcad.export.mesh.Mesh.stl_bytes = _stl
+wgcad.export.formats.mesh.Mesh.stl_bytes = _stl
 """
 
 #: copy -> (what it replaces, the module the swap patches, the swap, [(label, command line after ``wgcad``)]);
@@ -64,7 +64,7 @@ COPIES = {
     ),
     "mesh": (
         "trimesh's STL writer",
-        "wgcad.export.mesh",
+        "wgcad.export.formats.mesh",
         _TRIMESH,
         [
             ("generate d1_involute", ["generate", T / "d1_involute.toml", "--out", "{out}", "--quiet"]),

@@ -38,12 +38,12 @@ OUT = ROOT / "output" / "bench"
 
 def bench(design_path: Path, step: bool, tmp: Path, parts_step: bool = False) -> list[dict]:
     from wgcad.cli.common import circle
-    from wgcad.export.arcs import arc_deviation, fit_gear, fit_pieces
-    from wgcad.export.dxf import DxfLayer, write_dxf
+    from wgcad.export.formats.arcs import arc_deviation, fit_gear, fit_pieces
+    from wgcad.export.formats.dxf import DxfLayer, write_dxf
+    from wgcad.export.formats.stl import ring_solid, write_stl
+    from wgcad.export.formats.svg import write_svg
+    from wgcad.export.formats.threemf import write_3mf
     from wgcad.export.parts import build_parts
-    from wgcad.export.stl import ring_solid, write_stl
-    from wgcad.export.svg import write_svg
-    from wgcad.export.threemf import write_3mf
     from wgcad.profiles.band import gear_band_outline
 
     design = load_design(design_path)
@@ -117,8 +117,8 @@ def bench(design_path: Path, step: bool, tmp: Path, parts_step: bool = False) ->
     t, _ = best_of(lambda: write_3mf(p, {q.name: q.mesh() for q in parts}))
     row("3mf", "3 parts", t, p)
     if step:
+        from wgcad.export.formats.step import read_step, solid_props, write_step
         from wgcad.export.parts import kernel, recipe
-        from wgcad.export.step import read_step, solid_props, write_step
         from wgcad.profiles.band import gear_band_outline
 
         # the two toothed rings as prisms of their arc outlines (the gears alone)
@@ -140,7 +140,7 @@ def bench(design_path: Path, step: bool, tmp: Path, parts_step: bool = False) ->
             t_w, _ = best_of(lambda: write_step(p, solid), n=1)
             t_r, back = best_of(lambda: read_step(p), n=1)
             t_c, props = best_of(lambda: solid_props(back[0]), n=1)
-            from wgcad.export.arcs import path_area
+            from wgcad.export.formats.arcs import path_area
 
             vol = abs(path_area(path) - np.pi * rim * rim) * bw
             row(
@@ -155,7 +155,7 @@ def bench(design_path: Path, step: bool, tmp: Path, parts_step: bool = False) ->
                 faces=sum(props["faces"].values()),
             )
     if step and parts_step:
-        from wgcad.export.step import read_step, solid_props, write_step
+        from wgcad.export.formats.step import read_step, solid_props, write_step
 
         for prt in parts:
             t_sol, solid = best_of(lambda: prt.solid(), n=1)

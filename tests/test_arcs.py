@@ -1,4 +1,4 @@
-"""Tests of wgcad.export.arcs: biarcs within the chord tolerance of the exact tooth curves (sampled along the arcs), tangent where the curve is smooth, closed and simple, and their DXF round trip."""
+"""Tests of wgcad.export.formats.arcs: biarcs within the chord tolerance of the exact tooth curves (sampled along the arcs), tangent where the curve is smooth, closed and simple, and their DXF round trip."""
 
 import glob
 import math
@@ -13,7 +13,7 @@ import shapely
 
 from wgcad.design import load_design
 from wgcad.drive import build_drive
-from wgcad.export.arcs import (
+from wgcad.export.formats.arcs import (
     arc_deviation,
     arc_points,
     bulge_centres,
@@ -22,7 +22,7 @@ from wgcad.export.arcs import (
     path_area,
     segment_tangents,
 )
-from wgcad.export.dxf import DxfLayer, audit_dxf, read_dxf, write_dxf
+from wgcad.export.formats.dxf import DxfLayer, audit_dxf, read_dxf, write_dxf
 from wgcad.profiles import pieces as pc
 
 TEMPLATES = sorted(glob.glob(str(Path(__file__).parent.parent / "templates" / "*.toml")))

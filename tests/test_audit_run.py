@@ -1,4 +1,4 @@
-"""The audit as a library call (wgcad.report.audit_run.audit_document) gives the CLI's document and verdict.
+"""The audit as a library call (wgcad.services.audit_report.audit_document) gives the CLI's document and verdict.
 
 Issue 20: the 3D check, the baseline comparison and the NOT CHECKED notes were wired in the CLI, so a
 library user of run_audit got none of them.
@@ -13,7 +13,7 @@ from conftest import TEMPLATES
 from wgcad.audit import RunSettings
 from wgcad.cli import main
 from wgcad.regression import load_baseline
-from wgcad.report.audit_run import audit_document
+from wgcad.services.audit_report import audit_document
 
 D4 = TEMPLATES / "d4_discrete.toml"
 
@@ -67,11 +67,11 @@ def test_settings_errors_name_the_field_in_the_library_and_the_flag_in_the_cli(c
 
 
 def test_ke_as_a_library_call_gives_the_cli_document(tmp_path):
-    # issue 20: the KE's document and summary were built inside cmd_ke; wgcad.report.ke_run is the library call
+    # issue 20: the KE's document and summary were built inside cmd_ke; wgcad.services.ke is the library call
     from wgcad.design import load_design
     from wgcad.drive import build_drive
     from wgcad.placement.imperfect import Imperfections
-    from wgcad.report.ke_run import no_load
+    from wgcad.services.ke import no_load
 
     path = TEMPLATES / "d2_imperfect.toml"
     out = tmp_path / "ke.json"
@@ -84,8 +84,8 @@ def test_ke_as_a_library_call_gives_the_cli_document(tmp_path):
 
 def test_library_files_equal_the_clis(tmp_path):
     # the files of `wgcad audit` from a library call: the baseline and the pictures byte-identical to the CLI's
-    from wgcad.export.audit_files import plot_paths, write_audit_files
-    from wgcad.report.audit_run import baseline_document
+    from wgcad.export.files.audit import plot_paths, write_audit_files
+    from wgcad.services.audit_report import baseline_document
 
     cli = tmp_path / "cli"
     cli.mkdir()

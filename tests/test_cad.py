@@ -15,7 +15,7 @@ pytest.importorskip("build123d", reason="the CAD extra (build123d) is not instal
 import build123d as bd  # noqa: E402
 
 from wgcad import cad  # noqa: E402
-from wgcad.export.step import read_step, solid_props, write_step  # noqa: E402
+from wgcad.export.formats.step import read_step, solid_props, write_step  # noqa: E402
 
 ALL = sorted(p.stem for p in TEMPLATES.glob("*.toml"))
 

@@ -7,7 +7,6 @@ import numpy as np
 import pytest
 from conftest import TEMPLATES, edit_toml
 
-from wgcad.audit import _sections
 from wgcad.clearance import imperfect as IM
 from wgcad.clearance.engine import audit
 from wgcad.clearance.scene import Scene
@@ -19,6 +18,7 @@ from wgcad.drive import build_drive
 from wgcad.placement import transform
 from wgcad.placement.imperfect import Imperfections, flex_poses, rigid_poses
 from wgcad.report.audit import audit_json
+from wgcad.services.audit import _sections
 
 #: D2's tolerances of [S4] (docs/models.md 9), and an eccentricity of each gear
 S4 = Imperfections(
@@ -438,7 +438,7 @@ def test_generate_places_the_deformed_assembly_with_its_errors(tmp_path):
     # too, by a fraction of it: the teeth are a fraction of the area. Left out here.)
     import shapely
 
-    from wgcad.export.dxf import read_dxf
+    from wgcad.export.formats.dxf import read_dxf
     from wgcad.kinematics import gear_ratios
     from wgcad.placement.imperfect import cam_offset, rigid_translation
 

@@ -150,7 +150,7 @@ def test_generate_writes_everything(d4_run):
 
 
 def test_dxf_reads_back_equal_to_outline(d4_run):
-    from wgcad.export.dxf import audit_dxf, read_dxf
+    from wgcad.export.formats.dxf import audit_dxf, read_dxf
 
     drive = build_drive(load_design(TEMPLATES / "d4_discrete.toml"))
     doc = read_dxf(d4_run / "d4_discrete.dxf")

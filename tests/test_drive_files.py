@@ -11,7 +11,7 @@ import pytest
 
 import wgcad
 from wgcad.errors import OutputError
-from wgcad.export.drive_files import angle_tag, planned_names
+from wgcad.export.files.drive import angle_tag, planned_names
 
 ROOT = Path(__file__).resolve().parent.parent
 D1 = ROOT / "templates" / "d1_involute.toml"

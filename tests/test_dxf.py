@@ -1,4 +1,4 @@
-"""Tests of wgcad.export.dxf: exact round trip, one closed LWPOLYLINE per outline, mm header, clean audit."""
+"""Tests of wgcad.export.formats.dxf: exact round trip, one closed LWPOLYLINE per outline, mm header, clean audit."""
 
 import os
 import shutil
@@ -11,7 +11,7 @@ import pytest
 
 from wgcad.atomic import atomic_batch
 from wgcad.errors import InputFileError, OutputError
-from wgcad.export.dxf import DxfLayer, audit_dxf, build_dxf, clean_outline, read_dxf, write_dxf
+from wgcad.export.formats.dxf import DxfLayer, audit_dxf, build_dxf, clean_outline, read_dxf, write_dxf
 
 # DXF stores coordinates as decimal text; ezdxf writes Python's shortest
 # round-trip repr of each float64, so read-back is expected to be exact. The
@@ -199,7 +199,7 @@ def test_librecad_reads_the_file(tmp_path):
 
 def test_layer_names_follow_the_dxf_rule():
     # ezdxf's table-name rule, plus what wgcad adds: 1-255 printable characters, no AutoCAD-special "*" layer
-    from wgcad.export.dxf import is_valid_layer_name
+    from wgcad.export.formats.dxf import is_valid_layer_name
 
     for name in ["FLEXSPLINE", "GEAR_DATA", "RIGID OUTER", "xref|y", "Zähne 1", "x" * 255]:
         assert is_valid_layer_name(name), name

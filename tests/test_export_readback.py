@@ -13,7 +13,7 @@ import trimesh
 from conftest import ROOT, TEMPLATES, edit_toml
 
 from wgcad.cli import main
-from wgcad.export.dxf import audit_dxf, read_dxf
+from wgcad.export.formats.dxf import audit_dxf, read_dxf
 
 ALL = sorted(p.stem for p in TEMPLATES.glob("*.toml"))
 
@@ -124,8 +124,8 @@ def test_random_designs_read_back(tmp_path):
 SEED_SCRIPT = textwrap.dedent("""
     import hashlib, sys
     import numpy as np
-    from wgcad.export.arcs import fit_pieces
-    from wgcad.export.dxf import DxfLayer, write_dxf
+    from wgcad.export.formats.arcs import fit_pieces
+    from wgcad.export.formats.dxf import DxfLayer, write_dxf
     from wgcad.profiles import pieces as pc
     t = np.linspace(0, 2 * np.pi, 50, endpoint=False)
     arcs = fit_pieces([pc.arc((0, 0), 3.0, 0.0, 2 * np.pi)], 1e-3)

@@ -169,7 +169,7 @@ def test_the_modified_flexspline_is_lofted_in_step_and_stl(tmp_path):
     import trimesh
 
     from wgcad.cli import main
-    from wgcad.export.step import read_step, solid_props
+    from wgcad.export.formats.step import read_step, solid_props
 
     text = edit_toml((TEMPLATES / "d1_involute.toml").read_text(), "flexspline", "face_modification", '"depth"')
     src = tmp_path / "d1_depth.toml"

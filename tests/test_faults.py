@@ -217,7 +217,7 @@ def test_an_output_folder_turned_read_only_mid_run(disk):
     before = snapshot(out)
     # the file system goes read-only once the run has its DXF's temporary file written, before the STL
     hook = (
-        "import subprocess, wgcad.export.drive_files as m\n"
+        "import subprocess, wgcad.export.files.drive as m\n"
         "_w = m.write_stl\n"
         "def write_stl(*a, **k):\n"
         f"    subprocess.run(['mount', '-o', 'remount,ro', {str(disk)!r}], check=True)\n"

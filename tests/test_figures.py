@@ -7,8 +7,8 @@ import pytest
 from conftest import TEMPLATES
 from PIL import Image
 
-import wgcad.export.figures as F
-import wgcad.export.imperfect_figures as IF
+import wgcad.export.pictures.drive as F
+import wgcad.export.pictures.imperfect as IF
 from wgcad.cli import main
 
 NAMES = sorted(p.stem for p in TEMPLATES.glob("*.toml"))

@@ -1,4 +1,4 @@
-"""Tests of wgcad.export.gear_data: span W_k and pin dimensions (closed forms) against measurements taken on the gear outline."""
+"""Tests of wgcad.export.formats.gear_data: span W_k and pin dimensions (closed forms) against measurements taken on the gear outline."""
 
 import math
 
@@ -9,7 +9,7 @@ from conftest import TEMPLATES
 
 from wgcad.design import load_design
 from wgcad.drive import build_drive
-from wgcad.export.gear_data import data_lines, gear_data
+from wgcad.export.formats.gear_data import data_lines, gear_data
 from wgcad.profiles.involute import inv
 
 INVOLUTE = ["d1_involute", "d2", "d3_external", "d4_discrete"]

@@ -181,7 +181,7 @@ def test_the_ke_curve_is_thinned_to_its_extremes():
     to peak read off the page is the computed one."""
     import numpy as np
 
-    from wgcad.export.ke_html import MAX_POINTS, _envelope
+    from wgcad.export.pages.ke import MAX_POINTS, _envelope
 
     rng = np.random.default_rng(3)
     x = np.linspace(0.0, 100.0, 161600)

@@ -526,7 +526,7 @@ def test_the_chord_tolerance_shapes_the_outlines_and_the_record_says_which(tmp_p
     tolerance, not at the default) and the JSON carries it."""
     import json
 
-    from wgcad.report.ke_run import no_load
+    from wgcad.services.ke import no_load
 
     path = TEMPLATES / "d2_imperfect.toml"
     out = tmp_path / "k.json"

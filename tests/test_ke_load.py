@@ -203,7 +203,7 @@ def test_the_loaded_ke_picture_joins_each_cam_phase_into_one_line():
     import matplotlib.axes
 
     matplotlib.use("Agg")
-    from wgcad.export import ke_figures
+    from wgcad.export.pictures import ke as ke_figures
 
     turns = np.arange(404) * (100.0 / 404.0)
     assert ke_figures.strands(turns) == 4

@@ -1,4 +1,4 @@
-"""wgcad.export.mesh.Mesh against trimesh, an independent implementation: the same closedness, winding, volume,
+"""wgcad.export.formats.mesh.Mesh against trimesh, an independent implementation: the same closedness, winding, volume,
 Euler number and STL on the real solids, and broken meshes (a hole, a flipped face, turned inside out) refused."""
 
 from __future__ import annotations
@@ -9,8 +9,8 @@ import numpy as np
 import pytest
 import trimesh
 
-from wgcad.export.mesh import Mesh, concatenate
-from wgcad.export.stl import STL_HEADER, ring_solid
+from wgcad.export.formats.mesh import Mesh, concatenate
+from wgcad.export.formats.stl import STL_HEADER, ring_solid
 
 
 def _ring():

@@ -99,8 +99,8 @@ def test_with_the_extra_installed_the_same_check_passes(monkeypatch):
 def test_the_library_edges_name_the_extra_too(monkeypatch):
     """A library caller gets the same one line, not a bare ModuleNotFoundError: a picture without matplotlib, a page
     without plotly."""
-    from wgcad.export.mpl import pyplot
-    from wgcad.export.rating_html import rating_html
+    from wgcad.export.pages.rating import rating_html
+    from wgcad.export.pictures.mpl import pyplot
 
     monkeypatch.setitem(sys.modules, "matplotlib", None)
     with pytest.raises(DependencyError, match=r"pip install 'wgcad\[plots\]'"):

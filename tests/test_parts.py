@@ -5,6 +5,7 @@ import re
 import shutil
 import subprocess
 import sys
+from pathlib import Path
 
 import ezdxf
 import numpy as np
@@ -17,10 +18,11 @@ from wgcad.cli import main
 from wgcad.design import load_design
 from wgcad.design.parts import PartsSpec, load_parts, part_sizes
 from wgcad.drive import build_drive
-from wgcad.export.dxf import audit_dxf, read_dxf
+from wgcad.errors import DesignError
+from wgcad.export.formats.dxf import audit_dxf, read_dxf
+from wgcad.export.formats.threemf import read_3mf
 from wgcad.export.parts import build_parts
 from wgcad.export.parts.bodies import plug_outline
-from wgcad.export.threemf import read_3mf
 from wgcad.rating.plate_sizing import sized_parts
 
 ALL = sorted(p.stem for p in TEMPLATES.glob("*.toml"))
@@ -114,7 +116,7 @@ def small_run(tmp_path_factory):
 
 
 def test_step_solids_valid_with_2d_volumes_and_bounds(small_run):
-    from wgcad.export.step import read_step, solid_props
+    from wgcad.export.formats.step import read_step, solid_props
 
     out, parts, drive = small_run
     for name in ("flexspline", "plug", "rigid"):
@@ -145,7 +147,7 @@ def test_freecad_reads_every_step_solid(small_run, tmp_path):
     # a second reader, the way a user's CAD program opens the files: the STEP carries no pcurves (issue 22,
     # write.surfacecurve.mode 0), so the reader builds them; every part must come back one valid solid of the
     # volume OCP reads
-    from wgcad.export.step import read_step, solid_props
+    from wgcad.export.formats.step import read_step, solid_props
 
     out, parts, drive = small_run
     script = tmp_path / "read.py"
@@ -169,7 +171,7 @@ def test_step_is_byte_reproducible(small_run, tmp_path):
     """The STEP files of two runs are the same bytes: the header's time stamp is fixed and names the part, and
     nothing in the file depends on what else the process wrote before (the same solid built and written again in
     this process, after the fixture's run wrote three; and a run in a process of its own)."""
-    from wgcad.export.step import step_bytes
+    from wgcad.export.formats.step import step_bytes
 
     out, parts, drive = small_run
     a = (out / "small_rigid.step").read_bytes()
@@ -307,7 +309,7 @@ def test_step_without_the_cad_extra_names_it_and_writes_nothing(tmp_path):
 def test_cup_flexspline_step_solid_on_templates(name):
     # the cup is glued onto the toothed ring (OCCT's glue mode: they share a face, no volume); on the real
     # templates the glued solid must be one valid solid of the volume its 2D areas give
-    from wgcad.export.step import solid_props
+    from wgcad.export.formats.step import solid_props
 
     path = TEMPLATES / f"{name}.toml"
     drive = build_drive(load_design(path))
@@ -381,7 +383,7 @@ def test_plug_drawing_is_arcs_with_its_data_and_a_construction_neutral_line(name
     # arcs, the neutral line a polyline on a cuttable layer, and no data block. Read back with ezdxf: the outline
     # is tangent arcs within the chord tolerance of the exact outline (measured against it, 20,000 points), the
     # neutral line on a non-plotting CENTER layer, the data block names law, W0, diameters and bearing
-    from wgcad.export.arcs import _dist_to_segments
+    from wgcad.export.formats.arcs import _dist_to_segments
     from wgcad.export.parts.bodies import plug_outline
 
     path = TEMPLATES / f"{name}.toml"
@@ -407,7 +409,7 @@ def test_plug_drawing_is_arcs_with_its_data_and_a_construction_neutral_line(name
 
 def test_sectored_design_gets_its_sectored_rigid_gear():
     # issue 23, item 1: parts on templates/d4_sectored.toml wrote the plain 88-tooth rigid gear without a word
-    from wgcad.export.step import solid_props
+    from wgcad.export.formats.step import solid_props
     from wgcad.sector.run import run_sector
 
     path = TEMPLATES / "d4_sectored.toml"
@@ -443,7 +445,7 @@ def test_sectored_design_gets_its_sectored_rigid_gear():
 
 def test_library_call_writes_what_the_cli_wrote(small_run, tmp_path):
     # issue 20: the CLI only parses, calls and prints; a library user gets the same files and report
-    from wgcad.export.part_files import write_part_files
+    from wgcad.export.files.parts import write_part_files
 
     out, _, drive = small_run
     design = out.parent / "small.toml"
@@ -514,10 +516,46 @@ def test_every_template_part_mesh_reads_back_watertight_of_its_volume(name, tmp_
     """The meshes derived from each part's recipe (its walls' polygons in bands of quads, its caps triangulated on the
     same vertices) on every template: the STL read back by trimesh is watertight, a volume, within the chord
     tolerance of the part's exact volume."""
-    from wgcad.export.stl import write_stl
+    from wgcad.export.formats.stl import write_stl
 
     path = TEMPLATES / f"{name}.toml"
     drive = build_drive(load_design(path), tol=TOL)
     for p in build_parts(drive, part_sizes(load_parts(path), drive), tol=TOL):
         write_stl(tmp_path / f"{p.name}.stl", p.mesh())
         _check_mesh(trimesh.load(tmp_path / f"{p.name}.stl", force="mesh"), p, f"{name} {p.name}")
+
+
+def test_a_registered_format_is_written_for_every_part_that_has_its_source(small_run, tmp_path, monkeypatch):
+    """The part set's files are one loop over the format registry: a format added there (a text file of each
+    drawing's title here) is written for every part with a drawing, by write_part_files unchanged, in the
+    registry's order whatever order the formats are asked in; an unknown format is refused naming the field."""
+    from wgcad.export.files.parts import write_part_files
+    from wgcad.export.formats import registry
+
+    out, _, drive = small_run
+    design = out.parent / "small.toml"
+    sizes = part_sizes(load_parts(design), drive)
+    seen = []
+
+    def _txt(path, drawing):
+        seen.append(drawing.title)
+        Path(path).write_text(drawing.title + "\n")
+
+    monkeypatch.setitem(registry.FORMATS, "txt", registry.FileFormat("txt", "drawing", _txt))
+    res = write_part_files(drive, sizes, design, tmp_path / "a", formats=("txt", "svg"))
+    names = [p.name for p in res.files]
+    assert names == [
+        "small_flexspline.svg",
+        "small_flexspline.txt",
+        "small_plug.svg",
+        "small_plug.txt",
+        "small_rigid.svg",
+        "small_rigid.txt",
+        "small_parts.json",
+    ]
+    assert seen == [f"{drive.design.drive.name}: {n}" for n in ("flexspline", "plug", "rigid")]
+    assert (tmp_path / "a" / "small_plug.txt").read_text() == seen[1] + "\n"
+    assert res.report["formats"] == ["txt", "svg"]
+    with pytest.raises(DesignError, match=r"^formats: 'iges' is not a format \(choose from dxf, svg, stl, 3mf, step"):
+        write_part_files(drive, sizes, design, tmp_path / "b", formats=("dxf", "iges"))
+    assert not (tmp_path / "b").exists()

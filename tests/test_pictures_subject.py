@@ -8,9 +8,9 @@ import pytest
 import shapely
 from conftest import TEMPLATES
 
-import wgcad.export.figures as F
+import wgcad.export.pictures.drive as F
 from wgcad import api
-from wgcad.export.audit_figures import audit_plot_data
+from wgcad.export.pictures.audit import audit_plot_data
 
 #: an internal drive (tip contact) and the external one (the rigid teeth below the flexspline's)
 CASES = ["d1_involute", "d3_external"]
@@ -111,7 +111,7 @@ def test_audit_page_opens_on_the_band_that_matters(audits):
     """The page's passage plot opens on the PNG's band (at most 250 um on D1, not the 2000 um out of mesh) holding the
     minimum and the entry gap 5 % of the view clear of its edges; the plot against generator angle opens on the
     ripple around the audit's minimum (not 0 to 8.5 um); the full range is a button away; one word, "flank"."""
-    from wgcad.export.html import audit_figures, audit_html
+    from wgcad.export.pages.audit import audit_figures, audit_html
 
     run, data = audits["d1_involute"]
     figs = audit_figures(run.drive, run.doc, data)
@@ -166,7 +166,7 @@ def d2_sweep(tmp_path_factory):
 
 
 def _sweep_figures(monkeypatch, fn, *args):
-    import wgcad.export.sweep_figures as SF
+    import wgcad.export.pictures.sweep as SF
 
     monkeypatch.setattr(SF, "_png", lambda fig, plt: fig)
     return getattr(SF, fn)(*args)
@@ -219,7 +219,7 @@ def test_a_constant_figure_is_said_constant(d2_sweep, monkeypatch):
 def test_a_limit_contour_is_in_the_legend():
     import matplotlib.pyplot as plt
 
-    import wgcad.export.sweep_figures as SF
+    import wgcad.export.pictures.sweep as SF
 
     fig, ax = plt.subplots()
     try:
@@ -239,7 +239,7 @@ def test_design_best_has_its_own_name_and_the_search_title_fits(tmp_path, monkey
     search picture's title lies inside the picture (it ran off at "...(11 sto")."""
     import matplotlib.pyplot as plt
 
-    import wgcad.export.synthesis_files as SYN
+    import wgcad.export.files.synthesis as SYN
     from wgcad.cli import main
     from wgcad.design import load_design
 
@@ -282,8 +282,8 @@ def test_ke_spectrum_marks_the_strongest_orders(d2_ke, monkeypatch):
     under the plots (beside them they took 40 % of the width)."""
     import matplotlib.pyplot as plt
 
-    import wgcad.export.ke_figures as KF
-    from wgcad.export.ke_html import _ke, _spectrum
+    import wgcad.export.pictures.ke as KF
+    from wgcad.export.pages.ke import _ke, _spectrum
 
     run = d2_ke
     top = [(t["order"], t["amplitude_arcsec"]) for t in run.doc["spectrum_top"][:4]]
@@ -318,8 +318,8 @@ def test_rating_legends_are_readable_and_inside_the_picture():
     """Every legend of the datasheet picture at 8 pt or more (they were 6 and 7 pt) and inside the figure."""
     import matplotlib.pyplot as plt
 
-    from wgcad.export.figures import MIN_FONT_PT
-    from wgcad.export.rating_figures import rating_figure
+    from wgcad.export.pictures.drive import MIN_FONT_PT
+    from wgcad.export.pictures.rating import rating_figure
 
     ds = api.rating(TEMPLATES / "d1_involute.toml").datasheet
     fig = rating_figure(ds)

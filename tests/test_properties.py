@@ -22,7 +22,7 @@ from wgcad.design import load_design, with_changes
 from wgcad.drive import build_drive
 from wgcad.elastic import build_model, solve_load
 from wgcad.elastic.state import POSITION_TOL
-from wgcad.export.drive_files import write_drive_files
+from wgcad.export.files.drive import write_drive_files
 from wgcad.kinematics import gear_ratios
 from wgcad.placement.imperfect import Imperfections
 

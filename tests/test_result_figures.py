@@ -14,8 +14,8 @@ from wgcad.cli import main
 @pytest.fixture
 def caught(monkeypatch):
     """Every figure the KE and load picture modules render, kept open: ``list`` of matplotlib figures."""
-    import wgcad.export.ke_figures as kf
-    import wgcad.export.load_figures as lf
+    import wgcad.export.pictures.ke as kf
+    import wgcad.export.pictures.load as lf
 
     figs = []
 

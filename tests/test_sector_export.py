@@ -13,7 +13,7 @@ import trimesh
 from conftest import TEMPLATES, edit_toml
 
 from wgcad.cli import main
-from wgcad.export.dxf import audit_dxf, read_dxf
+from wgcad.export.formats.dxf import audit_dxf, read_dxf
 
 D4 = TEMPLATES / "d4_sectored.toml"
 FILES = (
@@ -238,7 +238,7 @@ def test_interfering_drive_exits_1_and_is_told_the_change_the_template_takes(tmp
 def test_library_call_writes_what_the_cli_wrote(run_quick, tmp_path):
     # issue 20: the CLI only parses, calls and prints; a library user gets the same files
     from wgcad.design import load_design
-    from wgcad.export.sector_files import write_sector_files
+    from wgcad.export.files.sector import write_sector_files
     from wgcad.sector.run import run_sector
 
     _, cli_out = run_quick

@@ -1,4 +1,4 @@
-"""Tests of wgcad.export.stl: extruded rings are closed solids of the right volume, STL bytes are reproducible."""
+"""Tests of wgcad.export.formats.stl: extruded rings are closed solids of the right volume, STL bytes are reproducible."""
 
 import numpy as np
 import pytest
@@ -6,7 +6,7 @@ import shapely
 import trimesh
 
 from wgcad.errors import GeometryError, OutputError
-from wgcad.export.stl import STL_HEADER, ring_solid, stl_bytes, write_stl
+from wgcad.export.formats.stl import STL_HEADER, ring_solid, stl_bytes, write_stl
 
 HEIGHT = 12.5
 

@@ -163,7 +163,7 @@ def test_design_study_is_a_table_not_a_distribution(tmp_path):
     # and drew histograms of them; a grid prints one row per design and draws the surface only
     from conftest import TEMPLATES
 
-    from wgcad.export.sweep_figures import sweep_pngs
+    from wgcad.export.pictures.sweep import sweep_pngs
     from wgcad.sweep.spec import load_spec
     from wgcad.sweep.summary import format_summary
 

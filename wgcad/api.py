@@ -14,10 +14,10 @@ from __future__ import annotations
 import os
 from dataclasses import dataclass
 
-from .audit import RunSettings
 from .design import Design, load_design
 from .drive import Drive, build_drive
 from .errors import DesignError
+from .services.audit import RunSettings
 
 __all__ = ["audit", "load_audit", "kinematic_error", "rating", "parts", "LoadAudit", "Rating", "PartSet"]
 
@@ -41,14 +41,14 @@ def _drive(design, chord_tol_um: float | None = None) -> Drive:
 
 
 def audit(design, settings: RunSettings | None = None, *, engine: str = "2d", baseline=None, by_section=False):
-    """The clearance audit over the generator cycle (``wgcad audit``): a :class:`wgcad.report.audit_run.AuditReport`
+    """The clearance audit over the generator cycle (``wgcad audit``): a :class:`wgcad.services.audit_report.AuditReport`
     with ``drive``, ``result`` (the findings: ``result.findings["min_clearance"].value`` in mm), ``doc`` and
     ``failed`` (interference or drift from ``baseline``, a :func:`wgcad.regression.load_baseline` dict: exit 1).
 
     ``settings`` default :class:`wgcad.audit.RunSettings` (0.5 degree steps, 1 um chords); ``engine`` "2d", "fcl"
     or "both" (the 3D check of the pairs the 2D engine singles out). A Drive is audited from its design, at the
     settings' chord tolerance (the audit builds its drive with its run's memory budget)."""
-    from .report.audit_run import audit_document
+    from .services.audit_report import audit_document
 
     return audit_document(
         _design(design), settings or RunSettings(), engine=engine, baseline=baseline, by_section=by_section
@@ -83,14 +83,14 @@ def kinematic_error(
     optimize_install_angle: bool = False,
     chord_tol_um: float | None = None,
 ):
-    """The kinematic error (``wgcad ke``): a :class:`wgcad.report.ke_run.KERun` with ``res`` (``res.ke``: the KE
+    """The kinematic error (``wgcad ke``): a :class:`wgcad.services.ke.KERun` with ``res`` (``res.ke``: the KE
     in rad at each angle, ``res.ke_pp``), the spectrum (``orders``, ``amp``) and ``doc``.
 
     ``imperfections`` (:class:`wgcad.placement.imperfect.Imperfections`) default the design's
     ``[imperfections]``; ``torque_nm`` (sequence, each > 0) adds the KE under load (``run.loaded``);
     ``optimize_install_angle`` the installation-angle scan (``run.scan``)."""
     from .placement.imperfect import Imperfections
-    from .report.ke_run import add_install_scan, add_loaded, no_load
+    from .services.ke import add_install_scan, add_loaded, no_load
 
     drive = _drive(design, chord_tol_um)
     imp = Imperfections.from_spec(drive.design.imperfections) if imperfections is None else imperfections
@@ -148,7 +148,7 @@ def parts(design, out=None, *, formats=None, dxf_style: str = "arcs", generator_
     folder) written there in ``formats`` (default every one: dxf, svg, stl, 3mf, step; STEP needs ``[cad]``).
     Sizes come from the design file's ``[parts]`` table, so ``design`` is a path or a Design read from one."""
     from .design.parts import load_parts
-    from .export.part_files import FORMATS, write_part_files
+    from .export.files.parts import FORMATS, write_part_files
     from .export.parts import build_parts
     from .rating.plate_sizing import sized_parts
 

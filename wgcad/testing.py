@@ -10,9 +10,9 @@ from __future__ import annotations
 
 import math
 
-from .audit import RunSettings, run_audit
 from .regression import baseline_figures, compare, format_drifts, load_baseline, make_baseline
 from .report.audit import audit_json
+from .services.audit import RunSettings, run_audit
 
 __all__ = ["baseline_drifts", "assert_matches_baseline", "record_baseline", "to_toml"]
 

@@ -7,14 +7,14 @@ import os
 import sys
 import textwrap
 
-from ..audit import FLAGS, RunSettings
 from ..errors import DesignError, OutputError
-from ..export.audit_files import plot_paths, write_audit_files
-from ..export.json_text import json_text
+from ..export.files.audit import plot_paths, write_audit_files
+from ..export.formats.json_text import json_text
 from ..regression import format_drifts, load_baseline
 from ..report.audit import audit_summary
-from ..report.audit_run import audit_document, baseline_document
 from ..report.sections import section_lines
+from ..services.audit import FLAGS, RunSettings
+from ..services.audit_report import audit_document, baseline_document
 from .bounds import bounded
 from .common import (
     COMMAND_HELP,

@@ -10,8 +10,8 @@ from __future__ import annotations
 import argparse
 import math
 
-from ..audit import BOUNDS as AUDIT_BOUNDS
 from ..numbers import Bound
+from ..services.audit import BOUNDS as AUDIT_BOUNDS
 
 __all__ = ["FLAG_BOUNDS", "COMMAND_BOUNDS", "REVERSE", "bound_of", "bounded"]
 

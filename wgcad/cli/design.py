@@ -8,7 +8,7 @@ from pathlib import Path
 
 from ..design.files import read_design_text
 from ..errors import DesignError
-from ..export.synthesis_files import write_search_files
+from ..export.files.synthesis import write_search_files
 from ..extras import require
 from ..report.synthesis import summary_lines
 from ..sweep.store import hold_folder

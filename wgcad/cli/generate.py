@@ -9,8 +9,8 @@ import time
 
 from ..design import load_design
 from ..drive import build_drive
-from ..export.drive_files import write_drive_files
-from ..export.json_text import json_text
+from ..export.files.drive import write_drive_files
+from ..export.formats.json_text import json_text
 from ..extras import require
 from ..report import format_summary
 from .bounds import bounded

@@ -12,11 +12,11 @@ from ..design import load_design
 from ..design.load import require_bearing
 from ..drive import build_drive
 from ..errors import DesignError, OutputError
-from ..export.json_text import json_text
-from ..export.ke_figures import ke_pngs
-from ..export.ke_html import ke_html
+from ..export.formats.json_text import json_text
+from ..export.pages.ke import ke_html
+from ..export.pictures.ke import ke_pngs
 from ..placement.imperfect import Imperfections
-from ..report.ke_run import add_install_scan, add_loaded, no_load
+from ..services.ke import add_install_scan, add_loaded, no_load
 from .bounds import bounded
 from .common import (
     COMMAND_HELP,

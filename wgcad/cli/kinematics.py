@@ -13,7 +13,7 @@ from ..atomic import atomic_batch
 from ..design import load_design
 from ..drive import build_drive
 from ..errors import DesignError
-from ..export.figures import velocities_png
+from ..export.pictures.drive import velocities_png
 from ..extras import require
 from ..kinematics import gear_ratios, ring_generator_velocities
 from .bounds import bounded

@@ -10,9 +10,9 @@ from ..constants import MAX_LOAD_LEVELS
 from ..design import load_design
 from ..design.budget import check_load_budget
 from ..errors import DesignError
-from ..export.json_text import json_text
-from ..export.load_figures import entry_gap_png, force_distribution_png
-from ..export.load_html import load_html
+from ..export.formats.json_text import json_text
+from ..export.pages.load import load_html
+from ..export.pictures.load import entry_gap_png, force_distribution_png
 from ..numbers import read_values
 from .bounds import REVERSE
 from .common import EXIT_INTERFERENCE, EXIT_OK, Progress, flag_value, key_float

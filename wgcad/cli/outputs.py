@@ -1,4 +1,4 @@
-"""Output paths of the CLI: checks before any work, ``-`` for standard output (the manifest of ``generate`` lives in :mod:`wgcad.export.manifest`)."""
+"""Output paths of the CLI: checks before any work, ``-`` for standard output (the manifest of ``generate`` lives in :mod:`wgcad.export.files.manifest`)."""
 
 from __future__ import annotations
 

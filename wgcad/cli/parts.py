@@ -9,8 +9,8 @@ from ..design import load_design
 from ..design.bolting import RULE
 from ..design.parts import load_parts
 from ..drive import build_drive
-from ..export.json_text import json_text
-from ..export.part_files import FORMATS, write_part_files
+from ..export.files.parts import FORMATS, write_part_files
+from ..export.formats.json_text import json_text
 from ..rating.plate_sizing import sized_parts
 from .bounds import bounded
 from .common import COMMAND_HELP, EXIT_OK, Progress, angles_deg, epilog, out_dir, want_progress

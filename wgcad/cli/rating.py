@@ -9,9 +9,9 @@ from ..atomic import atomic_batch
 from ..design import load_design
 from ..drive import build_drive
 from ..errors import OutputError
-from ..export.json_text import json_text
-from ..export.rating_figures import rating_png
-from ..export.rating_html import rating_html
+from ..export.formats.json_text import json_text
+from ..export.pages.rating import rating_html
+from ..export.pictures.rating import rating_png
 from .bounds import bounded
 from .common import (
     COMMAND_HELP,

@@ -7,8 +7,8 @@ import argparse
 from ..atomic import check_writable_dir
 from ..design import load_design
 from ..design.budget import check_sector_budget
-from ..export.json_text import json_text
-from ..export.sector_files import write_sector_files
+from ..export.files.sector import write_sector_files
+from ..export.formats.json_text import json_text
 from ..extras import require
 from ..report.sector import sector_summary_text
 from ..sector.run import run_sector

@@ -8,9 +8,9 @@ from pathlib import Path
 from ..atomic import atomic_batch, check_writable_dir
 from ..errors import DesignError, OutputError
 from ..errors import OutputError as _OutputError
-from ..export.json_text import json_text
-from ..export.sweep_figures import sweep_pngs
-from ..export.sweep_html import sweep_html
+from ..export.formats.json_text import json_text
+from ..export.pages.sweep import sweep_html
+from ..export.pictures.sweep import sweep_pngs
 from ..extras import require
 from ..sweep.runner import run_sweep
 from ..sweep.sampling import chunk_check

@@ -11,8 +11,8 @@ from wgcad.atomic import (
     discard_all,
     ensure_writable_dir,
 )
-from wgcad.export.dxf import DxfLayer, audit_dxf, build_dxf, read_dxf, write_dxf
-from wgcad.export.stl import ring_solid, stl_bytes, write_stl
+from wgcad.export.formats.dxf import DxfLayer, audit_dxf, build_dxf, read_dxf, write_dxf
+from wgcad.export.formats.stl import ring_solid, stl_bytes, write_stl
 
 __all__ = [
     "atomic_batch",

@@ -42,7 +42,7 @@ from ..design.rules import key_meta
 from ..design.schema import TABLES, base_type, parse_design
 from ..errors import DesignError, InputFileError, close_matches
 from ..numbers import read_float, show_value
-from .figures import check_figures
+from .recorded import check_figures
 
 __all__ = ["Parameter", "SweepSpec", "parse_spec", "load_spec", "MAX_SAMPLES", "DISTRIBUTIONS"]
 

@@ -37,7 +37,7 @@ from ..design.schema import parse_design
 from ..drive import build_drive
 from ..errors import DesignError, ModelError, WgcadError
 from ..placement.imperfect import Imperfections
-from .figures import parse_figure
+from .recorded import parse_figure
 from .sampling import envelope_amplitudes_um, sample_design_data, sample_values
 
 __all__ = ["run_batch", "run_sample", "columns_of", "cache_info", "clear_cache", "noop"]

@@ -1,7 +1,7 @@
 """The part set of a drive: cup flexspline, wave-generator plug, rigid gear with flange, deformed assembly; each as DXF layers and one recipe its solid and mesh derive from.
 
 A :class:`Part` holds what every exporter needs: its 2D drawing
-(:class:`~wgcad.export.dxf.DxfLayer` list, top view, mm), its recipe
+(:class:`~wgcad.export.formats.dxf.DxfLayer` list, top view, mm), its recipe
 (:mod:`~wgcad.export.parts.recipe`: loops of the exact curves swept into
 walls, closed by caps), from which the OpenCASCADE solid (build123d, built
 only when STEP or an object is asked for) and the mesh both derive, and the

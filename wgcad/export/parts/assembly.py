@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from wgcad.export.arcs import path_area
+from wgcad.export.formats.arcs import path_area
 from wgcad.placement.deformed import deformed_state, rim_samples, rotate
 from wgcad.plane import signed_area
 

@@ -8,9 +8,9 @@ import numpy as np
 import shapely
 
 from wgcad.errors import DesignError
-from wgcad.export.arcs import fit_closed_curve, fit_gear, path_area
-from wgcad.export.dxf import DxfLayer
-from wgcad.export.gear_data import data_lines, gear_data
+from wgcad.export.formats.arcs import fit_closed_curve, fit_gear, path_area
+from wgcad.export.formats.dxf import DxfLayer
+from wgcad.export.formats.gear_data import data_lines, gear_data
 from wgcad.placement import deformed_curve
 from wgcad.plane import signed_area
 from wgcad.profiles.band import gear_band_outline

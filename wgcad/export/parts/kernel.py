@@ -43,7 +43,7 @@ def _wire(loop, z: float, material_left: bool):
     from OCP.gp import gp_Ax2, gp_Circ, gp_Dir
     from OCP.TopoDS import TopoDS_Wire
 
-    from wgcad.export.arcs import arc_points
+    from wgcad.export.formats.arcs import arc_points
 
     flip = loop.ccw != material_left  # the loop's own direction against the one asked for
     wire = TopoDS_Wire()

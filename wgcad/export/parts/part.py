@@ -71,7 +71,7 @@ class Part:
 
     def mesh(self):
         """All members in one mesh (each a closed shell of its own)."""
-        from ..mesh import concatenate
+        from ..formats.mesh import concatenate
 
         meshes = list(self.member_meshes().values())
         return meshes[0] if len(meshes) == 1 else concatenate(meshes)

@@ -29,7 +29,7 @@ class Loop:
     """One closed plane outline: its exact curves and the mesh's polygon of them (mm, any direction).
 
     ``kind``: ``"path"`` (lines and arcs: segment starts ``vertices``, ``bulges`` = tan(theta / 4) as
-    :mod:`wgcad.export.arcs` stores them) or ``"circle"`` (centre ``vertices[0]``, ``radius``). ``polygon``: the same outline within the chord tolerance, no
+    :mod:`wgcad.export.formats.arcs` stores them) or ``"circle"`` (centre ``vertices[0]``, ``radius``). ``polygon``: the same outline within the chord tolerance, no
     repeated vertex. ``role`` names the faces its wall makes (``teeth``, ``bore``, ``flange``, ...).
     """
 
@@ -47,7 +47,7 @@ class Loop:
 
 
 def path_loop(path, polygon, role: str) -> Loop:
-    """A loop of lines and arcs (an :class:`~wgcad.export.arcs.ArcPath`) and its polygon (the band of the same
+    """A loop of lines and arcs (an :class:`~wgcad.export.formats.arcs.ArcPath`) and its polygon (the band of the same
     curves, or the path's own vertices for a polygon outline)."""
     return Loop("path", np.asarray(path.vertices, float), _clean(polygon), role, np.asarray(path.bulges, float))
 
@@ -66,7 +66,7 @@ def circle_loop(radius: float, tol: float, role: str, cx: float = 0.0, cy: float
 
 
 def _clean(points) -> np.ndarray:
-    from wgcad.export.rings import clean_outline
+    from wgcad.export.formats.rings import clean_outline
 
     return clean_outline(np.asarray(points, dtype=float))
 
@@ -135,12 +135,12 @@ def _ring(poly: np.ndarray, material_left: bool) -> np.ndarray:
 
 
 def mesh(body: Body):
-    """The triangle mesh of a body (:class:`wgcad.export.mesh.Mesh`): every wall a band of quads between its polygon
+    """The triangle mesh of a body (:class:`wgcad.export.formats.mesh.Mesh`): every wall a band of quads between its polygon
     at both ends, every cap triangulated from the same vertices (manifold3d), so each edge is shared by exactly two
     triangles: watertight by construction."""
     import manifold3d
 
-    from ..mesh import Mesh
+    from ..formats.mesh import Mesh
 
     verts, faces, rings = [], [], []
     at = 0

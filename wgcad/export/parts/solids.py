@@ -9,7 +9,7 @@ import numpy as np
 
 from wgcad.errors import GeometryError
 
-from ..mesh import Mesh
+from ..formats.mesh import Mesh
 
 __all__ = ["n_segments", "circle_points", "to_mesh", "bolt_circle"]
 
@@ -27,7 +27,7 @@ def circle_points(radius: float, tol: float, cx: float = 0.0, cy: float = 0.0) -
 
 
 def to_mesh(m):
-    """float64 :class:`wgcad.export.mesh.Mesh` of a manifold (``to_mesh64``: ``to_mesh`` would round to float32)."""
+    """float64 :class:`wgcad.export.formats.mesh.Mesh` of a manifold (``to_mesh64``: ``to_mesh`` would round to float32)."""
     mesh64 = m.to_mesh64()
     v = np.asarray(mesh64.vert_properties, dtype=np.float64)[:, :3]
     f = np.asarray(mesh64.tri_verts, dtype=np.int64)

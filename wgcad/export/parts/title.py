@@ -8,7 +8,7 @@ import numpy as np
 
 from wgcad import __version__
 
-from ..dxf import DxfLayer
+from ..formats.dxf import DxfLayer
 
 __all__ = ["TITLES", "drawing_extents", "title_layer"]
 

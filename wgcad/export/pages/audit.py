@@ -3,7 +3,7 @@
 ``wgcad audit --html PATH`` writes it. Nothing is fetched when the page is
 viewed (plotly.js is inlined once, about 4.8 MB): it opens from a disk, a
 mail or an archive. The figures are those of the PNGs
-(:func:`wgcad.export.audit_figures.audit_plot_data`, computed once for
+(:func:`wgcad.export.pictures.audit.audit_plot_data`, computed once for
 both) plus the whole drive at the tightest spot's generator angle, from
 which a designer zooms down to the tooth pair and its microns.
 """
@@ -14,13 +14,13 @@ import html
 
 import numpy as np
 
-from ..extras import require
-from ..placement.deformed import deformed_state
-from .figures import VS_ANGLE_MIN_PAD_UM, profile_y_range
-from .html_page import figure as _figure
-from .html_page import fmt as _fmt
-from .html_page import notes as _notes
-from .html_page import page
+from ...extras import require
+from ...placement.deformed import deformed_state
+from ..pictures.drive import VS_ANGLE_MIN_PAD_UM, profile_y_range
+from .frame import figure as _figure
+from .frame import fmt as _fmt
+from .frame import notes as _notes
+from .frame import page
 
 __all__ = ["audit_html", "audit_figures", "vs_angle_y_range"]
 
@@ -229,8 +229,8 @@ def _maybe_row(what: str, um, deg, why: str) -> tuple[str, str, str]:
 
 
 def audit_html(drive, result, doc: dict, data: dict) -> str:
-    """The page: verdict and figures of the audit (``doc``: :func:`wgcad.report.audit_run.audit_document`'s document;
-    ``data``: :func:`wgcad.export.audit_figures.audit_plot_data`)."""
+    """The page: verdict and figures of the audit (``doc``: :func:`wgcad.services.audit_report.audit_document`'s document;
+    ``data``: :func:`wgcad.export.pictures.audit.audit_plot_data`)."""
     name = drive.design.drive.name
     w, e = doc["worst"], doc["entry"]
     ids = {"drive": "The whole drive", "tightest": "The tightest spot"}

@@ -8,13 +8,13 @@ from pathlib import Path
 
 import numpy as np
 
-from ..atomic import atomic_batch
-from ..plane import circle_polygon
-from ..report.sector import heights_csv, loaded_csv, motion_csv, motion_phases_deg, summary_json
-from . import sector_figures as sf
-from .dxf import DxfLayer, write_dxf
-from .json_text import json_text
-from .stl import ring_solid, write_stl
+from ...atomic import atomic_batch
+from ...plane import circle_polygon
+from ...report.sector import heights_csv, loaded_csv, motion_csv, motion_phases_deg, summary_json
+from ..formats.dxf import DxfLayer, write_dxf
+from ..formats.json_text import json_text
+from ..formats.stl import ring_solid, write_stl
+from ..pictures import sector as sf
 
 __all__ = ["write_sector_files"]
 

@@ -9,12 +9,12 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from ..audit import RunSettings, audit_settings, run_audit
 from ..placement.imperfect import Imperfections
 from ..regression import baseline_figures, compare, make_baseline
-from .audit import audit_json
-from .notes import not_modelled
-from .sections import balanced_taper, section_rows
+from ..report.audit import audit_json
+from ..report.notes import not_modelled
+from ..report.sections import balanced_taper, section_rows
+from .audit import RunSettings, audit_settings, run_audit
 
 __all__ = ["AuditReport", "audit_document", "baseline_document", "imperfect_not_checked"]
 
@@ -109,7 +109,7 @@ def audit_document(
         if on_stage is not None:
             on_stage("3D check (fcl)")
         from ..clearance.fcl3d import verify_worst
-        from .check3d import check3d_document
+        from ..report.check3d import check3d_document
 
         imp = None
         if imperfect:

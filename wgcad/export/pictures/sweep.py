@@ -6,7 +6,7 @@ import math
 
 import numpy as np
 
-from ..sweep.summary import MIN_FAILING_TO_RANK, failing_samples, few_failing_note, passes, weakest_figure
+from ...sweep.summary import MIN_FAILING_TO_RANK, failing_samples, few_failing_note, passes, weakest_figure
 from .mpl import png_bytes
 from .mpl import pyplot as _plt
 

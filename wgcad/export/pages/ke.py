@@ -6,8 +6,8 @@ import numpy as np
 
 from wgcad.units import ARCSEC_PER_RAD
 
-from ..extras import require
-from .html_page import figure, fmt, notes, page, table
+from ...extras import require
+from .frame import figure, fmt, notes, page, table
 
 __all__ = ["ke_html"]
 
@@ -135,7 +135,7 @@ def _install(go, run):
 
 
 def ke_html(run) -> str:
-    """The page of a :class:`~wgcad.report.ke_run.KERun`."""
+    """The page of a :class:`~wgcad.services.ke.KERun`."""
     require("html")  # plotly draws the page
     import plotly.graph_objects as go
 

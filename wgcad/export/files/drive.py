@@ -10,19 +10,19 @@ from pathlib import Path
 
 import numpy as np
 
-from ..atomic import atomic_batch, check_target
-from ..errors import OutputError
-from ..placement.imperfect import Imperfections
-from ..plane import circle_polygon
-from ..profiles.band import gear_band_outline
-from ..report import drive_report
-from ..report.deformed import deformed_scene
-from ..report.notes import not_modelled
-from .dxf import DxfLayer, write_dxf
-from .figures import assembly_png
-from .json_text import json_text
+from ...atomic import atomic_batch, check_target
+from ...errors import OutputError
+from ...placement.imperfect import Imperfections
+from ...plane import circle_polygon
+from ...profiles.band import gear_band_outline
+from ...report import drive_report
+from ...report.deformed import deformed_scene
+from ...report.notes import not_modelled
+from ..formats.dxf import DxfLayer, write_dxf
+from ..formats.json_text import json_text
+from ..formats.stl import ring_solid, write_stl
+from ..pictures.drive import assembly_png
 from .manifest import Manifest, manifest_name
-from .stl import ring_solid, write_stl
 
 __all__ = ["DriveFiles", "angle_tag", "report_name", "planned_names", "write_drive_files"]
 

@@ -545,7 +545,7 @@ def _mark_spot(axs, ends, label: str) -> None:
 
 def tightest_spot_png(flex_teeth: np.ndarray, labels, rigid_teeth: np.ndarray, overlap, title: str, spot=None) -> bytes:
     """The teeth around the tightest spot, unrolled about the worst tooth: flexspline (blue), rigid (grey), overlaps
-    (red); ``spot`` (:func:`wgcad.export.audit_figures.tightest_points`, with a ``label``): the close-up framed on
+    (red); ``spot`` (:func:`wgcad.export.pictures.audit.tightest_points`, with a ``label``): the close-up framed on
     it and the spot marked."""
     return _png(tightest_spot_figure(flex_teeth, labels, rigid_teeth, overlap, title, spot))
 

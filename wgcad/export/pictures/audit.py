@@ -1,18 +1,18 @@
-"""The audit's pictures: what each one shows is computed here from the drive and the result, drawn by :mod:`wgcad.export.figures`."""
+"""The audit's pictures: what each one shows is computed here from the drive and the result, drawn by :mod:`wgcad.export.pictures.drive`."""
 
 from __future__ import annotations
 
 import numpy as np
 import shapely
 
-from ..clearance.engine import Scene, clearance_profile, clearance_vs_angle
-from ..clearance.entry import entry_crossings
-from ..clearance.imperfect import ImperfectScene, flex_poses_batch
-from ..placement import tooth_pose, transform
-from ..placement.imperfect import Imperfections
-from ..report.audit import audit_json
-from .figures import clearance_profile_png, clearance_vs_angle_png, tightest_spot_png
-from .imperfect_figures import entry_passages_png
+from ...clearance.engine import Scene, clearance_profile, clearance_vs_angle
+from ...clearance.entry import entry_crossings
+from ...clearance.imperfect import ImperfectScene, flex_poses_batch
+from ...placement import tooth_pose, transform
+from ...placement.imperfect import Imperfections
+from ...report.audit import audit_json
+from .drive import clearance_profile_png, clearance_vs_angle_png, tightest_spot_png
+from .imperfect import entry_passages_png
 
 __all__ = ["EXACT_BAND_MM", "audit_plot_data", "audit_pngs", "exact_near_minimum", "tightest_points"]
 

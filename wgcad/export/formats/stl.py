@@ -1,6 +1,6 @@
 """Extruded ring solids (manifold3d) and deterministic binary STL export, in mm.
 
-The solids are :class:`wgcad.export.mesh.Mesh` (numpy arrays, see there why
+The solids are :class:`wgcad.export.formats.mesh.Mesh` (numpy arrays, see there why
 not trimesh's); the tests read the STL back with trimesh.
 """
 
@@ -14,8 +14,8 @@ import shapely
 
 from wgcad.atomic import atomic_write
 from wgcad.errors import GeometryError
-from wgcad.export.mesh import Mesh
-from wgcad.export.rings import clean_outline
+from wgcad.export.formats.mesh import Mesh
+from wgcad.export.formats.rings import clean_outline
 from wgcad.plane import signed_area
 
 __all__ = ["ring_solid", "stl_bytes", "write_stl"]

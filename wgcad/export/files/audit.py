@@ -6,10 +6,10 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from ..atomic import atomic_batch
-from .audit_figures import audit_plot_data, audit_pngs
-from .html import audit_html
-from .json_text import json_text
+from ...atomic import atomic_batch
+from ..formats.json_text import json_text
+from ..pages.audit import audit_html
+from ..pictures.audit import audit_plot_data, audit_pngs
 
 __all__ = ["plot_paths", "write_audit_files"]
 
@@ -23,7 +23,7 @@ def plot_paths(plot) -> list[tuple[str, Path]]:
 def write_audit_files(
     run, *, json_path=None, baseline=None, baseline_path=None, plot=None, html=None, on_pictures=None
 ) -> list[Path]:
-    """Write what is asked of the audit ``run`` (:func:`wgcad.report.audit_run.audit_document`): the JSON document
+    """Write what is asked of the audit ``run`` (:func:`wgcad.services.audit_report.audit_document`): the JSON document
     to ``json_path``, the baseline document ``baseline`` to ``baseline_path``, the pictures named after ``plot``
     (:func:`plot_paths`), the page to ``html``. Nothing is written unless all is; ``on_pictures()`` is called
     when the pictures start. Returns the paths written."""

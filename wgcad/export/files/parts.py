@@ -7,22 +7,16 @@ from __future__ import annotations
 from dataclasses import dataclass
 from pathlib import Path
 
-from ..atomic import atomic_batch, check_writable_dir
-from ..errors import GeometryError
-from .dxf import write_dxf
-from .json_text import json_text
-from .parts import build_parts
-from .parts.kernel import require
-from .parts.title import title_layer
-from .step import step_bytes
-from .stl import write_stl
-from .svg import write_svg
-from .threemf import exploded, write_3mf
+from ...atomic import atomic_batch, check_writable_dir
+from ...errors import DesignError, GeometryError
+from ..formats.json_text import json_text
+from ..formats.registry import FORMATS, Drawing
+from ..formats.step import step_bytes
+from ..parts import build_parts
+from ..parts.kernel import require
+from ..parts.title import title_layer
 
 __all__ = ["FORMATS", "PartFiles", "write_part_files", "part_report"]
-
-#: the file formats of the part set
-FORMATS = ("dxf", "svg", "stl", "3mf", "step")
 
 
 def _jsonable(v):
@@ -48,19 +42,6 @@ class PartFiles:
     files: list
 
 
-def _write_drawings(part, drive, source, fmts, target) -> None:
-    """The part's DXF and SVG drawings (``target(kind)`` gives each file's temporary path), each with its title block
-    (what, from which design, units, scale, material)."""
-    if not part.layers:
-        return
-
-    layers = [*part.layers, title_layer(part.name, drive.design, source, part.layers, drive.tol)]
-    if "dxf" in fmts:
-        write_dxf(target("dxf"), layers)
-    if "svg" in fmts:
-        write_svg(target("svg"), layers, f"{drive.design.drive.name}: {part.name}")
-
-
 def write_part_files(
     drive, sizes, source, out, *, formats=FORMATS, dxf_style: str = "arcs", generator_angles_deg=(), progress=None
 ) -> PartFiles:
@@ -71,35 +52,44 @@ def write_part_files(
     :class:`~wgcad.errors.GeometryError`, nothing written; STEP without build123d a
     :class:`~wgcad.errors.DependencyError` naming the extra); ``progress(fraction, stage)`` follows the work."""
     tick = progress or (lambda f, stage: None)
-    fmts = list(formats)
+    chosen = list(formats)
+    for name in chosen:
+        if name not in FORMATS:
+            raise DesignError("formats", f"'{name}' is not a format (choose from {', '.join(FORMATS)})")
+    fmts = [f for name, f in FORMATS.items() if name in chosen]  # written in the registry's order
+    sources = {f.source for f in fmts}
     out, stem = Path(out), Path(source).stem
     parts = build_parts(drive, sizes, style=dxf_style, tol=drive.tol, generator_angles_deg=list(generator_angles_deg))
-    # the steps weighted by what they cost (a mesh or a DXF/SVG/STL file is one unit, a STEP solid and its text
-    # each several): the progress moves with the work
-    step_parts = [p for p in parts if not p.name.startswith("assembly")] if "step" in fmts else []
+    # what the chosen formats are written from, each part's: its drawing, mesh (also for the set's 3MF) and solid
+    step_parts = [p for p in parts if not p.name.startswith("assembly")] if "solid" in sources else []
     if step_parts:
         require()  # a missing CAD extra is said before anything is built
-    n_mesh = len(parts) if {"stl", "3mf"} & set(fmts) else 0
+    n_mesh = len(parts) if {"mesh", "set"} & sources else 0
+    # the steps weighted by what they cost (a mesh or a DXF/SVG/STL file is one unit, a STEP solid and its text
+    # each several): the progress moves with the work
     total = 1.0 + 1.0 * n_mesh + 8.0 * len(step_parts) + 0.5 * len(parts)
     done = 1.0
     tick(done / total, "meshes" if n_mesh else "solids")
     # build everything before the output folder is touched
-    meshes = {}
-    if n_mesh:
+    items = {"drawing": {}, "mesh": {}, "solid": {}}
+    if "drawing" in sources:
         for p in parts:
-            tick(done / total, f"mesh: {p.name}")
-            m = p.mesh()
-            if not m.is_watertight:
-                raise GeometryError(f"{p.name}: mesh is not watertight")
-            meshes[p.name] = m
-            done += 1.0
-    texts = {}
+            if p.layers:  # with its title block (what, from which design, units, scale, material)
+                title = title_layer(p.name, drive.design, source, p.layers, drive.tol)
+                items["drawing"][p.name] = Drawing([*p.layers, title], f"{drive.design.drive.name}: {p.name}")
+    for p in parts if n_mesh else ():
+        tick(done / total, f"mesh: {p.name}")
+        m = p.mesh()
+        if not m.is_watertight:
+            raise GeometryError(f"{p.name}: mesh is not watertight")
+        items["mesh"][p.name] = m
+        done += 1.0
     for p in step_parts:
         tick(done / total, f"STEP solid: {p.name}")
         solid = p.solid()
         done += 4.0
         tick(done / total, f"STEP text: {p.name}")
-        texts[p.name] = step_bytes(solid)
+        items["solid"][p.name] = step_bytes(solid)
         done += 4.0
     check_writable_dir(out)
     files = []
@@ -109,7 +99,7 @@ def write_part_files(
         "dxf_style": dxf_style,
         # [load] rated_torque_nm: the torque the bolts are sized for, not the datasheet's rated torque (docs/glossary.md)
         "design_torque_nm": drive.design.load.rated_torque_nm,
-        "formats": fmts,
+        "formats": chosen,
         # only the sizes of parts this drive has (an external drive has no cup and no flange)
         "sizes_mm": _jsonable({k: sizes.values[k] for k in sizes.used if sizes.values.get(k) is not None}),
         "derived_from_gear_size": list(sizes.derived),
@@ -127,22 +117,13 @@ def write_part_files(
         for p in parts:
             tick(done / total, f"files: {p.name}")
             report["parts"][p.name] = part_report(p)
-            _write_drawings(p, drive, source, fmts, lambda kind, p=p: target(f"{stem}_{p.name}.{kind}"))
-            if "stl" in fmts:
-                write_stl(target(f"{stem}_{p.name}.stl"), meshes[p.name])
-            if p.name in texts:
-                Path(target(f"{stem}_{p.name}.step")).write_bytes(texts[p.name])
+            for f in fmts:
+                if f.source != "set" and p.name in items[f.source]:
+                    f.write(target(f"{stem}_{p.name}.{f.name}"), items[f.source][p.name])
             done += 0.5
-        if "3mf" in fmts:
-            # the parts side by side (once: assembled at the origin they shared 1234 mm^3, which a slicer takes
-            # for intersecting objects); the deformed assemblies below stay assembled: that is what they show
-            own = {p.name: meshes[p.name] for p in parts if not p.name.startswith("assembly")}
-            write_3mf(target(f"{stem}_parts.3mf"), own, exploded(own))
-            for p in parts:
-                if p.name.startswith("assembly"):
-                    write_3mf(
-                        target(f"{stem}_{p.name}.3mf"), {f"{p.name}_{k}": m for k, m in p.member_meshes().items()}
-                    )
+        for f in fmts:
+            if f.source == "set":
+                f.write(target, stem, parts, items["mesh"])
         # named by the design, as every other file here: two designs can share a folder
         report["files"] = [f.name for f in files] + [f"{stem}_parts.json"]
         Path(target(f"{stem}_parts.json")).write_text(json_text(report) + "\n")

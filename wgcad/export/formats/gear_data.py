@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..profiles.measure import pin_check, span_check
+from ...profiles.measure import pin_check, span_check
 
 __all__ = ["span_measurement", "pin_dimension", "gear_data", "data_lines"]
 

@@ -8,7 +8,7 @@ import os
 import stat
 from pathlib import Path
 
-from ..errors import OutputError
+from ...errors import OutputError
 
 __all__ = ["manifest_name", "Manifest"]
 

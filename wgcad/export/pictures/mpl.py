@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import io
 
-from ..extras import require
+from ...extras import require
 
 __all__ = ["pyplot", "png_bytes"]
 

@@ -23,7 +23,7 @@ def step_bytes(shape) -> bytes:
     files are less than half the size and written faster). The header's time stamp is fixed; its file name is the
     shape's label.
     """
-    from .parts.kernel import require
+    from ..parts.kernel import require
 
     bd = require()
     buf = io.BytesIO()
@@ -45,7 +45,7 @@ def read_step(path: str | os.PathLike) -> list:
     GeometryError
         If the file cannot be read.
     """
-    from .parts.kernel import require
+    from ..parts.kernel import require
 
     require()
     from OCP.IFSelect import IFSelect_RetDone

@@ -14,8 +14,8 @@ import numpy as np
 from wgcad.atomic import atomic_write
 from wgcad.constants import DUPLICATE_TOL  # noqa: F401  (re-exported for callers)
 from wgcad.errors import InputFileError
-from wgcad.export.arcs import arc_points
-from wgcad.export.rings import clean_outline, min_spacing
+from wgcad.export.formats.arcs import arc_points
+from wgcad.export.formats.rings import clean_outline, min_spacing
 
 __all__ = [
     "DxfLayer",
@@ -74,7 +74,7 @@ class DxfLayer:
         AutoCAD Color Index of the layer, 1..255 (7 = white/black).
     paths : tuple of ((N, 2) float, (N,) float) pairs
         Closed paths of arcs: vertices and the bulge ``tan(theta/4)`` of the
-        segment starting at each vertex (an :class:`~wgcad.export.arcs.ArcPath`
+        segment starting at each vertex (an :class:`~wgcad.export.formats.arcs.ArcPath`
         also works). Written as LWPOLYLINE with bulges.
     texts : tuple of (x, y, height, str)
         Single-line texts (lower-left corner, character height, mm).

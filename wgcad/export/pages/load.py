@@ -4,8 +4,8 @@ from __future__ import annotations
 
 import html
 
-from ..extras import require
-from .html_page import figure, fmt, page, table
+from ...extras import require
+from .frame import figure, fmt, page, table
 
 __all__ = ["load_html", "load_figures"]
 

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .figures import DPI, MIN_FONT_PT, legend_outside
+from .drive import DPI, MIN_FONT_PT, legend_outside
 from .mpl import png_bytes, pyplot
 
 __all__ = ["entry_passages_figure", "entry_passages_png"]

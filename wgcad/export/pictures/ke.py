@@ -280,7 +280,7 @@ def ke_load_png(title: str, res, loaded: list) -> bytes:
 
 
 def ke_pngs(run) -> dict:
-    """The pictures of a KE run (:class:`wgcad.report.ke_run.KERun`) as ``{suffix: PNG bytes}``: ``_ke``, ``_flank``
+    """The pictures of a KE run (:class:`wgcad.services.ke.KERun`) as ``{suffix: PNG bytes}``: ``_ke``, ``_flank``
     and, where computed, ``_ke_load`` and ``_install``."""
     drive, imp = run.drive, run.imp
     d = drive.design.drive

@@ -6,9 +6,9 @@ import itertools
 
 import numpy as np
 
-from ..extras import require
-from ..sweep.summary import MIN_FAILING_TO_RANK, failing_samples, few_failing_note, weakest_figure
-from .html_page import figure, fmt, page, table
+from ...extras import require
+from ...sweep.summary import MIN_FAILING_TO_RANK, failing_samples, few_failing_note, weakest_figure
+from .frame import figure, fmt, page, table
 
 __all__ = ["sweep_html"]
 

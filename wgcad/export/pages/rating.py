@@ -8,8 +8,8 @@ import numpy as np
 
 from wgcad.units import ARCMIN_PER_RAD, UM_PER_MM
 
-from ..extras import require
-from .html_page import figure, fmt, notes, page, table
+from ...extras import require
+from .frame import figure, fmt, notes, page, table
 
 __all__ = ["rating_html"]
 

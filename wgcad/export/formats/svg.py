@@ -8,7 +8,7 @@ from xml.sax.saxutils import escape
 import numpy as np
 
 from wgcad.atomic import atomic_write
-from wgcad.export.arcs import bulge_centres
+from wgcad.export.formats.arcs import bulge_centres
 
 __all__ = ["svg_text", "write_svg"]
 

@@ -6,10 +6,10 @@ import numpy as np
 
 from wgcad.units import ARCMIN_PER_RAD, UM_PER_MM
 
-from .friction_figures import efficiency_panel, input_panel, loop_panel
+from .friction import efficiency_panel, input_panel, loop_panel
 from .mpl import png_bytes, pyplot
 
-#: the legends' font, points (the pictures' smallest font is 8 pt, :data:`wgcad.export.figures.MIN_FONT_PT`)
+#: the legends' font, points (the pictures' smallest font is 8 pt, :data:`wgcad.export.pictures.drive.MIN_FONT_PT`)
 LEGEND_PT = 8.5
 
 __all__ = ["LEGEND_PT", "rating_figure", "rating_png"]

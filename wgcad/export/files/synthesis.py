@@ -8,11 +8,11 @@ import io
 import textwrap
 from pathlib import Path
 
-from ..atomic import atomic_batch
-from ..report.synthesis import design_text, search_json, trial_rows
-from ..synthesis.requirements import OBJECTIVES
-from .json_text import json_text
-from .mpl import png_bytes, pyplot
+from ...atomic import atomic_batch
+from ...report.synthesis import design_text, search_json, trial_rows
+from ...synthesis.requirements import OBJECTIVES
+from ..formats.json_text import json_text
+from ..pictures.mpl import png_bytes, pyplot
 
 __all__ = ["write_search_files", "search_figure", "search_plot"]
 
