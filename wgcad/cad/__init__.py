@@ -36,7 +36,7 @@ def _parts(design, tol_mm, generator_angles_deg) -> list:
 
 def _shape(part):
     """The part's build123d shape with its entry of the parts JSON as ``wgcad``."""
-    from wgcad.export.files.parts import part_report
+    from wgcad.report.parts import part_report
 
     shape = part.solid()
     shape.wgcad = part_report(part)

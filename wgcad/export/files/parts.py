@@ -9,6 +9,7 @@ from pathlib import Path
 
 from ...atomic import atomic_batch, check_writable_dir
 from ...errors import DesignError, GeometryError
+from ...report.parts import part_report, parts_document
 from ..formats.json_text import json_text
 from ..formats.registry import FORMATS, Drawing
 from ..formats.step import step_bytes
@@ -16,20 +17,7 @@ from ..parts import build_parts
 from ..parts.kernel import require
 from ..parts.title import title_layer
 
-__all__ = ["FORMATS", "PartFiles", "write_part_files", "part_report"]
-
-
-def _jsonable(v):
-    if isinstance(v, dict):
-        return {k: _jsonable(x) for k, x in v.items() if k not in ("plug_outline", "neutral_line")}
-    if isinstance(v, float):
-        return round(v, 6)
-    return v
-
-
-def part_report(part) -> dict:
-    """The part's entry of ``<design>_parts.json``: its volume and the figures of its ``info``, rounded."""
-    return {"volume_mm3": round(part.volume_mm3, 4), **_jsonable(part.info)}
+__all__ = ["FORMATS", "PartFiles", "write_part_files"]
 
 
 @dataclass(slots=True)
@@ -93,20 +81,7 @@ def write_part_files(
         done += 4.0
     check_writable_dir(out)
     files = []
-    report = {
-        "design": str(source),
-        "chord_tol_mm": drive.tol,
-        "dxf_style": dxf_style,
-        # [load] rated_torque_nm: the torque the bolts are sized for, not the datasheet's rated torque (docs/glossary.md)
-        "design_torque_nm": drive.design.load.rated_torque_nm,
-        "formats": chosen,
-        # only the sizes of parts this drive has (an external drive has no cup and no flange)
-        "sizes_mm": _jsonable({k: sizes.values[k] for k in sizes.used if sizes.values.get(k) is not None}),
-        "derived_from_gear_size": list(sizes.derived),
-        "size_rules": dict(sizes.rules),
-        "warnings": list(sizes.notes),
-        "parts": {},
-    }
+    report = parts_document(drive, sizes, source, dxf_style, chosen)
     with atomic_batch() as batch:
 
         def target(name):
