@@ -271,7 +271,7 @@ def bench_engines(quick: bool) -> list[dict]:
     d4 = build_drive(load_design(ROOT / "templates" / "d4_discrete.toml"))
     sc = Scene(d4)
     phis = np.deg2rad(np.linspace(30.0, 60.0, 7 if quick else 13))
-    t2, c2 = best_of(lambda: tooth_clearance(sc, phis, None)["min"], 5)
+    t2, c2 = best_of(lambda: tooth_clearance(sc, phis, None).min, 5)
     t3, res = best_of(lambda: [check_tooth(sc, float(p)) for p in phis], 1)
     diff = max(abs(1e3 * (r.fcl_distance - c)) for r, c in zip(res, c2))
     rows.append(

@@ -39,14 +39,11 @@ def _pairs(scene: Scene, n: int = 240, reach: float = 0.4):
         phi = np.linspace(-pi / scene.n_w, pi / scene.n_w, n)
         rot, shift = scene.pose_sections(phi, np.zeros(n, dtype=int), [z])
         det = clearance_at_poses(scene, rot, shift)
-        for key, jk in (("lower", "lo"), ("upper", "up"), ("third", "th")):
-            if key not in det:
-                continue
-            v = det[key]
+        for v, rigid in ((det.lower, det.lo), (det.upper, det.up), (det.third, det.th)):
             sel = np.nonzero(np.isfinite(v) & (v > scene.chord_gap) & (v < reach))[0]
             rots.append(rot[sel])
             shifts.append(shift[sel])
-            js.append(det[jk][sel])
+            js.append(rigid[sel])
     return np.concatenate(rots), np.concatenate(shifts), np.concatenate(js)
 
 

@@ -93,7 +93,7 @@ def test_tooth_angle_reduction_matches_the_real_tooth(d1):
         lo, up, _ = scene.neighbours(shift, rot)
         real = np.minimum(scene.clearance_to(rot, shift, lo), scene.clearance_to(rot, shift, up))
         red = tooth_clearance(scene, (phi + pi) % (2 * pi) - pi, None, third=False)
-        np.testing.assert_allclose(np.minimum(red["lower"], red["upper"]), real, atol=1e-12)
+        np.testing.assert_allclose(np.minimum(red.lower, red.upper), real, atol=1e-12)
 
 
 SHORTCUTS = ["use_period", "use_waves", "use_mirror", "cull", "bound"]
@@ -158,7 +158,7 @@ def test_deliberately_interfering_design_is_found_where_and_how_deep(d4):
     radial = bad.rigid.r_f - bad.flex.r_a - bad.law.w0
     assert radial == pytest.approx(-0.140, abs=1e-12)
     scene = Scene(bad)
-    at_axis = tooth_clearance(scene, np.array([0.0]))["min"][0]
+    at_axis = tooth_clearance(scene, np.array([0.0])).min[0]
     # the deepest vertex is the tip corner, measured to the root arc: the radial overlap,
     # within the chord tolerance of the polygons (1 um)
     assert at_axis == pytest.approx(radial, abs=1e-3)
@@ -199,7 +199,7 @@ def test_crossing_is_where_the_tip_meets_the_rigid_tip_circle_and_delta_is_the_p
     c, s = np.cos(rot[0]), np.sin(rot[0])
     placed = p @ np.array([[c, s], [-s, c]]) + shift[0]
     assert np.hypot(placed[:, 0], placed[:, 1]).max() == pytest.approx(d1n.rigid.r_a, abs=1e-7)
-    assert tooth_clearance(scene, np.array([phi]), z, exact=True)["min"][0] == pytest.approx(cr.value, abs=1e-7)
+    assert tooth_clearance(scene, np.array([phi]), z, exact=True).min[0] == pytest.approx(cr.value, abs=1e-7)
     e = audit_json(res)["entry"]
     assert e["kind"] == "pinch" and res.entry_gap <= cr.value
     assert res.entry_gap == res.findings["entry_pinch"].value
@@ -208,7 +208,7 @@ def test_crossing_is_where_the_tip_meets_the_rigid_tip_circle_and_delta_is_the_p
     pphi = np.deg2rad(e["pinch_tooth_angle_deg"])
     near = np.linspace(pphi - np.deg2rad(1), pphi + np.deg2rad(1), 401)
     pz = e["pinch_section_z_mm"]
-    assert e["pinch_um"] <= 1e3 * tooth_clearance(scene, near, pz)["min"].min() + 1e3 * scene.chord_gap + 1e-4
+    assert e["pinch_um"] <= 1e3 * tooth_clearance(scene, near, pz).min.min() + 1e3 * scene.chord_gap + 1e-4
 
 
 def test_backlash_of_a_clean_design_by_rotation(d4):

@@ -140,8 +140,7 @@ def test_rigid_eccentricity_deepens_by_its_amplitude(d1):
         z=z,
     )
     det = IM.clearance_at_poses(scene, rot, shift)
-    side = min(("lower", "upper"), key=lambda s: det[s][0])
-    j = det["lo"] if side == "lower" else det["up"]
+    j = det.lo if det.lower[0] <= det.upper[0] else det.up
     th = np.radians(np.arange(0.0, 360.0, 0.5))
     t = 1e-3 * np.stack([np.cos(th), np.sin(th)], -1)
     vals = scene.exact_to(np.full(th.size, rot[0]), shift + t, np.full(th.size, j[0]))[0]  # on the exact curves

@@ -13,7 +13,13 @@ from test_stability import designs
 
 from wgcad.cli import main
 from wgcad.design import load_design, parse_design, with_changes
-from wgcad.design.budget import DEFAULT_MAX_MEMORY_MB, check_budget, estimate_run, outline_vertices_per_tooth
+from wgcad.design.budget import (
+    DEFAULT_MAX_MEMORY_MB,
+    RunShape,
+    check_budget,
+    estimate_run,
+    outline_vertices_per_tooth,
+)
 from wgcad.drive import build_drive, tooth_spec
 from wgcad.errors import DesignError
 from wgcad.profiles.gear import make_gear
@@ -94,12 +100,11 @@ def test_refused_before_any_large_allocation():
 
 def test_no_budget_means_no_refusal_and_the_estimate_grows_with_the_work():
     d = load_design(TEMPLATES / "d4_discrete.toml")
-    a = estimate_run(d, 1e-3, angles=720, sections=3)
-    b = estimate_run(d, 1e-4, angles=720, sections=3)
-    c = estimate_run(d, 1e-3, angles=7200, sections=3)
-    full = estimate_run(
-        d, 1e-3, angles=720, sections=3, use_period=False, use_waves=False, use_mirror=False, bound=False
-    )
+    a = estimate_run(d, 1e-3, run=RunShape(angles=720, sections=3))
+    b = estimate_run(d, 1e-4, run=RunShape(angles=720, sections=3))
+    c = estimate_run(d, 1e-3, run=RunShape(angles=7200, sections=3))
+    bare = RunShape(angles=720, sections=3, use_period=False, use_waves=False, use_mirror=False, bound=False)
+    full = estimate_run(d, 1e-3, run=bare)
     assert a.memory_mb < b.memory_mb and a.memory_mb < c.memory_mb < full.memory_mb * 10
     assert a.memory_mb < full.memory_mb
     assert check_budget(full, None) is full
@@ -143,9 +148,9 @@ print(json.dumps({"code": code, "rss_mb": int(hwm) / 1024}))
     [
         (
             ["audit", "d1_involute", "--step-deg", "0.05", "--sections", "3", "--quiet"],
-            dict(angles=7200, sections=3, exports=False),
+            RunShape(angles=7200, sections=3, exports=False),
         ),
-        (["generate", "d4_discrete", "--chord-tol-um", "0.1", "--quiet"], dict(exports=True)),
+        (["generate", "d4_discrete", "--chord-tol-um", "0.1", "--quiet"], RunShape(exports=True)),
     ],
 )
 def test_memory_estimate_is_above_the_measured_peak_and_not_far(argv, run, tmp_path):
@@ -161,7 +166,7 @@ def test_memory_estimate_is_above_the_measured_peak_and_not_far(argv, run, tmp_p
     tol = 1e-4 if "0.1" in argv else 1e-3
     drive = build_drive(d, tol=tol)
     counts = {"flexspline": _per_tooth(drive.flex), "rigid": _per_tooth(drive.rigid)}
-    est = estimate_run(d, tol, vertices_per_tooth=counts, **run).memory_mb
+    est = estimate_run(d, tol, run=run, vertices_per_tooth=counts).memory_mb
     # an estimate is for refusing runs: above the real peak, and within 4x of it (fitted on other runs)
     assert res["rss_mb"] <= est <= 4.0 * res["rss_mb"], (res["rss_mb"], est)
 
@@ -186,7 +191,7 @@ def test_generate_estimate_is_within_2x_of_the_peak_on_every_template(name, tmp_
         args = ["generate", str(TEMPLATES / f"{name}.toml"), "--out", str(tmp_path / f"o{stl}"), "--quiet", *extra]
         code, peak = _peak_mb(args, ROOT)
         assert code == 0
-        est = estimate_run(d, 1e-3, exports=stl).memory_mb  # what build_drive checks for generate
+        est = estimate_run(d, 1e-3, run=RunShape(exports=stl)).memory_mb  # what build_drive checks for generate
         assert peak <= est <= 2.0 * peak, (name, stl, peak, est)
 
 
@@ -199,5 +204,6 @@ def test_audit_estimate_is_within_2x_of_the_peak_on_every_template(name):
     d = load_design(TEMPLATES / f"{name}.toml")
     drive = build_drive(d, tol=1e-3)
     counts = {"flexspline": _per_tooth(drive.flex), "rigid": _per_tooth(drive.rigid)}
-    est = estimate_run(d, 1e-3, vertices_per_tooth=counts, angles=720, sections=3, exports=False).memory_mb
+    run = RunShape(angles=720, sections=3, exports=False)
+    est = estimate_run(d, 1e-3, run=run, vertices_per_tooth=counts).memory_mb
     assert peak <= est <= 2.0 * peak, (name, peak, est)

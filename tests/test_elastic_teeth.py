@@ -28,10 +28,10 @@ def test_flank_gaps_are_the_engines_signed_clearance(name):
             shift = shift + np.array(dv)
             ref = clearance_at_poses(scene, rot, shift, third=False)
             got = flank_contacts(scene, rot, shift)
-            for key, j in (("lower", "lo"), ("upper", "up")):
-                assert np.array_equal(got[key].rigid, ref[j])
-                assert np.abs(got[key].gap - ref[key]).max() < 1e-12
-                n_over += int((ref[key] < 0).sum())
+            for key, val, rigid in (("lower", ref.lower, ref.lo), ("upper", ref.upper, ref.up)):
+                assert np.array_equal(got[key].rigid, rigid)
+                assert np.abs(got[key].gap - val).max() < 1e-12
+                n_over += int((val < 0).sum())
                 n = got[key].normal
                 assert np.allclose(np.hypot(n[:, 0], n[:, 1]), 1.0)
     assert n_over > 0  # the overlapping branch was exercised

@@ -127,7 +127,7 @@ def test_loft_finds_a_minimum_between_sections():
 def test_d4_fcl_equals_2d(d4):
     phi = np.deg2rad(np.arange(30.0, 61.0, 7.5))
     c = tooth_clearance(d4, phi)
-    assert np.all(c["min"] > 0)
+    assert np.all(c.min > 0)
     for p in phi:
         r = tooth_check_document(fcl3d.check_tooth(d4, float(p)))
         assert r["agree"] and not r["fcl_overlap"] and r["bound_um"] == 0.0
@@ -140,7 +140,7 @@ def test_d4_fcl_equals_2d(d4):
             assert not ov and abs(d - c2) <= 1e-6
     # the engine's figure is the minimum over the teeth checked
     r = tooth_check_document(fcl3d.check_tooth(d4, float(phi[0])))
-    assert r["clearance_2d_um"] == pytest.approx(1e3 * c["min"][0], abs=1e-6)
+    assert r["clearance_2d_um"] == pytest.approx(1e3 * c.min[0], abs=1e-6)
 
 
 def test_d4_penetration_is_an_overlap(d4):
@@ -169,7 +169,7 @@ def test_d1_fcl_within_bound(d1):
     for n in (9, 17):
         zs = np.linspace(0.0, d1.drive.design.drive.face_width, n)
         for p in phis:
-            assert min(tooth_clearance(d1, np.array([p]), float(z))["min"][0] for z in zs) > 0
+            assert min(tooth_clearance(d1, np.array([p]), float(z)).min[0] for z in zs) > 0
             r = tooth_check_document(fcl3d.check_tooth(d1, float(p), n_sections=n))
             assert r["agree"] and not r["fcl_overlap"]
             d, c2, b = r["fcl_distance_um"], r["clearance_2d_um"], r["bound_um"]

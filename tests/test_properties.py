@@ -170,8 +170,8 @@ def test_a_symmetric_drive_is_its_own_mirror_image(phi, thinning, w0, law):
     a = tooth_clearance(scene, phi, exact=True)
     b = tooth_clearance(scene, -phi, exact=True)
     # the two sides are measured on mirrored polygons through separate shapely calls: round-off only
-    np.testing.assert_allclose(a["lower"], b["upper"], rtol=0, atol=1e-9)
-    np.testing.assert_allclose(a["upper"], b["lower"], rtol=0, atol=1e-9)
+    np.testing.assert_allclose(a.lower, b.upper, rtol=0, atol=1e-9)
+    np.testing.assert_allclose(a.upper, b.lower, rtol=0, atol=1e-9)
 
 
 # --------------------------------------------------------------------------- clearance against thinning and W0
@@ -216,7 +216,7 @@ def test_backlash_is_never_negative_and_nan_only_where_teeth_overlap(phi_h, thin
     d = drive.design.drive
     k = np.arange(d.z_flex)
     phi = 2 * math.pi * k / d.z_flex + phi_h / gear_ratios(d.z_flex, d.z_rigid)["u_hg"] - phi_h
-    c = float(tooth_clearance(scene, phi, exact=True)["min"].min())
+    c = float(tooth_clearance(scene, phi, exact=True).min.min())
     b = backlash(scene, phi_h, exact=True)
     if c > 1e-9:
         assert b > 0.0, (c, b)

@@ -37,14 +37,14 @@ def _pairs(name, n_pairs=12):
     rot, shift = scene.pose(phi, z)
     det = clearance_at_poses(scene, rot, shift)
     rows, idx = [], []
-    for key, jk in (("lower", "lo"), ("upper", "up")):
-        sel = np.nonzero(det[key] < 0.05)[0]
+    for val, rigid in ((det.lower, det.lo), (det.upper, det.up)):
+        sel = np.nonzero(val < 0.05)[0]
         pick = sel[np.linspace(0, len(sel) - 1, min(n_pairs // 2, len(sel))).astype(int)] if sel.size else sel
         # and the pairs nearest to grazing contact (|clearance| smallest), where the value is flattest
-        graze = np.argsort(np.abs(det[key]))[:3]
+        graze = np.argsort(np.abs(val))[:3]
         pick = np.union1d(pick, graze)
         rows.append(pick)
-        idx.append(det[jk][pick])
+        idx.append(rigid[pick])
     rows, idx = np.concatenate(rows), np.concatenate(idx)
     return drive, scene, z, rot[rows], shift[rows], idx
 
@@ -110,11 +110,11 @@ def test_pairs_far_apart_match_dense_polygons(name):
     rot, shift = scene.pose(phi, z)
     det = clearance_at_poses(scene, rot, shift)
     rows, idx = [], []
-    for key, jk in (("lower", "lo"), ("upper", "up")):
-        sel = np.nonzero((det[key] > 0.05) & (det[key] < 1.5))[0]
+    for val, rigid in ((det.lower, det.lo), (det.upper, det.up)):
+        sel = np.nonzero((val > 0.05) & (val < 1.5))[0]
         pick = sel[np.linspace(0, len(sel) - 1, min(10, len(sel))).astype(int)] if sel.size else sel
         rows.append(pick)
-        idx.append(det[jk][pick])
+        idx.append(rigid[pick])
     rows, j = np.concatenate(rows), np.concatenate(idx)
     assert len(rows) >= 10
     rot, shift = rot[rows], shift[rows]

@@ -220,6 +220,6 @@ def test_transmission_sector_is_the_plain_drive(d4):
             mine[int(k)] = min(mine.get(int(k), np.inf), v)
         ks = np.array(sorted(mine))
         rot, shift, _ = sc.flex_state(np.array([phi_h]))
-        ref = clearance_at_poses(plain, rot[0, ks], shift[0, ks])["min"]
+        ref = clearance_at_poses(plain, rot[0, ks], shift[0, ks]).min
         assert len(ks) > 8
         assert np.allclose([mine[k] for k in ks], ref, rtol=0, atol=1e-12)

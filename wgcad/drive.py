@@ -10,7 +10,7 @@ import numpy as np
 
 from . import constants
 from .design import Design
-from .design.budget import DEFAULT_MAX_MEMORY_MB, check_budget, estimate_run
+from .design.budget import DEFAULT_MAX_MEMORY_MB, RunShape, check_budget, estimate_run
 from .envelope.rigid import conjugate_rigid_gear
 from .errors import DesignError
 from .laws import Law, coned_w0, make_law
@@ -200,7 +200,7 @@ def build_drive(
     tol: float = constants.CHORD_TOL,
     *,
     max_memory_mb: float | None = DEFAULT_MAX_MEMORY_MB,
-    run: dict | None = None,
+    run: RunShape = RunShape(exports=False),
     rigid_gear: Gear | None = None,
 ) -> Drive:
     """Build both gears and the deformation law, checking the derived geometry.
@@ -210,7 +210,7 @@ def build_drive(
 
     Before any outline is sampled the run is estimated
     (:func:`wgcad.design.budget.estimate_run`, with ``run`` its audit and
-    export settings) and refused if it would exceed ``max_memory_mb``
+    exports; the default: the outlines alone) and refused if it would exceed ``max_memory_mb``
     (None: no limit); an audit is checked again with the built gears' own
     vertex counts.
 
@@ -222,16 +222,15 @@ def build_drive(
     """
     if not tol > 0:
         raise DesignError("chord_tol", f"must be > 0, got {tol:g}")
-    run = dict(run or {"exports": False})
     # the outlines first, from the upper estimate of their vertex counts; the audit's arrays
     # (which dwarf the outlines) once the gears give their own counts, before the audit starts
-    check_budget(estimate_run(design, tol, **{**run, "angles": 0}), max_memory_mb)
+    check_budget(estimate_run(design, tol, run=replace(run, angles=0)), max_memory_mb)
     flex = make_gear(tooth_spec(design, "flexspline"), tol)
     rigid = make_gear(tooth_spec(design, "rigid"), tol)
     _check_teeth_meet(design)  # after each gear's own rules, which name the field to change first
-    if run.get("angles"):
+    if run.angles:
         counts = {"flexspline": len(flex.period) - 1, "rigid": len(rigid.period) - 1}
-        check_budget(estimate_run(design, tol, vertices_per_tooth=counts, **run), max_memory_mb)
+        check_budget(estimate_run(design, tol, run=run, vertices_per_tooth=counts), max_memory_mb)
     h1 = design.flexspline.rim_thickness
     if design.external:
         # internal-toothed flexspline: rim outside its root circle

@@ -52,7 +52,15 @@ from .entry import (
     smallest,
 )
 from .findings import AuditRun, Finding
-from .scene import Scene, classify, clearance_at_poses, refine_min, tooth_clearance, tooth_clearance_sections
+from .scene import (
+    PairFigures,
+    Scene,
+    classify,
+    clearance_at_poses,
+    refine_min,
+    tooth_clearance,
+    tooth_clearance_sections,
+)
 from .search import AuditSettings, SectionSearch, evaluate, fold, sample_phi
 
 __all__ = [
@@ -180,9 +188,7 @@ def _canonical(scene: Scene, folded: np.ndarray, phi_w: float, z, exact: bool):
     det = tooth_clearance(scene, both, z, exact=exact)  # the spot and its mirror image in one call
     placed = scene.place(both, z)
     for i, p in enumerate(both):
-        side = min(("lower", "upper", "third"), key=lambda k: det[k][i])
-        ridx = det["up"][i] if side == "upper" else det["lo"][i] if side == "lower" else det["th"][i]
-        locs.append(classify(scene, placed[i], int(ridx), float(p), z))
+        locs.append(classify(scene, placed[i], det.nearest(i)[1], float(p), z))
     return a, locs[0], locs[1], flat, sgn
 
 
@@ -320,14 +326,13 @@ def _refine(drive, scene: Scene, phi_sorted, sections, cands, settings: AuditSet
         # the finer polygons' figure of every pair of every candidate, once they have been measured: the exact
         # refinement then takes only the pairs within the finer margin of their sample's smallest (the pair that
         # holds a sample's exact minimum is among them), about half the pairs of a flat minimum
-        finer = {}
+        finer, finer_gap = None, None
 
         def fine(idx, bar=np.inf):
             # many samples within the polygon-curve margin (a flat minimum): polygons FINE times finer
+            nonlocal finer, finer_gap
             ref_scene = Scene(drive.sampled_at(drive.tol / FINE))
-            n = len(cand_v)
-            finer.update({key: np.full(n, np.inf) for key in ("lower", "upper", "third", "min")})
-            finer.update({key: np.zeros(n, dtype=int) for key in ("lo", "up", "th")})
+            finer = PairFigures.full(len(cand_v))
 
             def part(sl):
                 k = idx[sl]
@@ -338,22 +343,20 @@ def _refine(drive, scene: Scene, phi_sorted, sections, cands, settings: AuditSet
                 need = coarse <= np.nanmin(coarse, axis=1, keepdims=True) + 2.0 * scene.chord_gap
                 need &= coarse - scene.chord_gap < bar  # nor those that cannot go below the exact figures' best
                 det = clearance_at_poses(ref_scene, rot, shift, need=need)
-                for key, arr in finer.items():
-                    arr[k] = det[key]
-                return det["min"]
+                finer.put(k, det)
+                return det.min
 
             vals = _chunked(part, len(idx))
-            finer["gap"] = ref_scene.chord_gap
-            return vals, ref_scene.chord_gap
+            finer_gap = ref_scene.chord_gap
+            return vals, finer_gap
 
         def exact(idx):
             def part(c):
                 k = idx[c]
-                if not finer:
+                if finer is None:
                     return tooth_clearance_sections(scene, phi_sorted[cand_i[k]], cand_s[k], sections, exact=True)
                 rot, shift = scene.pose_sections(phi_sorted[cand_i[k]], cand_s[k], sections)
-                det = {key: finer[key][k] for key in ("lower", "upper", "third", "min", "lo", "up", "th")}
-                return refine_min(scene, rot, shift, det, gap=finer["gap"])["min"]
+                return refine_min(scene, rot, shift, finer.take(k), gap=finer_gap).min
 
             return _chunked(part, len(idx))
 
@@ -464,9 +467,7 @@ def _worst_finding(
     ai, k = divmod(flat, scene.z_g)
     phi_rep = sgn_c * phi_c
     detail = tooth_clearance(scene, np.array([phi_rep]), z_w, area=True)
-    side_val = {"lower": detail["lower"][0], "upper": detail["upper"][0], "third": detail["third"][0]}
-    side = min(side_val, key=side_val.get)
-    area = detail.get(f"{side}_area", np.zeros(1))[0] if side != "third" else 0.0
+    area = detail.overlap_area(detail.nearest(0)[0], 0)
     return Finding(
         "min_clearance",
         float(best),
@@ -519,8 +520,8 @@ def clearance_profile(scene: Scene, sections, step_deg: float = 0.1) -> dict:
     out = []
     for z in sections:
         res = tooth_clearance(scene, phi, z, third=False)
-        w, n = ("upper", "lower") if scene.working == "upper" else ("lower", "upper")
-        out.append({"z": z, "working": res[w], "nonworking": res[n]})
+        w, n = (res.upper, res.lower) if scene.working == "upper" else (res.lower, res.upper)
+        out.append({"z": z, "working": w, "nonworking": n})
     return {"phi": phi, "sections": out}
 
 

@@ -334,7 +334,7 @@ def check_tooth(scene: Scene, phi: float, n_sections: int = 9, sections=None, tr
     """FCL distance of the flexspline tooth at ``phi`` to the rigid teeth it can touch, against the 2D engine over the same sections.
 
     Rigid teeth: :meth:`Scene.neighbours` (lower, upper, third) at every
-    section, middle section first. 2D figure: ``tooth_clearance(...)["min"]``
+    section, middle section first. 2D figure: ``tooth_clearance(...).min``
     minimised over the sections, and per rigid tooth
     :meth:`Scene.clearance_to` minimised over the sections.
 
@@ -437,9 +437,7 @@ def _section_clearances(scene: Scene, rot, shift, teeth) -> tuple[np.ndarray, np
             for k in range(n)
         ]
     )
-    c_engine = np.array(
-        [float(clearance_at_poses(scene, rot[k : k + 1], shift[k : k + 1])["min"][0]) for k in range(n)]
-    )
+    c_engine = np.array([float(clearance_at_poses(scene, rot[k : k + 1], shift[k : k + 1]).min[0]) for k in range(n)])
     return c, c_engine
 
 

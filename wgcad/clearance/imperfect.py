@@ -40,7 +40,7 @@ from .findings import AuditRun, Finding, ImperfectRun
 from .imperfect_bounds import ErrorBound, PerfectBound, PerfectBounds, chunk_bounds
 from .imperfect_entry import imperfect_entry
 from .imperfect_scene import ImperfectScene
-from .scene import Scene, clearance_at_poses, refine_min
+from .scene import PairFigures, Scene, clearance_at_poses, refine_min
 
 __all__ = [
     "ImperfectScene",
@@ -75,7 +75,7 @@ def _evaluate_poses(scene, rot, shift) -> np.ndarray:
     vals = np.empty(len(rot))
     for a in range(0, len(rot), _BATCH):
         b = min(a + _BATCH, len(rot))
-        vals[a:b] = clearance_at_poses(scene, rot[a:b], shift[a:b])["min"]
+        vals[a:b] = clearance_at_poses(scene, rot[a:b], shift[a:b]).min
     return vals
 
 
@@ -348,30 +348,26 @@ def _refine(run: _Run, found: _Found) -> tuple[float, int, int, int]:
 
     # the finer polygons' figure of every pair of every candidate: the exact refinement then takes only the pairs
     # within the finer margin of their sample's smallest (as the perfect drive's audit, engine._refine)
-    finer = {}
-    keys = ("lower", "upper", "third", "min", "lo", "up", "th")
+    finer, finer_gap = None, None
 
     def fine(idx, bar=None):
+        nonlocal finer, finer_gap
         ref = ImperfectScene.from_scene(Scene(run.drive.sampled_at(run.drive.tol / FINE)), run.imp)
         rot, shift = run.poses(found.a[idx], found.k[idx], found.s[idx])
-        n = len(found.v)
-        finer.update(
-            {key: (np.zeros(n, dtype=int) if key in ("lo", "up", "th") else np.full(n, np.inf)) for key in keys}
-        )
+        finer = PairFigures.full(len(found.v))
         # in batches: a candidate on the finer polygons holds ~18 kB while measured, and their number
         # grows with the sampling density (2900 at 0.05 deg on D1 [S4])
         for a in range(0, len(rot), _FINE_BATCH):
             det = clearance_at_poses(ref, rot[a : a + _FINE_BATCH], shift[a : a + _FINE_BATCH])
-            for key in keys:
-                finer[key][idx[a : a + _FINE_BATCH]] = det[key]
-        finer["gap"] = ref.chord_gap
-        return finer["min"][idx], ref.chord_gap
+            finer.put(idx[a : a + _FINE_BATCH], det)
+        finer_gap = ref.chord_gap
+        return finer.min[idx], finer_gap
 
     def exact(idx):
         rot, shift = run.poses(found.a[idx], found.k[idx], found.s[idx])
-        if not finer:
-            return refine_min(run.isc, rot, shift, clearance_at_poses(run.isc, rot, shift))["min"]
-        return refine_min(run.isc, rot, shift, {key: finer[key][idx] for key in keys}, gap=finer["gap"])["min"]
+        if finer is None:
+            return refine_min(run.isc, rot, shift, clearance_at_poses(run.isc, rot, shift)).min
+        return refine_min(run.isc, rot, shift, finer.take(idx), gap=finer_gap).min
 
     return refine_candidates(found.v, run.isc.chord_gap, exact, fine=fine, one_call=_ONE_CALL)
 
@@ -382,9 +378,8 @@ def _worst_finding(run: _Run, found: _Found, where: int, best: float, best_poly:
     ai, k, si = int(found.a[where]), int(found.k[where]), int(found.s[where])
     rot, shift = run.poses(np.array([ai]), np.array([k]), np.array([si]))
     det = clearance_at_poses(isc, rot, shift, area=True)
-    side = min(("lower", "upper", "third"), key=lambda s: det[s][0])
-    j = int(det["lo"][0] if side == "lower" else det["up"][0] if side == "upper" else det["th"][0])
-    area = det.get(f"{side}_area", np.zeros(1))[0] if side != "third" else 0.0
+    side, j = det.nearest(0)
+    area = det.overlap_area(side, 0)
     phi_tooth = float((2 * pi * k / run.z_g + angles[ai] / scene.ratios["u_hg"] - angles[ai] + pi) % (2 * pi) - pi)
     phi_major = float((phi_tooth + pi / scene.n_w) % (2 * pi / scene.n_w) - pi / scene.n_w)
     return Finding(

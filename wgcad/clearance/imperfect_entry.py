@@ -163,7 +163,7 @@ def imperfect_entry(drive, imp, isc, scene, perfect_gaps, perfect_pinch, angles,
         po, ko = ph[ok], k[ok]
         v = np.concatenate(
             [
-                clearance_at_poses(isc, *_poses(drive, imp, isc, po[a : a + _CHUNK], ko[a : a + _CHUNK], z))["min"]
+                clearance_at_poses(isc, *_poses(drive, imp, isc, po[a : a + _CHUNK], ko[a : a + _CHUNK], z)).min
                 for a in range(0, len(po), _CHUNK)
             ]
             or [np.zeros(0)]
@@ -193,7 +193,7 @@ def imperfect_entry(drive, imp, isc, scene, perfect_gaps, perfect_pinch, angles,
                 for a in range(0, len(m), _CHUNK):
                     mm = m[a : a + _CHUNK]
                     rot, shift = _poses(drive, imp, isc, ph[order[mm]], k[order[mm]], perfect_gaps[s][1])
-                    vf[mm] = clearance_at_poses(fine, rot, shift)["min"]
+                    vf[mm] = clearance_at_poses(fine, rot, shift).min
             vr, margin = np.full(len(v), np.inf), fine.chord_gap
             vr[order] = vf
             order = order[np.argsort(vf, kind="stable")]
@@ -205,7 +205,7 @@ def imperfect_entry(drive, imp, isc, scene, perfect_gaps, perfect_pinch, angles,
             for s in np.unique(si[b]):
                 sel = b[si[b] == s]
                 rot, shift = _poses(drive, imp, isc, ph[sel], k[sel], perfect_gaps[s][1])
-                vals = refine_min(isc, rot, shift, clearance_at_poses(isc, rot, shift))["min"]
+                vals = refine_min(isc, rot, shift, clearance_at_poses(isc, rot, shift)).min
                 j = int(np.argmin(vals))
                 if vals[j] < gap:
                     gap, best = float(vals[j]), int(sel[j])
@@ -243,7 +243,7 @@ def _pinch(drive, imp, isc, scene, perfect_gaps, perfect_pinch, shifts, refine):
         for a in range(0, len(centre), _CHUNK):
             phs = centre[a : a + _CHUNK, None] + offs[None, :] / c
             rot, shift = _poses(drive, imp, isc, phs.ravel(), np.repeat(ko[a : a + _CHUNK], G), z)
-            v[a : a + _CHUNK] = clearance_at_poses(isc, rot, shift)["min"].reshape(-1, G)
+            v[a : a + _CHUNK] = clearance_at_poses(isc, rot, shift).min.reshape(-1, G)
         cand.append((v.min(axis=1), v.min(axis=1) - 0.5 * speed[si] * (offs[1] - offs[0]) / abs(c), centre, ko, si))
     best = min(float(x[0].min()) for x in cand if len(x[0]))
     # passages whose window can hold a value below the best sampled one (Lipschitz between grid points)
@@ -264,7 +264,7 @@ def _pinch(drive, imp, isc, scene, perfect_gaps, perfect_pinch, shifts, refine):
         for s in np.unique(ss[idx]):
             m = ss[idx] == s
             rot, shift = _poses(drive, imp, isc, x[m], kk[idx][m], perfect_gaps[s][1])
-            vals[m] = clearance_at_poses(isc, rot, shift)["min"]
+            vals[m] = clearance_at_poses(isc, rot, shift).min
         return vals
 
     V = np.array([speed[s] for s in ss])
@@ -286,7 +286,7 @@ def _pinch(drive, imp, isc, scene, perfect_gaps, perfect_pinch, shifts, refine):
         for _ in range(4):
             g = np.clip(p_c + np.linspace(-w, w, 17), lo_[i], hi_[i])
             rot, shift = _poses(drive, imp, isc, g, np.full(17, kk[i]), z)
-            v = refine_min(isc, rot, shift, clearance_at_poses(isc, rot, shift))["min"]
+            v = refine_min(isc, rot, shift, clearance_at_poses(isc, rot, shift)).min
             j = int(np.argmin(v))
             if v[j] < val:
                 val, p_c = float(v[j]), float(g[j])
@@ -295,7 +295,7 @@ def _pinch(drive, imp, isc, scene, perfect_gaps, perfect_pinch, shifts, refine):
     z = perfect_gaps[ss[i]][1]
     rot, shift = _poses(drive, imp, isc, np.array([x]), np.array([kk[i]]), z)
     det = clearance_at_poses(isc, rot, shift)
-    side = "lower" if det["lower"][0] <= det["upper"][0] else "upper"
+    rigid = det.lo if det.lower[0] <= det.upper[0] else det.up
     return {
         "pinch": float(val),
         "pinch_phi_h": float(x),
@@ -304,5 +304,5 @@ def _pinch(drive, imp, isc, scene, perfect_gaps, perfect_pinch, shifts, refine):
         "pinch_tooth_angle": float(2 * pi * kk[i] / scene.z_g + c * x),
         "pinch_rot": float(rot[0]),
         "pinch_shift": shift[0],
-        "pinch_rigid": int(det["lo" if side == "lower" else "up"][0]),
+        "pinch_rigid": int(rigid[0]),
     }

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from dataclasses import dataclass, replace
 from functools import cached_property
 from math import pi
 
@@ -13,7 +14,80 @@ from ..placement import pose_from_displacements, tooth_frames, tooth_pose, trans
 from .distance import Template, signed_clearance
 from .refine import ExactTooth, apart_pairs, refine_pairs
 
-__all__ = ["Scene", "tooth_clearance", "tooth_clearance_sections", "clearance_at_poses", "refine_min", "classify"]
+__all__ = [
+    "Scene",
+    "PairFigures",
+    "tooth_clearance",
+    "tooth_clearance_sections",
+    "clearance_at_poses",
+    "refine_min",
+    "classify",
+]
+
+# the pairs a placed tooth is measured against, in the order of PairFigures.pairs
+_SIDES = ("lower", "upper", "third")
+
+
+@dataclass(frozen=True, slots=True)
+class PairFigures:
+    """Signed clearance of K placed flexspline teeth to the rigid teeth below, above and third nearest.
+
+    Attributes
+    ----------
+    lower, upper, third : (K,) float
+        Clearance to each pair's rigid tooth, mm (negative: penetration
+        depth; inf: not measured).
+    min : (K,) float
+        Each tooth's smallest of the three.
+    lo, up, th : (K,) int
+        The rigid teeth below, above and third nearest.
+    lower_area, upper_area : (K,) float or None
+        Overlap areas of the lower and upper pairs, mm^2 (measured on request).
+    """
+
+    lower: np.ndarray
+    upper: np.ndarray
+    third: np.ndarray
+    min: np.ndarray
+    lo: np.ndarray
+    up: np.ndarray
+    th: np.ndarray
+    lower_area: np.ndarray | None = None
+    upper_area: np.ndarray | None = None
+
+    @classmethod
+    def full(cls, n: int) -> PairFigures:
+        """``n`` teeth not measured yet: every figure inf, every rigid index 0 (a store filled by :meth:`put`)."""
+        inf = [np.full(n, np.inf) for _ in range(4)]
+        return cls(*inf, *(np.zeros(n, dtype=int) for _ in range(3)))
+
+    def take(self, idx) -> PairFigures:
+        """The figures of teeth ``idx`` (an index array or a mask)."""
+        area = [None if a is None else a[idx] for a in (self.lower_area, self.upper_area)]
+        return PairFigures(*(a[idx] for a in self._measured()), *area)
+
+    def put(self, idx, other: PairFigures) -> None:
+        """Write ``other``'s figures and rigid indices into teeth ``idx`` of this store (its areas are not kept)."""
+        for mine, theirs in zip(self._measured(), other._measured()):
+            mine[idx] = theirs
+
+    def pairs(self) -> np.ndarray:
+        """``(K, 3)``: each tooth's lower, upper and third figures."""
+        return np.stack([self.lower, self.upper, self.third], axis=1)
+
+    def nearest(self, i: int) -> tuple[str, int]:
+        """The pair holding tooth ``i``'s smallest figure (lower, upper, third: the first on a tie) and its rigid tooth."""
+        side = min(_SIDES, key=lambda s: getattr(self, s)[i])
+        rigid = {"lower": self.lo, "upper": self.up, "third": self.th}[side]
+        return side, int(rigid[i])
+
+    def overlap_area(self, side: str, i: int) -> float:
+        """Tooth ``i``'s overlap area with the rigid tooth of pair ``side``, mm^2 (0 for the third or unmeasured)."""
+        area = {"lower": self.lower_area, "upper": self.upper_area}.get(side)
+        return 0.0 if area is None else float(area[i])
+
+    def _measured(self):
+        return self.lower, self.upper, self.third, self.min, self.lo, self.up, self.th
 
 
 class Scene:
@@ -223,16 +297,15 @@ class Scene:
         return self.rigid_rot[j], self.rigid_shift[j], 2.0 * self.chord_gap
 
 
-def tooth_clearance(scene: Scene, phi, z=None, third: bool = True, area: bool = False, exact: bool = False) -> dict:
+def tooth_clearance(
+    scene: Scene, phi, z=None, third: bool = True, area: bool = False, exact: bool = False
+) -> PairFigures:
     """Signed clearance of a tooth at angles ``phi`` to the rigid teeth below and above it (and the third nearest).
 
-    Returns
-    -------
-    dict of (K,) arrays: ``lower``, ``upper``, ``third`` (mm, negative =
-    penetration depth), ``min``, ``lo``/``up`` rigid tooth indices, and with
-    ``area`` the overlap areas ``lower_area``, ``upper_area``. With
-    ``exact`` the figures of every pair that can hold the minimum are
-    refined on the exact curves (:func:`refine_min`).
+    Returns the figures of every angle (:class:`PairFigures`, with ``area``
+    the lower and upper overlap areas). With ``exact`` the figures of every
+    pair that can hold the minimum are refined on the exact curves
+    (:func:`refine_min`).
     """
     phi = np.atleast_1d(np.asarray(phi, dtype=float))
     rot, shift = scene.pose(phi, z)
@@ -250,54 +323,43 @@ def tooth_clearance_sections(
     if exact:
         out = refine_min(scene, rot, shift, out)
     if pairs:
-        return out["min"], np.stack([out["lower"], out["upper"], out["third"]], axis=1)
-    return out["min"]
+        return out.min, out.pairs()
+    return out.min
 
 
-def refine_min(scene: Scene, rot: np.ndarray, shift: np.ndarray, det: dict, gap: float | None = None) -> dict:
+def refine_min(
+    scene: Scene, rot: np.ndarray, shift: np.ndarray, det: PairFigures, gap: float | None = None
+) -> PairFigures:
     """Refine on the exact curves every pair of :func:`clearance_at_poses` that can hold a tooth's minimum.
 
     A pair's exact figure is within ``scene.chord_gap`` of its polygon one,
     so only pairs whose polygon figure is within twice that of the tooth's
     smallest are refined; the others keep their polygon figures (they
     cannot be the minimum; ``gap``: the polygons' own where ``det`` comes from finer
-    polygons than the scene's). Adds ``refined_lower``/``_upper``/``_third``
-    (bool) and ``point_lower``... (the extremal point, rigid-tooth frame
-    for side 0) to ``det`` and updates the figures and ``min``.
+    polygons than the scene's). Returns ``det`` with the refined figures and ``min``.
     """
-    out = dict(det)
     gap = scene.chord_gap if gap is None else gap
-    best = det["min"]
-    idx = {"lower": det["lo"], "upper": det["up"]}
-    if "th" in det:
-        idx["third"] = det["th"]
-    needs = {}
-    for key in idx:
-        val = np.asarray(det[key], dtype=float)
-        needs[key] = np.nonzero(np.isfinite(val) & (val <= best + 2.0 * gap))[0]
+    figs = [np.asarray(v, dtype=float) for v in (det.lower, det.upper, det.third)]
+    rigid = (det.lo, det.up, det.th)
+    needs = [np.nonzero(np.isfinite(v) & (v <= det.min + 2.0 * gap))[0] for v in figs]
     # every pair of every kind in one call: the refinement's cost is per call more than per pair
-    allk = np.concatenate([needs[k] for k in idx])
-    allj = np.concatenate([idx[k][needs[k]] for k in idx])
+    allk = np.concatenate(needs)
+    allj = np.concatenate([j[need] for j, need in zip(rigid, needs)])
     # a pair whose polygon figure exceeds the polygons' gap is apart on the curves too
-    apart = np.concatenate([np.asarray(det[k], dtype=float)[needs[k]] > gap for k in idx])
+    apart = np.concatenate([v[need] > gap for v, need in zip(figs, needs)])
     ex = scene.exact_to(rot[allk], shift[allk], allj, apart=apart)[0] if allk.size else np.zeros(0)
     at = 0
-    for key in idx:
-        val = np.asarray(det[key], dtype=float).copy()
-        need = needs[key]
-        val[need] = ex[at : at + need.size]
+    for i, need in enumerate(needs):
+        figs[i] = figs[i].copy()
+        figs[i][need] = ex[at : at + need.size]
         at += need.size
-        done = np.zeros(len(val), dtype=bool)
-        done[need] = True
-        out[key] = val
-        out[f"refined_{key}"] = done
-    out["min"] = np.minimum(np.minimum(out["lower"], out["upper"]), out.get("third", np.inf))
-    return out
+    lower, upper, third = figs
+    return replace(det, lower=lower, upper=upper, third=third, min=np.minimum(np.minimum(lower, upper), third))
 
 
 def clearance_at_poses(
     scene: Scene, rot: np.ndarray, shift: np.ndarray, third: bool = True, area: bool = False, need=None
-) -> dict:
+) -> PairFigures:
     """:func:`tooth_clearance` for teeth given by their poses (rigid frame).
 
     ``need (K, 3)`` bool, optional: which of the lower, upper and third
@@ -306,20 +368,23 @@ def clearance_at_poses(
     lo, up, th = scene.neighbours(shift, rot)
     pts = transform(scene.flex_local, rot, shift)
     geoms = shapely.polygons(pts)  # built once, measured against every neighbour
-    out = {}
-    for col, (key, idx) in enumerate((("lower", lo), ("upper", up))):
+    figs, areas = [], [None, None]
+    for col, idx in enumerate((lo, up)):
         if need is not None:
             k = np.nonzero(need[:, col])[0]
-            out[key] = np.full(len(rot), np.inf)
-            out[key][k] = scene.clearance_to(rot[k], shift[k], idx[k], flex_geoms=geoms[k])
+            val = np.full(len(rot), np.inf)
+            val[k] = scene.clearance_to(rot[k], shift[k], idx[k], flex_geoms=geoms[k])
+            figs.append(val)
             continue
         res = scene.clearance_to(rot, shift, idx, area=area, flex_geoms=geoms)
         if area:
-            out[key], out[f"{key}_area"] = res
+            figs.append(res[0])
+            areas[col] = res[1]
         else:
-            out[key] = res
-    best = np.minimum(out["lower"], out["upper"])
-    out["third"] = np.full(len(rot), np.inf)
+            figs.append(res)
+    lower, upper = figs
+    best = np.minimum(lower, upper)
+    third_v = np.full(len(rot), np.inf)
     if third:
         # the third tooth lies beyond a bracketing one: 2 R sin(dphi/2) bounds its distance,
         # with dphi the angular gap between the tooth and the third tooth's flank extent
@@ -335,10 +400,8 @@ def clearance_at_poses(
             near &= need[:, 2]
         k = np.nonzero(near)[0]
         if k.size:
-            out["third"][k] = scene.clearance_to(rot[k], shift[k], th[k], flex_geoms=geoms[k])
-    out["min"] = np.minimum(best, out["third"])
-    out["lo"], out["up"], out["th"] = lo, up, th
-    return out
+            third_v[k] = scene.clearance_to(rot[k], shift[k], th[k], flex_geoms=geoms[k])
+    return PairFigures(lower, upper, third_v, np.minimum(best, third_v), lo, up, th, *areas)
 
 
 def classify(scene: Scene, pts: np.ndarray, rigid_idx: int, phi: float, z) -> str:

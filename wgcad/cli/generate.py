@@ -8,6 +8,7 @@ import textwrap
 import time
 
 from ..design import load_design
+from ..design.budget import RunShape
 from ..drive import build_drive
 from ..export.files.drive import write_drive_files
 from ..export.formats.json_text import json_text
@@ -31,7 +32,7 @@ def cmd_generate(args) -> int:
     bar.set(0.0, "reading the design")
     design = load_design(args.design)
     # the STL meshes dominate what the exports add (wgcad.design.budget)
-    run = {"exports": not args.no_stl}
+    run = RunShape(exports=not args.no_stl)
     drive = build_drive(design, tol=args.chord_tol_um * 1e-3, max_memory_mb=args.max_memory_mb, run=run)
     res = write_drive_files(
         drive,

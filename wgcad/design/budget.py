@@ -20,6 +20,7 @@ from ..errors import DesignError
 
 __all__ = [
     "DEFAULT_MAX_MEMORY_MB",
+    "RunShape",
     "RunEstimate",
     "outline_vertices_per_tooth",
     "estimate_run",
@@ -93,6 +94,31 @@ class RunEstimate:
         }
 
 
+@dataclass(frozen=True, slots=True)
+class RunShape:
+    """What a run will do, as far as its memory goes: the audit's size and shortcuts and the exports.
+
+    Attributes
+    ----------
+    angles, sections : int
+        Generator angles over a revolution and cross-sections of an audit
+        (``angles=0``: no audit). Without coning one section is computed.
+    use_period, use_waves, use_mirror, bound : bool
+        The audit's shortcuts (:class:`wgcad.clearance.engine.AuditSettings`):
+        without them far more samples are kept and evaluated at once.
+    exports : bool
+        Whether the STL solids of the outlines are written (``generate``; its DXF alone fits in the base).
+    """
+
+    angles: int = 0
+    sections: int = 1
+    use_period: bool = True
+    use_waves: bool = True
+    use_mirror: bool = True
+    bound: bool = True
+    exports: bool = True
+
+
 def outline_vertices_per_tooth(form: str, module: float, tol: float) -> int:
     """Upper estimate of the vertices of one pitch of a sampled outline (tip, flanks, fillets, root)."""
     return int(ceil(_VERTS_A + _VERTS_B.get(form, max(_VERTS_B.values())) * sqrt(module / tol)))
@@ -102,13 +128,7 @@ def estimate_run(
     design,
     tol: float = constants.CHORD_TOL,
     *,
-    angles: int = 0,
-    sections: int = 1,
-    use_period: bool = True,
-    use_waves: bool = True,
-    use_mirror: bool = True,
-    bound: bool = True,
-    exports: bool = True,
+    run: RunShape = RunShape(),
     vertices_per_tooth: dict | None = None,
 ) -> RunEstimate:
     """Estimate the outline sizes, audit samples and peak memory of a run, from the design alone.
@@ -119,14 +139,8 @@ def estimate_run(
         A validated design (field bounds hold, so every product below is finite).
     tol : float
         Chord tolerance, mm.
-    angles, sections : int
-        Generator angles over a revolution and cross-sections of an audit
-        (``angles=0``: no audit). Without coning one section is computed.
-    use_period, use_waves, use_mirror, bound : bool
-        The audit's shortcuts (:class:`wgcad.clearance.engine.AuditSettings`):
-        without them far more samples are kept and evaluated at once.
-    exports : bool
-        Whether the STL solids of the outlines are written (``generate``; its DXF alone fits in the base).
+    run : RunShape
+        The audit and exports of the run (the default: the outlines and their exports, no audit).
     vertices_per_tooth : dict, optional
         Measured vertices of one pitch (``{"flexspline": n, "rigid": n}``) of
         gears already built, instead of the upper estimate.
@@ -139,20 +153,20 @@ def estimate_run(
     verts = dict(vertices_per_tooth) if vertices_per_tooth else {"flexspline": per, "rigid": per}
     n_out = verts["flexspline"] * dr.z_flex + verts["rigid"] * dr.z_rigid
     mem = _BASE_B + n_out * 16.0 * 6  # outline arrays and their intermediates (angles, radii, polar)
-    if exports:
+    if run.exports:
         mem += n_out * _PER_EXPORT_VERTEX_B
     mem += _CONJUGATE_B * sum(getattr(design, g).flanks == "conjugate" for g in ("flexspline", "rigid"))
     samples = 0
-    if angles > 0:
-        secs = sections if design.generator.cone_length is not None else 1
-        n_s = angles * dr.z_flex
+    if run.angles > 0:
+        secs = run.sections if design.generator.cone_length is not None else 1
+        n_s = run.angles * dr.z_flex
         samples = n_s * secs
         fold = 1
-        if use_period:
-            fold *= 2 if use_mirror else 1
-            fold *= dr.waves if (use_waves and dr.z_flex % dr.waves == 0) else 1
-        n_u = n_s // fold if use_period else n_s
-        batch = n_u * secs if not bound else max(1, n_u * secs // _BOUND_BATCH_DIVISOR)
+        if run.use_period:
+            fold *= 2 if run.use_mirror else 1
+            fold *= dr.waves if (run.use_waves and dr.z_flex % dr.waves == 0) else 1
+        n_u = n_s // fold if run.use_period else n_s
+        batch = n_u * secs if not run.bound else max(1, n_u * secs // _BOUND_BATCH_DIVISOR)
         p = verts["flexspline"] + 2  # a tooth polygon: one pitch closed through the body
         mem += (
             n_s * _PER_SAMPLE_B

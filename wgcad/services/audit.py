@@ -6,14 +6,14 @@ The library's users reach it as :mod:`wgcad.audit` (``from wgcad.audit import Ru
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
 from ..clearance.engine import AuditSettings, audit
 from ..clearance.imperfect import audit_imperfect, chunk_angles
 from ..design import load_design
-from ..design.budget import DEFAULT_MAX_MEMORY_MB
+from ..design.budget import DEFAULT_MAX_MEMORY_MB, RunShape
 from ..drive import build_drive
 from ..errors import DesignError
 from ..numbers import Bound
@@ -114,22 +114,22 @@ def run_audit(design_path, rs: RunSettings, progress=None):
     design = load_design(design_path)
     n = int(round(360.0 / rs.step_deg))
     # judged before any large allocation: outlines, sample arrays and evaluation batches
-    run = {
-        "angles": n,
-        "sections": rs.sections,
-        "use_period": rs.use_period,
-        "use_waves": rs.use_waves,
-        "use_mirror": rs.use_mirror,
-        "bound": rs.bound,
-        "exports": False,
-    }
+    run = RunShape(
+        angles=n,
+        sections=rs.sections,
+        use_period=rs.use_period,
+        use_waves=rs.use_waves,
+        use_mirror=rs.use_mirror,
+        bound=rs.bound,
+        exports=False,
+    )
     # the imperfect poses (docs/models.md 6.2) take the rigid gear as the fixed member (the housing's
     # frame); with a fixed flexspline the audit stays on perfect parts and says so (cli.common.not_modelled)
     imperfect = design.imperfections.any and design.drive.fixed == "rigid"
     if imperfect:
         # imperfect parts: the sweep is held one chunk of generator angles at a time
         # (wgcad.clearance.imperfect), whatever its length
-        run.update(angles=min(n, chunk_angles(design.drive.z_flex, rs.sections)), use_period=False)
+        run = replace(run, angles=min(n, chunk_angles(design.drive.z_flex, rs.sections)), use_period=False)
     turns = 1
     if imperfect:
         turns = full_cycle_turns(design.drive.z_flex, design.drive.z_rigid) if rs.turns is None else rs.turns
