@@ -1,6 +1,6 @@
-"""Two rules of the code's own text (docs/architecture.md): no module imports another's private name (a name shared
+"""Rules of the code's own text (docs/architecture.md): no module imports another's private name (a name shared
 between modules is public, in one place), and no tracker numbers in the code (the tracker is not in the
-repository: the code says why in words)."""
+repository: the code says why in words), no run times in its prose (they go stale)."""
 
 from __future__ import annotations
 
@@ -53,3 +53,27 @@ def test_no_tracker_numbers_in_the_code(path):
         if TRACKER.search(line)
     ]
     assert not hits, "\n".join(hits)
+
+
+#: a run time quoted in the code's prose goes stale with the next machine or release: milliseconds, seconds of CPU,
+#: wall or whole-process time, a before -> after timing (benchmarks/ and the README carry the measured figures)
+TIMING = re.compile(
+    r"\b\d+(\.\d+)?(-\d+(\.\d+)?)? ?ms\b|\b\d+(\.\d+)?(-\d+(\.\d+)?)? s (CPU|wall|whole)|\d s -> |-> \d+(\.\d+)? s\b"
+)
+
+
+def test_no_run_times_in_the_code():
+    hits = [
+        f"{p.relative_to(PACKAGE.parent)}:{i}: {line.strip()}"
+        for p in MODULES
+        for i, line in enumerate(p.read_text(encoding="utf-8").splitlines(), 1)
+        if TIMING.search(line)
+    ]
+    assert not hits, "\n".join(hits)
+
+
+@pytest.mark.parametrize(
+    "line", ["# 3.2 ms per factorisation", "(1.2-1.3 s whole process)", "d2 2.49 -> 2.0 s)", "~30ms of import"]
+)
+def test_the_timing_check_finds_a_planted_one(line):
+    assert TIMING.search(line)

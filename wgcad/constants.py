@@ -61,12 +61,12 @@ REFINE_TOL = 1e-6
 
 #: Most torque levels one ``--torque-nm`` takes (``wgcad audit``, ``wgcad ke``). 1000 levels resolve a stiffness or
 #: entry-gap curve to 0.1 % of its torque range, finer than its figure's pixels and its table's lines need; they
-#: are ~3 min of elastic solves for D1 (0.2 s a level) and ~1.3 GB of solved states at 3 sections, inside the
+#: are a thousand elastic solves and ~1.3 GB of solved states for D1 at 3 sections, inside the
 #: default memory budget (wgcad.design.budget: the memory estimate judges each run's levels too).
 MAX_LOAD_LEVELS = 1000
 
 #: Most generator angles one ``--generator-angle`` takes (``wgcad generate``, ``wgcad parts``): one deformed-state
-#: drawing per degree of a revolution. Each angle writes its own DXF and PNG (~0.8 MB of files and ~4 s for D1), so
-#: 360 are already ~0.3 GB and half an hour; memory grows ~1 MB an angle (peak RSS of ``generate`` D1 --no-stl: 129 MB
+#: drawing per degree of a revolution. Each angle writes its own DXF and PNG (~0.8 MB of files for D1), so
+#: 360 are already ~0.3 GB; memory grows ~1 MB an angle (peak RSS of ``generate`` D1 --no-stl: 129 MB
 #: at 11 angles, 139 MB at 21), so these stay well inside the default memory budget without an estimate of their own.
 MAX_GENERATOR_ANGLES = 360

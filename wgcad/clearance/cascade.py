@@ -19,7 +19,7 @@ import numpy as np
 __all__ = ["refine_candidates", "FINE", "FINE_ABOVE"]
 
 #: above this many candidates they are first sorted out on polygons FINE times finer (chord tolerance / 8:
-#: margin 8 times smaller), which costs one finer outline (~30 ms) and a polygon pass, far less than refining
+#: margin 8 times smaller), which costs one finer outline and a polygon pass, far less than refining
 #: hundreds of samples on the curves
 FINE_ABOVE = 48
 FINE = 8

@@ -78,8 +78,8 @@ def _nearest_part(local, r, sh, rigid_g):
 
 def _nearest(local, r, sh, rigid_g):
     """The nearest points ``(K, 2, 2)`` (flexspline point first) of the flexspline outline ``local`` placed at
-    ``(r, sh)`` (K poses) to the rigid teeth ``rigid_g``, on two threads for many pairs (on 2 free cores wgcad ke
-    d2_imperfect 2.49 -> 2.0 s)."""
+    ``(r, sh)`` (K poses) to the rigid teeth ``rigid_g``, on two threads for many pairs (shapely releases the GIL in
+    its queries, so the two halves run at once)."""
     return in_halves(_nearest_part, (r, sh, rigid_g), shared=(local,))
 
 

@@ -1,4 +1,5 @@
-"""Command-line interface: ``wgcad generate``, ``audit`` and ``kinematics``, one module per subcommand (heavy modules imported lazily)."""
+"""Command-line interface: ``wgcad COMMAND``, one module per subcommand (:data:`COMMANDS`), each only parsing its
+flags, calling the library and printing; only the named command's module is imported."""
 
 from __future__ import annotations
 
@@ -6,9 +7,9 @@ import argparse
 import os
 import sys
 
-# The solvers' matrices are small (a few hundred rows): BLAS threads cost more than they save and,
-# on a busy machine, thrash (benchmarks/elastic.py measured 3.2 ms against 0.05 ms per Cholesky
-# factorisation, a 13-level torque sweep 2.7x slower). Set before numpy loads; a user's own setting wins.
+# The solvers' matrices are small (a few hundred rows): BLAS threads cost more than they save and, on a busy
+# machine, thrash (benchmarks/elastic.py run with and without
+# OPENBLAS_NUM_THREADS=1 shows it). Set before numpy loads; a user's own setting wins.
 for _var in ("OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
     os.environ.setdefault(_var, "1")
 
@@ -44,8 +45,7 @@ def build_parser(command: str | None = None) -> argparse.ArgumentParser:
     A subcommand's module imports the pipeline it runs at its top, so registering all ten loads every model,
     exporter and the synthesis (~500 modules); :func:`main` registers only the command named on its command
     line (the others are listed, with their one line of help, for ``wgcad --help`` and for argparse's
-    messages). ``wgcad audit templates/d1_involute.toml`` then loads 385 modules instead of 519 and takes a
-    quarter less time (1.2-1.3 s against 1.7-1.8 s whole process on 2 cores at load ~2).
+    messages), so a command loads only its own pipeline.
     """
     p = Parser(
         prog="wgcad",

@@ -20,7 +20,7 @@ __all__ = ["Ellipse", "ellipe", "ellipeinc"]
 
 
 def ellipe(m):
-    """Complete elliptic integral of the second kind (scipy.special, imported on first use: ~0.35 s)."""
+    """Complete elliptic integral of the second kind (scipy.special, imported on first use)."""
     from scipy.special import ellipe as _e
 
     return _e(m)

@@ -26,8 +26,8 @@ from .manifest import Manifest, manifest_name
 
 __all__ = ["DriveFiles", "angle_tag", "report_name", "planned_names", "write_drive_files"]
 
-# Relative cost of the steps, for a progress bar (measured on D1 involute: build 0.01-0.04 s, DXF 0.03 s, one
-# STL 0.2-0.8 s, one deformed-state picture 3.5-5.5 s on a loaded 2-core machine); only the bar's pace uses them.
+# Relative cost of the steps, for a progress bar (on D1 a deformed-state picture costs ~100 DXF files, an STL
+# ~10); only the bar's pace uses them.
 _COST = {"design": 0.3, "dxf": 0.3, "stl": 2.0, "angle_dxf": 1.0, "angle_png": 15.0, "report": 0.2}
 
 

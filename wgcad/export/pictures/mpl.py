@@ -1,4 +1,4 @@
-"""matplotlib at the edge: pyplot on the Agg backend, imported only when a picture is drawn (~1 s), and figures rendered to PNG bytes."""
+"""matplotlib at the edge: pyplot on the Agg backend, imported only when a picture is drawn, and figures rendered to PNG bytes."""
 
 from __future__ import annotations
 
