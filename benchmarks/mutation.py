@@ -43,6 +43,10 @@ SETS = {
     "solve": (["wgcad/elastic/solve.py"], ["tests/test_elastic_solver.py", "tests/test_solver_checks.py"]),
     "kinematics": (["wgcad/kinematics.py"], ["tests/test_kinematics.py", "tests/test_kinematics_checks.py"]),
     "plane": (["wgcad/plane.py", "wgcad/units.py"], ["tests/test_placement.py", "tests/test_kinematics.py"]),
+    "placement": (
+        ["wgcad/placement/law.py", "wgcad/placement/deformed.py"],
+        ["tests/test_placement.py", "tests/test_placement_checks.py", "tests/test_deformed_checks.py"],
+    ),
 }
 
 #: what is copied into the temporary folder (the tests read templates, docs and the README)
