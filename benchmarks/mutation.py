@@ -47,6 +47,10 @@ SETS = {
         ["wgcad/placement/law.py", "wgcad/placement/deformed.py"],
         ["tests/test_placement.py", "tests/test_placement_checks.py", "tests/test_deformed_checks.py"],
     ),
+    "profiles": (
+        ["wgcad/profiles/involute.py", "wgcad/profiles/cycloid.py", "wgcad/profiles/pieces.py"],
+        ["tests/test_profiles.py", "tests/test_pieces.py"],
+    ),
 }
 
 #: what is copied into the temporary folder (the tests read templates, docs and the README)

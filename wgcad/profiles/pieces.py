@@ -129,15 +129,23 @@ class Piece:
         return self._eval(np.atleast_1d(np.asarray(t, dtype=float)), 2)
 
     def length(self, n: int = 64) -> float:
-        """Arc length (Gauss-Legendre on ``n`` nodes; exact for arcs and lines), mm."""
+        """Arc length (Gauss-Legendre on ``n`` nodes, each spline segment its own; exact for arcs and lines), mm."""
         if self.kind == "arc":
             return abs(self.t1 - self.t0) * self.radius
         if self.kind == "line":
             return abs(self.t1 - self.t0) * float(np.hypot(self.params[2], self.params[3]))
         x, w = gauss_legendre(n)
-        h = 0.5 * (self.t1 - self.t0)
-        d = self.deriv(self.t0 + h * (x + 1.0))
-        return float(abs(h) * np.dot(w, np.hypot(d[:, 0], d[:, 1])))
+        lo, hi = sorted((self.t0, self.t1))
+        # a spline's speed jumps at its knots: the rule runs over each segment, where it is smooth (over the whole
+        # range it was 0.3 % short on a five-point spline)
+        cuts = np.arange(np.floor(lo) + 1.0, np.ceil(hi)) if self.kind == "spline" else np.zeros(0)
+        ends = np.concatenate([[lo], cuts, [hi]])
+        total = 0.0
+        for a, b in zip(ends[:-1], ends[1:]):
+            h = 0.5 * (b - a)
+            d = self.deriv(a + h * (x + 1.0))
+            total += h * float(np.dot(w, np.hypot(d[:, 0], d[:, 1])))
+        return total
 
     # -- transforms ----------------------------------------------------------------
     def reversed(self) -> Piece:
