@@ -49,7 +49,7 @@ SETS = {
     ),
     "profiles": (
         ["wgcad/profiles/involute.py", "wgcad/profiles/cycloid.py", "wgcad/profiles/pieces.py"],
-        ["tests/test_profiles.py", "tests/test_pieces.py"],
+        ["tests/test_profiles.py", "tests/test_pieces.py", "tests/test_piece_checks.py"],
     ),
 }
 
