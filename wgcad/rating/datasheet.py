@@ -45,32 +45,44 @@ CRITERIA = {
 }
 _BISECTIONS = 5
 _DOUBLINGS = 9
+#: the figures a level can hold, by group: a search between torques measures only the group its criterion reads
+#: (the levels the datasheet lists and the rated one hold them all)
+FIGURES = frozenset({"stresses", "life", "entry_gap", "depth"})
+#: the group each criterion's margin reads
+_READS = {"fatigue": "stresses", "yield": "stresses", "bearing_life": "life", "entry_gap": "entry_gap"}
 
 
 @dataclass(frozen=True, slots=True)
 class Level:
-    """The figures of one solved torque (internal units: N m, mm, MPa, rad, h)."""
+    """The figures of one solved torque (internal units: N m, mm, MPa, rad, h).
+
+    A level solved inside a search holds only the figures of the criterion searched (:data:`FIGURES`): the
+    others are None and :meth:`margins` leaves them out.
+    """
 
     torque_nm: float
     state: object = field(repr=False)
-    stresses: list = field(repr=False)
-    safety: float
-    yield_safety: float
-    life_h: float
+    stresses: list | None = field(repr=False)
+    safety: float | None
+    yield_safety: float | None
+    life_h: float | None
     life: object = field(repr=False)
-    entry_gap: float
-    depth: np.ndarray
-    max_pressure: float
+    entry_gap: float | None
+    depth: np.ndarray | None
+    max_pressure: float | None
 
     def margins(self, ld) -> dict:
-        """Each criterion's margin (>= 0: met) against the ``[load]`` table ``ld``; ratcheting and the static limit
-        are torques of their own."""
-        return {
-            "fatigue": self.safety - ld.fatigue_safety_min,
-            "yield": self.yield_safety - 1.0,
-            "bearing_life": np.log(self.life_h / ld.required_life_h) if self.life_h > 0 else -np.inf,
-            "entry_gap": self.entry_gap + INTERFERENCE_TOL,
-        }
+        """Each criterion's margin (>= 0: met) against the ``[load]`` table ``ld``, of the figures this level holds;
+        ratcheting and the static limit are torques of their own."""
+        out = {}
+        if self.stresses is not None:
+            out["fatigue"] = self.safety - ld.fatigue_safety_min
+            out["yield"] = self.yield_safety - 1.0
+        if self.life_h is not None:
+            out["bearing_life"] = np.log(self.life_h / ld.required_life_h) if self.life_h > 0 else -np.inf
+        if self.entry_gap is not None:
+            out["entry_gap"] = self.entry_gap + INTERFERENCE_TOL
+        return out
 
 
 @dataclass(frozen=True, slots=True)
@@ -115,26 +127,33 @@ class Datasheet:
     warnings: tuple = ()
 
 
-def _level(sheet_ctx, T: float, warm, offset) -> Level:
+def _level(sheet_ctx, T: float, warm, offset, need=FIGURES) -> Level:
+    """The level at ``T`` holding the figure groups ``need`` (a subset of :data:`FIGURES`)."""
     model, setup, br, dm, speed, ratio = sheet_ctx
     st = solve_load(model, T, offset[0], offset[1], warm=warm)
-    stresses = state_stresses(setup, st)
-    c = st.contacts
-    F = c["force"][c["kind"] == 0]
-    life = bearing_life(F, br.ball_diameter_mm, dm, br.groove_conformity, speed, ratio)
-    laws = [law.shifted(p) for p in (0.0, pi) for law in st.laws]
-    gaps = [g.delta for g in entry_gaps(model.scene, laws) if np.isfinite(g.delta)]
+    stresses = state_stresses(setup, st) if "stresses" in need else None
+    life = pressure = None
+    if "life" in need:
+        c = st.contacts
+        F = c["force"][c["kind"] == 0]
+        life = bearing_life(F, br.ball_diameter_mm, dm, br.groove_conformity, speed, ratio)
+        pressure = float(model.bearing.pressure(F).max())
+    gap = None
+    if "entry_gap" in need:
+        laws = [law.shifted(p) for p in (0.0, pi) for law in st.laws]
+        gaps = [g.delta for g in entry_gaps(model.scene, laws) if np.isfinite(g.delta)]
+        gap = min(gaps) if gaps else float("inf")
     return Level(
         torque_nm=float(T),
         state=st,
         stresses=stresses,
-        safety=min(s.safety for s in stresses if s.rated),
-        yield_safety=min(s.yield_safety for s in stresses if s.rated),
-        life_h=life.l10_h,
+        safety=None if stresses is None else min(s.safety for s in stresses if s.rated),
+        yield_safety=None if stresses is None else min(s.yield_safety for s in stresses if s.rated),
+        life_h=None if life is None else life.l10_h,
         life=life,
-        entry_gap=min(gaps) if gaps else float("inf"),
-        depth=engagement_depth(st),
-        max_pressure=float(model.bearing.pressure(F).max()),
+        entry_gap=gap,
+        depth=engagement_depth(st) if "depth" in need else None,
+        max_pressure=pressure,
     )
 
 
@@ -147,10 +166,10 @@ class _Stop:
     static: bool = False
 
 
-def _try(ctx, T, warm, offset):
+def _try(ctx, T, warm, offset, need=FIGURES):
     """``(Level, None)`` or ``(None, _Stop)`` when the model cannot answer at ``T``."""
     try:
-        return _level(ctx, T, warm, offset), None
+        return _level(ctx, T, warm, offset, need), None
     except DesignError as e:  # the bearing's static limit (FlexibleBearing.check)
         return None, _Stop(str(e.rule), static=True)
     except ModelError as e:
@@ -162,11 +181,12 @@ def _first_torque(drive) -> float:
     return 100.0 * (drive.r_m / 80.0) ** 3
 
 
-def _bracket(ctx, lo: Level, hi_T: float, ok, offset) -> tuple[float, Level]:
-    """Bisect between ``lo`` (met) and ``hi_T`` (failed, or the model stopped): the highest level found met."""
+def _bracket(ctx, lo: Level, hi_T: float, ok, offset, need) -> tuple[float, Level]:
+    """Bisect between ``lo`` (met) and ``hi_T`` (failed, or the model stopped): the highest level found met; the
+    levels between hold the figure groups ``need``."""
     for _ in range(_BISECTIONS):
         mid = 0.5 * (lo.torque_nm + hi_T)
-        lv, _ = _try(ctx, mid, lo.state, offset)
+        lv, _ = _try(ctx, mid, lo.state, offset, need)
         if lv is not None and ok(lv):
             lo = lv
         else:
@@ -189,10 +209,11 @@ def _limits(ctx, levels, ld, offset, ratchet_T, static: Limit) -> dict:
         if k is None:
             out[name] = Limit(name, static.torque_nm, True, static.note)
             continue
-        hi, lo = _bracket(ctx, levels[k - 1], levels[k].torque_nm, ok, offset)
+        need = {_READS[name]}
+        hi, lo = _bracket(ctx, levels[k - 1], levels[k].torque_nm, ok, offset, need)
         # between the last level met and the first failed, the margin's zero by linear interpolation
         m_lo, m_hi = float(lo.margins(ld)[name]), None
-        lv_hi, _ = _try(ctx, hi, lo.state, offset)
+        lv_hi, _ = _try(ctx, hi, lo.state, offset, need)
         if lv_hi is not None:
             m_hi = float(lv_hi.margins(ld)[name])
         T = lo.torque_nm if m_hi is None or m_hi >= m_lo else lo.torque_nm + (hi - lo.torque_nm) * m_lo / (m_lo - m_hi)
@@ -208,7 +229,7 @@ def _static_limit(ctx, levels, stop_T, stop: _Stop, offset) -> Limit:
     """Where the bearing's static limit stops the model (bisected), or the last torque solved when it did not."""
     if not stop.static:
         return Limit("bearing_static", levels[-1].torque_nm, True, stop.why)
-    hi, lo = _bracket(ctx, levels[-1], stop_T, lambda lv: True, offset)
+    hi, lo = _bracket(ctx, levels[-1], stop_T, lambda lv: True, offset, need=())
     return Limit(
         "bearing_static",
         0.5 * (lo.torque_nm + hi),
@@ -217,16 +238,17 @@ def _static_limit(ctx, levels, stop_T, stop: _Stop, offset) -> Limit:
     )
 
 
-def _doubling(ctx, drive, offset, progress=None, stop_when=None) -> tuple[list, _Stop, float]:
+def _doubling(ctx, drive, offset, progress=None, stop_when=None, need=FIGURES) -> tuple[list, _Stop, float]:
     """Levels at zero and at torques doubling from :func:`_first_torque`, until the model stops or ``stop_when(level)``;
-    returns the levels, why the search stopped and the torque the model could not solve (inf if none)."""
-    first, why = _try(ctx, 0.0, None, offset)
+    returns the levels (holding the figure groups ``need``), why the search stopped and the torque the model could
+    not solve (inf if none)."""
+    first, why = _try(ctx, 0.0, None, offset, need)
     if first is None:
         raise ModelError(f"the unloaded drive does not solve: {why.why}")
     levels = [first]
     T = _first_torque(drive)
     for k in range(_DOUBLINGS):
-        lv, why = _try(ctx, T, levels[-1].state, offset)
+        lv, why = _try(ctx, T, levels[-1].state, offset, need)
         if progress:
             progress(0.05 + 0.45 * (k + 1) / _DOUBLINGS, "torque levels")
         if lv is None:
@@ -250,7 +272,7 @@ def _ratcheting(ctx, levels, static: Limit, offset, stop_T: float = float("inf")
     out_of_mesh = k is not None
     for _ in range(_BISECTIONS + 2):
         mid = 0.5 * (lo.torque_nm + hi)
-        m, _ = _try(ctx, mid, lo.state, offset)
+        m, _ = _try(ctx, mid, lo.state, offset, {"depth"})
         if m is not None and m.depth.min() > 0:
             lo = m
         else:
@@ -308,7 +330,7 @@ def ratcheting_torque(drive, cam_offset_um: float = 0.0, cam_offset_deg: float =
     torques), or, ``above`` True, the torque where the model stopped with every wave still in mesh."""
     ctx, _ = _context(drive, sections, drive.design.load.input_speed_rpm)
     offset = (cam_offset_um, cam_offset_deg)
-    levels, stop, stop_T = _doubling(ctx, drive, offset, stop_when=lambda lv: lv.depth.min() <= 0)
+    levels, stop, stop_T = _doubling(ctx, drive, offset, stop_when=lambda lv: lv.depth.min() <= 0, need={"depth"})
     return _ratcheting(ctx, levels, _static_limit(ctx, levels, stop_T, stop, offset), offset, stop_T)
 
 

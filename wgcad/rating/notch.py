@@ -90,15 +90,39 @@ def _sector_boundary(gear, bore: float, pitches: int, step: float) -> tuple[np.n
     return pts, np.sort(corners), half
 
 
+class _GradedSize:
+    """The mesh's element size at points: ``h_min`` at the roots' points, growing by a quarter of the distance
+    from them, at most ``h_max``."""
+
+    def __init__(self, roots: np.ndarray, h_min: float, h_max: float):
+        from scipy.spatial import cKDTree
+
+        self.roots = np.asarray(roots, dtype=float)
+        self.tree = cKDTree(self.roots)
+        self.h_min, self.h_max = float(h_min), float(h_max)
+
+    def __call__(self, P) -> np.ndarray:
+        d, _ = self.tree.query(np.atleast_2d(P))
+        return np.minimum(self.h_max, self.h_min + 0.25 * d)
+
+    def near(self, h: float) -> tuple:
+        """A box ``(x0, y0, x1, y1)`` holding every point whose size is below ``h``."""
+        reach = 4.0 * max(h - self.h_min, 0.0)
+        lo = self.roots.min(axis=0) - reach
+        hi = self.roots.max(axis=0) + reach
+        return float(lo[0]), float(lo[1]), float(hi[0]), float(hi[1])
+
+
 def _resample(pts: np.ndarray, size) -> np.ndarray:
     """Points along the closed polyline ``pts`` at spacing ``size(p)`` (every vertex where the outline turns kept)."""
     out = []
     n = len(pts)
+    hs = size(pts)  # the size at every vertex in one query (a segment takes the smaller of its ends')
     for i in range(n):
         a, b = pts[i], pts[(i + 1) % n]
         out.append(a)
         L = float(np.hypot(*(b - a)))
-        h = float(min(size(a[None])[0], size(b[None])[0]))
+        h = float(min(hs[i], hs[(i + 1) % n]))
         k = int(np.ceil(L / h))
         if k > 1:
             t = np.arange(1, k)[:, None] / k
@@ -135,8 +159,15 @@ def _interior(poly, size, h_max: float, boundary: np.ndarray) -> np.ndarray:
     for level in range(12):
         ys = np.arange(y0, y1 + s, s * np.sqrt(3) / 2)
         xs = np.arange(x0, x1 + s, s)
-        X, Y = np.meshgrid(xs, ys)
-        X = X + 0.5 * s * (np.arange(len(ys)) % 2)[:, None]
+        rows = np.arange(len(ys))
+        if level:
+            # a finer level keeps only points whose size is below 2 s, i.e. near the roots: the rows and columns
+            # of the same lattice that can hold them (the others' size is >= 2 s and they were dropped anyway)
+            bx0, by0, bx1, by1 = size.near(2.0 * s)
+            rows = rows[(ys >= by0 - s) & (ys <= by1 + s)]
+            xs = xs[(xs >= bx0 - s) & (xs <= bx1 + s)]
+        X, Y = np.meshgrid(xs, ys[rows])
+        X = X + 0.5 * s * (rows % 2)[:, None]
         P = np.column_stack([X.ravel(), Y.ravel()])
         h = size(P)
         lvl = (h < 2 * s) & (h >= s) if level else h >= s
@@ -280,15 +311,7 @@ def root_concentration(gear, bore_radius: float, pitches: int = 5, fineness: flo
     # the roots of the middle pitch: where the toothed outline is within a fillet radius of the root circle
     pr = np.hypot(gear.period[:, 0], gear.period[:, 1])
     near = np.abs(pr - r_f) < 0.5 * m + rho_f
-    root_pts = gear.period[near]
-    from scipy.spatial import cKDTree
-
-    roots = cKDTree(root_pts)
-
-    def size(P):
-        d, _ = roots.query(np.atleast_2d(P))
-        return np.minimum(h_max, h_min + 0.25 * d)
-
+    size = _GradedSize(gear.period[near], h_min, h_max)
     nodes, tri, n_b = _mesh(outline, size, h_max, corners)
     Ep = E / (1 - nu**2)
     K, B, D, dof, _ = _stiffness(nodes, tri, E, nu)

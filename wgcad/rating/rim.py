@@ -85,8 +85,11 @@ class RimCycle:
 
     @property
     def peak_at(self) -> float:
-        """Angle of the largest tension, rad."""
-        return float(self.psi[int(np.argmax(self.sigma))])
+        """Angle of the largest tension, rad; of tensions equal to a 1e-9 part of the cycle's range (the waves of a
+        symmetric drive) the first, so rounding does not choose between them."""
+        s = self.sigma
+        tie = 1e-9 * max(float(s.max() - s.min()), float(np.abs(s).max()), 1e-300)
+        return float(self.psi[int(np.argmax(s >= s.max() - tie))])
 
 
 def rim_cycle(law, E: float, y: float, psi) -> RimCycle:
