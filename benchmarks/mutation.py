@@ -39,7 +39,10 @@ SETS = {
         ["wgcad/laws/harmonic.py", "wgcad/laws/base.py", "wgcad/laws/coning.py"],
         ["tests/test_laws.py", "tests/test_coning.py", "tests/test_law_checks.py"],
     ),
-    "ring": (["wgcad/elastic/ring.py"], ["tests/test_elastic_ring.py", "tests/test_ring_checks.py"]),
+    "ring": (
+        ["wgcad/elastic/ring.py"],
+        ["tests/test_elastic_ring.py", "tests/test_ring_checks.py", "tests/test_loaded_figures.py"],
+    ),
     "solve": (["wgcad/elastic/solve.py"], ["tests/test_elastic_solver.py", "tests/test_solver_checks.py"]),
     "kinematics": (["wgcad/kinematics.py"], ["tests/test_kinematics.py", "tests/test_kinematics_checks.py"]),
     "plane": (["wgcad/plane.py", "wgcad/units.py"], ["tests/test_placement.py", "tests/test_kinematics.py"]),

@@ -131,3 +131,155 @@ def test_the_pivot_cap_is_reported():
     M = (B @ B.T + m * np.eye(m)) * 1e-4
     with pytest.raises(ContactSolveError, match=r"no convergence in 1 pivots \(\d+ contacts still infeasible\)"):
         solve_contact_qp(M, rng.uniform(-0.02, 0.0, m), np.ones((m, 1)), [-5000.0], max_iter=1)
+
+
+def _problem(seed):
+    """A random small problem whose block pivots stall, so that Murty's single pivots finish it (the seeds below
+    were found by tracing the solver over 4,000 of these: each takes at least one single pivot)."""
+    rng = np.random.default_rng(seed)
+    m = int(rng.integers(5, 10))
+    B = rng.normal(size=(m, m))
+    M = (B @ B.T + 0.05 * m * np.eye(m)) * 1e-4
+    q = rng.uniform(-0.02, 0.03, m)
+    A = np.column_stack([np.ones(m), rng.uniform(-1, 1, m)])
+    f = np.array([rng.uniform(50, 500), rng.uniform(-50, 50)])
+    k = np.array([0.0, 0.0]) if seed % 2 == 0 else np.array([rng.uniform(1e3, 1e5), 0.0])
+    return M, q, A, f, k, rng.random(m) < 0.5
+
+
+@pytest.mark.parametrize("seed", [1746, 2102, 2556, 2694, 3848])
+def test_problems_the_single_pivots_finish_equal_the_enumeration(seed):
+    """Where the block pivots stop reducing the infeasible contacts, the anti-cycling single pivots take over: the
+    same forces and displacements as trying every active set."""
+    M, q, A, f, k, active = _problem(seed)
+    F_ref, a_ref = enumerated(M, q, A, f, k)
+    s = solve_contact_qp(M, q, A, f, active=active, stiffness=k)
+    np.testing.assert_allclose(s.F, F_ref, rtol=0, atol=1e-9 * max(float(F_ref.max()), 1.0))
+    np.testing.assert_allclose(s.a, a_ref, rtol=1e-9, atol=1e-12)
+
+
+def test_a_soft_spring_and_a_free_body_with_every_contact_open():
+    """No contact loaded: a sprung freedom moves by its load over its stiffness, however soft (0.5 N/mm), and a free
+    freedom with no load stays where the least-norm answer puts it (0); the equilibrium is judged against the
+    load itself (no contact force to compare with), and holds."""
+    M = np.diag([1e-4, 2e-4, 3e-4])
+    q = np.array([5.0, 6.0, 7.0])  # far open: 10 N on 0.5 N/mm moves the body 20 mm, still short of every contact
+    A = np.array([[0.0, 0.1], [0.0, 0.1], [0.0, 0.1]])
+    s = solve_contact_qp(M, q, A, [0.0, 10.0], stiffness=[0.0, 0.5])
+    np.testing.assert_array_equal(s.F, 0.0)
+    np.testing.assert_allclose(s.a, [0.0, 20.0], rtol=1e-14, atol=1e-15)
+    np.testing.assert_allclose(s.gap, q - 2.0, rtol=1e-14)
+    assert s.equilibrium < 1e-14
+    # a spring whose k (f / k) rounds off f by 3.6e-15: judged against the load, that is no residual
+    k, f = 0.5348999931723383, 18.766376051967598
+    s = solve_contact_qp(M, q * 10, A, [0.0, f], stiffness=[0.0, k])
+    assert s.a[1] == pytest.approx(f / k, rel=1e-15) and 0 < s.equilibrium < 1e-15
+
+
+def test_a_preload_with_no_outside_load_balances_on_its_own_forces():
+    """A free body squeezed between two overlapping contacts and no outside load: the contacts' forces balance
+    each other, and the equilibrium is judged against them (the load is zero), not refused."""
+    c = 1e-4
+    s = solve_contact_qp(np.diag([c, c]), [-0.01, -0.01], [[1.0], [-1.0]], [0.0])
+    np.testing.assert_allclose(s.F, [100.0, 100.0], rtol=1e-12)
+    assert s.a[0] == pytest.approx(0.0, abs=1e-15)
+    assert s.equilibrium < 1e-12
+    # unequal contacts, whose forces balance only to rounding (6.5e-15 N of 77 N): a residual against the forces
+    A = np.array([[1.0], [-0.7]])
+    s = solve_contact_qp(np.diag([1e-4, 3e-4]), [-0.01, -0.02], A, [0.0])
+    assert s.F[0] == pytest.approx(0.7 * s.F[1], rel=1e-13) and s.F[1] > 70.0
+    assert 0 < s.equilibrium < 1e-15
+
+
+def test_a_load_no_contact_can_carry_is_refused_at_any_scale():
+    """The refusal is of a load no contact can carry, whatever its size: 1e-10 N as 100 N."""
+    for P in (100.0, 1e-10):
+        with pytest.raises(ContactSolveError, match="no set of contacts can carry"):
+            solve_contact_qp(np.diag([1e-4, 1e-4]), [-0.01, -0.01], [[1.0, 0.0], [1.0, 0.0]], [P, P])
+
+
+def test_no_contact_at_all():
+    """A problem with no contact: a sprung body moves by its load over its stiffness, the figures are zero."""
+    s = solve_contact_qp(np.zeros((0, 0)), np.zeros(0), np.zeros((0, 1)), [3.0], stiffness=[2.0])
+    assert s.F.shape == (0,) and s.a[0] == pytest.approx(1.5, rel=1e-15)
+    assert s.complementarity == 0.0 and s.equilibrium == 0.0 and s.iterations == 1
+
+
+def test_block_pivots_take_few_steps_on_large_problems():
+    """Judice and Pires' block pivots change every infeasible contact at once: a cold start of 40 to 130 contacts
+    (random SPD compliance, overlaps and gaps, a free body) needs a handful of pivots (2-4 measured), where single
+    pivots would need about one per loaded contact (40-125), and more contacts than the base pivot cap's 500 / 4
+    are solved (the cap grows with them)."""
+    rng = np.random.default_rng(5)
+    for m in (40, 60, 130):
+        B = rng.normal(size=(m, m))
+        M = (B @ B.T + m * np.eye(m)) * 1e-4
+        q = rng.uniform(-0.02, 0.03, m)
+        A = np.column_stack([np.ones(m), rng.uniform(-1, 1, m)])
+        s = solve_contact_qp(M, q, A, [300.0, 20.0])
+        assert s.iterations <= 8 < int((s.F > 0).sum())
+        assert s.gap.min() >= -1e-12 and s.equilibrium < 1e-12
+
+
+class _Columns:
+    """A compliance seen only through columns (as the elastic model's :class:`~wgcad.elastic.tables.Compliance`)."""
+
+    def __init__(self, M):
+        self._M = np.asarray(M, dtype=float)
+        self.diag = np.diag(self._M).copy()
+        self.shape = self._M.shape
+
+    def cols(self, W):
+        return self._M[:, W]
+
+    def with_field(self, U, W):
+        return _Columns(self._M + U @ W @ U.T)
+
+
+def test_the_reported_figures_are_as_documented():
+    """``iterations`` counts the systems solved (one from the right active set given), ``complementarity`` is
+    ``max |F gap| / (max F max |q|)`` and ``equilibrium`` ``|A'F + K a - f| / max(|A_j| F_j, |f|)``."""
+    rng = np.random.default_rng(4)
+    m = 7
+    B = rng.normal(size=(m, m))
+    M = (B @ B.T + m * np.eye(m)) * 1e-4
+    q = rng.uniform(-0.02, 0.03, m)
+    A = np.column_stack([np.ones(m), rng.uniform(-1, 1, m)])
+    f = np.array([300.0, 20.0])
+    cold = solve_contact_qp(M, q, A, f)
+    warm = solve_contact_qp(M, q, A, f, active=cold.F > 0)
+    assert warm.iterations == 1 and cold.iterations >= 1
+    np.testing.assert_allclose(warm.F, cold.F, rtol=0, atol=1e-10 * cold.F.max())
+    for s in (cold, warm):
+        comp = np.abs(s.F * s.gap).max() / (s.F.max() * np.abs(q).max())
+        assert s.complementarity == pytest.approx(comp, rel=1e-12, abs=1e-300)
+        eq = np.abs(A.T @ s.F - f).max() / max(np.abs(A * s.F[:, None]).max(), np.abs(f).max())
+        assert s.equilibrium == pytest.approx(eq, rel=1e-9, abs=1e-18)
+
+
+def test_supported_freedoms_free_sprung_and_held_equal_the_enumeration():
+    """``solve_supported`` with one freedom free, one sprung and one held: the held one dropped (its displacement
+    reported 0), the others as :func:`solve_contact_qp` with the two, checked by enumeration."""
+    rng = np.random.default_rng(8)
+    m = 6
+    B = rng.normal(size=(m, m))
+    M = (B @ B.T + m * np.eye(m)) * 1e-4
+    q = rng.uniform(-0.02, 0.02, m)
+    A = np.column_stack([np.ones(m), rng.uniform(-1, 1, m), rng.uniform(-1, 1, m)])
+    f = np.array([250.0, -30.0, 1e6])  # the held freedom's load goes to its support
+    k = np.array([0.0, 2e4, np.inf])
+    s = solve_supported(M, q, A, f, k)
+    F_ref, a_ref = enumerated(M, q, A[:, :2], f[:2], k[:2])
+    np.testing.assert_allclose(s.F, F_ref, rtol=0, atol=1e-9 * F_ref.max())
+    np.testing.assert_allclose(s.a[:2], a_ref, rtol=1e-9, atol=1e-12)
+    assert s.a[2] == 0.0 and len(s.a) == 3
+    # the compliance given by columns only, with a field joined: the same as the dense matrix with it
+    U = rng.normal(size=(m, 1))
+    Wf = np.array([[3e-5]])
+    by_cols = solve_supported(_Columns(M), q, A, f, k, field=(U, Wf))
+    dense = solve_supported(M + U @ Wf @ U.T, q, A, f, k)
+    np.testing.assert_allclose(by_cols.F, dense.F, rtol=0, atol=1e-10 * dense.F.max())
+    # a warm start from the solution's own contacts is taken: one system solved
+    warm = solve_supported(M, q, A, f, k, active=s.F > 0)
+    assert warm.iterations == 1
+    np.testing.assert_allclose(warm.F, s.F, rtol=0, atol=1e-10 * s.F.max())
