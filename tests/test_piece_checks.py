@@ -120,3 +120,50 @@ def test_merge_arcs_joins_only_arcs_that_continue_each_other():
     # within the tolerance: one
     assert len(pc.merge_arcs([a, pc.arc((0.0, 0.0), 2.0 + 1e-13, 0.5 + 1e-13, 1.2)])) == 1
     assert pc.merge_arcs([]) == []
+
+
+def _hermite(p0, m0, p1, m1, v):
+    """The cubic Hermite interpolant at ``v`` in [0, 1] by its basis functions (an independent form of the Bezier)."""
+    h00, h10 = 2 * v**3 - 3 * v**2 + 1, v**3 - 2 * v**2 + v
+    h01, h11 = -2 * v**3 + 3 * v**2, v**3 - v**2
+    return h00 * p0 + h10 * m0 + h01 * p1 + h11 * m1
+
+
+def test_a_cubic_piece_is_the_hermite_segment_it_is_given():
+    """``cubic(p0, m0, p1, m1)``: from ``p0`` to ``p1`` on ``t`` in [0, 1], with the end derivatives given, and in
+    between the Hermite interpolant's values (its basis functions, not the Bezier form)."""
+    from wgcad.profiles.pieces import cubic
+
+    p0, m0, p1, m1 = np.array([1.0, 2.0]), np.array([3.0, -1.0]), np.array([4.5, 0.5]), np.array([0.5, 2.5])
+    c = cubic(p0, m0, p1, m1)
+    assert c.kind == "cubic" and (c.t0, c.t1) == (0.0, 1.0)
+    np.testing.assert_allclose(c.start, p0, rtol=0, atol=1e-14)
+    np.testing.assert_allclose(c.end, p1, rtol=0, atol=1e-14)
+    np.testing.assert_allclose(c.deriv([0.0, 1.0]), [m0, m1], rtol=0, atol=1e-13)
+    v = np.linspace(0, 1, 11)
+    want = np.array([_hermite(p0, m0, p1, m1, x) for x in v])
+    np.testing.assert_allclose(c.point(v), want, rtol=0, atol=1e-13)
+
+
+def test_a_spline_piece_passes_its_points_along_its_tangents():
+    """``spline(points, tangents)``: ``t`` in [0, n - 1], through every point at its knot, each segment the
+    Hermite interpolant whose end derivatives are the unit tangents times the segment's own chord (so the
+    derivative's direction is continuous and its length jumps at a knot between chords of different length)."""
+    from wgcad.profiles.pieces import spline
+
+    rng = np.random.default_rng(2)
+    n = 6
+    ang = np.sort(rng.uniform(0.2, 1.4, n))
+    rad = rng.uniform(9.0, 11.0, n)
+    p = np.column_stack([rad * np.cos(ang), rad * np.sin(ang)])
+    d = np.column_stack([-np.sin(ang + 0.1), np.cos(ang + 0.1)])
+    s = spline(p, d)
+    assert s.kind == "spline" and (s.t0, s.t1) == (0.0, float(n - 1))
+    np.testing.assert_allclose(s.point(np.arange(n, dtype=float)), p, rtol=0, atol=1e-13)
+    L = np.hypot(*np.diff(p, axis=0).T)
+    for k in range(n - 1):
+        m0, m1 = d[k] * L[k], d[k + 1] * L[k]
+        v = np.linspace(0.0, 1.0, 7)[:-1]
+        np.testing.assert_allclose(s.point(k + v), [_hermite(p[k], m0, p[k + 1], m1, x) for x in v], atol=1e-12)
+        np.testing.assert_allclose(s.deriv([k + 1e-12])[0], m0, rtol=0, atol=1e-9)
+        np.testing.assert_allclose(s.deriv([k + 1 - 1e-12])[0], m1, rtol=0, atol=1e-9)
