@@ -197,3 +197,20 @@ def test_a_search_level_holds_the_figures_of_a_full_level():
             assert np.array_equal(part.depth, full.depth)
         else:
             assert part.depth is None
+
+
+@pytest.mark.parametrize("name", ["d1_involute", "d1_cycloidal"])
+def test_one_edge_measured_alone_is_the_two_edge_measurement(name):
+    """The entry refinement measures only the edge each of its jobs follows: the same figures, exact and on the
+    outlines, as measuring both edges and reading one, at poses through a tooth's entry."""
+    from wgcad.clearance.entry import edge_gaps, section_poses
+
+    scene = _model(name).scene
+    poses = section_poses(scene, [0.0])
+    phi = np.linspace(0.02, 0.2, 12) * scene.entry_sign
+    rot, shift = poses(phi, np.zeros(len(phi), dtype=int))
+    e = np.arange(len(phi)) % 2
+    for exact in (True, False):
+        both = edge_gaps(scene, rot, shift, exact=exact)
+        one = edge_gaps(scene, rot, shift, exact=exact, edges=e)
+        np.testing.assert_array_equal(one, both[np.arange(len(phi)), e])

@@ -152,15 +152,20 @@ def edge_index(scene: Scene, rot, shift):
     return (up, lo) if scene.working == "upper" else (lo, up)
 
 
-def edge_gaps(scene: Scene, rot: np.ndarray, shift: np.ndarray, exact: bool = True) -> np.ndarray:
+def edge_gaps(scene: Scene, rot: np.ndarray, shift: np.ndarray, exact: bool = True, edges=None) -> np.ndarray:
     """Gaps ``(N, 2)`` by the working and the non-working edge of teeth at poses ``(rot, shift)`` (mm, negative: overlap depth).
 
     Each is the signed clearance between the tooth and the rigid tooth on
     that side: on the exact curves (``exact``), else on the outlines.
+    ``edges`` ``(N,)`` (0 working, 1 non-working): only that edge of each
+    tooth, ``(N,)`` (each pair measured as in the two-edge call).
     """
     rot = np.atleast_1d(rot)
     shift = np.atleast_2d(shift)
     jw, jn = edge_index(scene, rot, shift)
+    if edges is not None:
+        j = np.where(np.asarray(edges) == 0, jw, jn)
+        return scene.exact_to(rot, shift, j)[0] if exact else scene.clearance_to(rot, shift, j)
     out = np.empty((len(rot), 2))
     if exact:
         val = scene.exact_to(np.concatenate([rot, rot]), np.concatenate([shift, shift]), np.concatenate([jw, jn]))[0]
@@ -268,9 +273,7 @@ def _refine(scene: Scene, poses, jobs, exact: bool):
     for _ in range(_NEST):
         t = np.clip(c[:, None] + w[:, None] * u[None, :], lo[:, None], hi[:, None])
         rot, shift = poses(sgn * t.ravel(), np.repeat(k, _NEST_PTS))
-        g = edge_gaps(scene, rot, shift, exact=exact)[np.arange(J * _NEST_PTS), np.repeat(e, _NEST_PTS)].reshape(
-            J, _NEST_PTS
-        )
+        g = edge_gaps(scene, rot, shift, exact=exact, edges=np.repeat(e, _NEST_PTS)).reshape(J, _NEST_PTS)
         j = np.argmin(g, axis=1)
         gv = g[np.arange(J), j]
         better = gv < best
