@@ -71,6 +71,17 @@ def test_the_only_feasible_answer_is_found(tmp_path, capsys):
     assert "held by ratio (moved up to 201: margin -1.010)" in best
     assert doc["best"]["held_by"]["drive.z_flex"]["constraint"] == "ratio"
     assert main(["audit", str(out / "req_best.toml"), "--quiet"]) == 0
+    # the time of each working stage: the candidates that reached it, summed and per candidate; the ratio's
+    # eight stopped before any (no rating or KE budget is asked here)
+    st = doc["stage_seconds"]
+    assert set(st) <= {"design rules", "audit"} and st["audit"]["candidates"] == 1
+    assert st["design rules"]["candidates"] == stages.count("done") + stages.count("design rules")
+    # one candidate: its mean is its total (rounded to 0.001 s and 0.01 s)
+    assert 0 < st["audit"]["total_s"] <= doc["seconds"] and st["audit"]["mean_s"] == pytest.approx(
+        st["audit"]["total_s"], abs=5.5e-3
+    )
+    assert set(doc["best"]["stage_seconds"]) == {"design rules", "audit"}
+    assert sum(doc["best"]["stage_seconds"].values()) <= doc["best"]["seconds"] + 0.01
 
 
 def test_an_infeasible_search_says_what_no_candidate_met(tmp_path, capsys):

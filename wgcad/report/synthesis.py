@@ -25,7 +25,20 @@ def _candidate(ev) -> dict:
         "objectives": {k: _r(v) for k, v in ev.objectives.items()},
         "message": ev.message,
         "seconds": _r(ev.seconds, 2),
+        "stage_seconds": {k: _r(v, 3) for k, v in ev.stage_seconds.items()},
     }
+
+
+def _stage_times(evaluations) -> dict:
+    """Per working stage: how many candidates ran it, its wall seconds over all of them, and the mean per candidate
+    (the candidates resumed from a journal count with the times they were measured with; one of an earlier release
+    has none)."""
+    out = {}
+    for st in STAGES:
+        ts = [ev.stage_seconds[st] for ev in evaluations if st in ev.stage_seconds]
+        if ts:
+            out[st] = {"candidates": len(ts), "total_s": _r(sum(ts), 2), "mean_s": _r(sum(ts) / len(ts), 3)}
+    return out
 
 
 def _binding(ev, n: int = 3) -> list:
@@ -49,6 +62,7 @@ def search_json(res) -> dict:
         "resumed_trials": res.resumed,
         "feasible": len(res.ranked),
         "seconds": _r(res.seconds, 2),
+        "stage_seconds": _stage_times(res.evaluations),
         "best": None
         if res.best is None
         else {**_candidate(res.best), "binding": _binding(res.best), "held_by": res.held},

@@ -58,6 +58,8 @@ class Evaluation:
     feasible: bool = False
     message: str = ""
     seconds: float = 0.0
+    #: wall seconds of each stage the candidate reached that does work (design rules, audit, rating, ke budget)
+    stage_seconds: dict = field(default_factory=dict)
 
     @property
     def worst(self) -> tuple[str, float] | None:
@@ -107,12 +109,15 @@ def _run(base, free, ev: Evaluation, req) -> None:
             return
         ev.margins["ratio"] = 0.0
     ev.stage = "design rules"
+    t = time.perf_counter()
     try:
         drive = build_drive(apply(base, free, ev.values))
     except DesignError as e:
         ev.margins["design rules"] = -1.0
         ev.message = f"{e.field}: {e.rule}"
         return
+    finally:
+        ev.stage_seconds["design rules"] = time.perf_counter() - t
     ev.margins["design rules"] = 0.0
     ev.stage = "outside diameter"
     od = 2.0 * drive.rigid_rim_radius
@@ -131,17 +136,26 @@ def _run(base, free, ev: Evaluation, req) -> None:
             ev.message = f"flexspline {length:g} mm long, allowed {req.max_length_mm:g}"
             return
     ev.stage = "audit"
-    if not _audit(drive, ev, req):
+    if not _timed(ev, "audit", _audit, drive, ev, req):
         return
     if req.needs_rating:
         ev.stage = "rating"
-        if not _rating(drive, ev, req):
+        if not _timed(ev, "rating", _rating, drive, ev, req):
             return
     if req.ke_max_arcsec is not None:
         ev.stage = "ke budget"
-        if not _ke_budget(free, ev, req):
+        if not _timed(ev, "ke budget", _ke_budget, free, ev, req):
             return
     ev.stage, ev.feasible = "done", True
+
+
+def _timed(ev: Evaluation, stage: str, fn, *args) -> bool:
+    """``fn(*args)``, its wall seconds kept as the stage's (an error's too: the stage ran)."""
+    t = time.perf_counter()
+    try:
+        return fn(*args)
+    finally:
+        ev.stage_seconds[stage] = time.perf_counter() - t
 
 
 def _audit(drive, ev: Evaluation, req) -> bool:

@@ -163,13 +163,14 @@ def _from_trial(ft) -> Evaluation | None:
         feasible=bool(a.get("feasible")),
         message=a.get("message", ""),
         seconds=float(a.get("seconds", 0.0)),
+        stage_seconds=dict(a.get("stage_seconds", {})),  # a journal of an earlier release has none
     )
 
 
 def _tell(study, trial, ev: Evaluation, req: Requirements, names: list) -> None:
     for c in names:  # optuna: <= 0 is met; a constraint the candidate never reached counts as violated by 1
         trial.set_constraint(c, -ev.margins[c] if ev.margins.get(c) is not None else 1.0)
-    for k in ("margins", "objectives", "stage", "feasible", "message", "seconds"):
+    for k in ("margins", "objectives", "stage", "feasible", "message", "seconds", "stage_seconds"):
         trial.set_user_attr(k, getattr(ev, k))
     # an objective a candidate never reached: the worst value any candidate can have (constraints rank it anyway)
     vals = [ev.objectives.get(o, -1e30 if OBJECTIVES[o][0] == "max" else 1e30) for o in req.objectives]
