@@ -77,3 +77,35 @@ def test_core_matches_the_reference(name):
     kt = notch.root_concentration(d.flex, d.flex_rim_radius).kt
     ref = _reference(name)["kt"]
     assert abs(kt / ref - 1.0) < 0.05, f"{name}: core kt {kt:.4f}, reference {ref:.4f}"
+
+
+def test_a_solved_geometry_is_answered_from_memory_and_any_change_of_it_is_solved_again(monkeypatch):
+    """The FE runs once per geometry: the same flexspline asked twice (a datasheet with a cam offset rates its
+    drive twice) is one solve; a generator's amplitude, which moves no tooth, is none; a fillet, a thinned tooth,
+    a thinner rim (the bore) each change the digest, are solved again, and give their own K (not the first one's)."""
+    from wgcad.design.schema import with_changes
+    from wgcad.rating import notch
+
+    calls = []
+    real = notch._root_concentration
+    monkeypatch.setattr(notch, "_SOLVED", {})
+    monkeypatch.setattr(notch, "_root_concentration", lambda *a: calls.append(a) or real(*a))
+    base = load_design(ROOT / "templates" / "d1_involute.toml")
+
+    def kt(design):
+        d = build_drive(design)
+        return notch.root_concentration(d.flex, d.flex_rim_radius)
+
+    first = kt(base)
+    assert kt(base) is first and len(calls) == 1
+    assert kt(with_changes(base, generator={"w0_coef": 0.95})) is first and len(calls) == 1
+    changed = [
+        with_changes(base, flexspline={"fillet_coef": base.flexspline.fillet_coef * 1.5}),
+        with_changes(base, flexspline={"thinning": 0.04}),
+        with_changes(base, flexspline={"rim_thickness": base.flexspline.rim_thickness * 0.9}),
+    ]
+    for n, d in enumerate(changed, start=2):
+        k = kt(d)
+        assert len(calls) == n and k is not first
+        fresh = real(build_drive(d).flex, build_drive(d).flex_rim_radius, 5, 2.0, 206e3, 0.3)
+        assert k == fresh

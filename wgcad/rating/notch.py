@@ -287,6 +287,26 @@ def _patch_stress(nodes, tri, sig, at: np.ndarray, radius: np.ndarray) -> np.nda
     return out
 
 
+#: the last few results of :func:`root_concentration`, keyed by a digest of everything it reads (a datasheet with a
+#: cam offset rates the drive twice, a study's candidates that differ only in the generator share their teeth)
+_SOLVED: dict = {}
+_SOLVED_MAX = 16
+
+
+def _geometry_key(gear, bore_radius, pitches, fineness, E, nu) -> bytes:
+    """A digest of what the FE model is made of: the tooth's pieces as sampled for the mesh, its polyline, the counts
+    and sizes the mesh reads, the bore and the settings."""
+    import hashlib
+
+    sp = gear.spec
+    h = hashlib.sha256()
+    h.update(np.asarray(_dense_period(gear, 1e-3), dtype=float).tobytes())
+    h.update(np.asarray(gear.period, dtype=float).tobytes())
+    head = [sp.z, sp.module, sp.fillet_coef, gear.r_f, bore_radius, pitches, fineness, E, nu]
+    h.update(np.array(head, dtype=float).tobytes())
+    return h.digest()
+
+
 def root_concentration(gear, bore_radius: float, pitches: int = 5, fineness: float = 2.0, E=206e3, nu=0.3):
     """The tooth roots' stress concentration of the flexspline ``gear`` on a rim down to ``bore_radius`` (mm).
 
@@ -294,12 +314,24 @@ def root_concentration(gear, bore_radius: float, pitches: int = 5, fineness: flo
     ``fineness`` scales the element size down (default 2: at the roots a twentieth of the fillet radius, elsewhere
     a sixteenth of the rim; tests/test_rating_notch.py). Returns
     :class:`RootConcentration`. ``E`` and ``nu`` only set the plane-strain
-    modulus; ``K`` is a ratio and does not depend on them.
+    modulus; ``K`` is a ratio and does not depend on them. A geometry solved before in this process (the same
+    digest of pieces, outline, sizes and settings) is answered from memory.
     """
-    from scipy.sparse.linalg import spsolve
-
     if pitches < 3 or pitches % 2 == 0:
         raise ValueError(f"pitches must be odd and >= 3, got {pitches}")
+    key = _geometry_key(gear, bore_radius, pitches, fineness, E, nu)
+    got = _SOLVED.get(key)
+    if got is None:
+        got = _root_concentration(gear, bore_radius, pitches, fineness, E, nu)
+        if len(_SOLVED) >= _SOLVED_MAX:
+            _SOLVED.pop(next(iter(_SOLVED)))
+        _SOLVED[key] = got
+    return got
+
+
+def _root_concentration(gear, bore_radius: float, pitches: int, fineness: float, E, nu) -> RootConcentration:
+    from scipy.sparse.linalg import spsolve
+
     m = gear.spec.module
     r_f = gear.r_f
     h1 = abs(r_f - bore_radius)
