@@ -50,6 +50,10 @@ SETS = {
         ["wgcad/placement/law.py", "wgcad/placement/deformed.py"],
         ["tests/test_placement.py", "tests/test_placement_checks.py", "tests/test_deformed_checks.py"],
     ),
+    "clearance": (
+        ["wgcad/clearance/distance.py", "wgcad/clearance/refine.py", "wgcad/clearance/apart.py"],
+        ["tests/test_clearance.py", "tests/test_refine.py", "tests/test_apart.py"],
+    ),
     "profiles": (
         ["wgcad/profiles/involute.py", "wgcad/profiles/cycloid.py", "wgcad/profiles/pieces.py"],
         ["tests/test_profiles.py", "tests/test_pieces.py", "tests/test_piece_checks.py"],
