@@ -294,13 +294,13 @@ _SOLVED_MAX = 16
 
 
 def _geometry_key(gear, bore_radius, pitches, fineness, E, nu) -> bytes:
-    """A digest of what the FE model is made of: the tooth's pieces as sampled for the mesh, its polyline, the counts
-    and sizes the mesh reads, the bore and the settings."""
+    """A digest of what the FE model is made of: the tooth's exact pieces (their exact ``repr``) and polyline, the
+    counts and sizes the mesh reads, the bore and the settings."""
     import hashlib
 
     sp = gear.spec
     h = hashlib.sha256()
-    h.update(np.asarray(_dense_period(gear, 1e-3), dtype=float).tobytes())
+    h.update(repr(tuple(gear.pieces)).encode())
     h.update(np.asarray(gear.period, dtype=float).tobytes())
     head = [sp.z, sp.module, sp.fillet_coef, gear.r_f, bore_radius, pitches, fineness, E, nu]
     h.update(np.array(head, dtype=float).tobytes())
