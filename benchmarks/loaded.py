@@ -44,6 +44,8 @@ ROWS = [
         ["design", "{T}/requirements/d1_ratio100.toml", "--workers", "1", "--out", "{OUT}"],
     ),
 ]
+
+
 def _trials(path: Path) -> int:
     """The requirements file's trials: the design row is per candidate."""
     import tomllib
