@@ -54,6 +54,7 @@ SETS = {
         ["wgcad/clearance/distance.py", "wgcad/clearance/refine.py", "wgcad/clearance/apart.py"],
         ["tests/test_clearance.py", "tests/test_refine.py", "tests/test_apart.py"],
     ),
+    "ke": (["wgcad/accuracy/ke.py", "wgcad/accuracy/ke_lanes.py"], ["tests/test_ke_checks.py"]),
     "profiles": (
         ["wgcad/profiles/involute.py", "wgcad/profiles/cycloid.py", "wgcad/profiles/pieces.py"],
         ["tests/test_profiles.py", "tests/test_pieces.py", "tests/test_piece_checks.py"],
@@ -183,19 +184,20 @@ def main(argv=None) -> int:
         sets = {n: SETS[n] for n in names}
     OUT.mkdir(parents=True, exist_ok=True)
     summary_path = OUT / "summary.json"
-    summary = json.loads(summary_path.read_text()) if summary_path.exists() else {}
     print("| set | mutants | killed | survived | other | score | s |\n|---|---|---|---|---|---|---|")
     for name, (modules, tests) in sets.items():
         r = run_set(name, modules, tests, args.max_children, args.budget_min)
         (OUT / f"{name}.md").write_text(_report(r), encoding="utf-8")
+        # read again before each write: another run of this script (another set) may have written meanwhile
+        summary = json.loads(summary_path.read_text()) if summary_path.exists() else {}
         summary[name] = {k: v for k, v in r.items() if k != "survivors"} | {"survived": len(r["survivors"])}
+        summary_path.write_text(json.dumps(summary, indent=1), encoding="utf-8")
         c = r["counts"]
         other = r["mutants"] - c.get("killed", 0) - c.get("survived", 0)
         print(
             f"| {name} | {r['mutants']} | {c.get('killed', 0)} | {c.get('survived', 0)} | {other} | {r['score']} | {r['seconds']} |"
         )
         sys.stdout.flush()
-    summary_path.write_text(json.dumps(summary, indent=1), encoding="utf-8")
     return 0
 
 

@@ -182,7 +182,10 @@ def kinematic_error(
     theta, lm = _theta(tab, dw, dn)
     phi_h = np.arange(I) * (2 * tab.sigma) * pi  # sigma i 2 pi / (z_b N), the same products in fewer passes
     phi_h /= tab.z_b * tab.N
-    eng = "single-flank (backlash)" if lm.min() >= 0 else "double-flank (interference)" if lm.max() < 0 else "mixed"
+    if not I:
+        eng = "none (no samples)"
+    else:
+        eng = "single-flank (backlash)" if lm.min() >= 0 else "double-flank (interference)" if lm.max() < 0 else "mixed"
     if I:
         np.subtract(theta, theta[0], out=theta)
     return KEResult(

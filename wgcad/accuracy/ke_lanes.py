@@ -414,7 +414,9 @@ def undominated(lanes: np.ndarray, A: np.ndarray, g: np.ndarray) -> np.ndarray:
             break
         d = np.argmin(np.where(open_, ge, np.inf), axis=1)
         spread = np.abs(Ae - Ae[rows, d][:, None, :]).sum(axis=2)
-        alive &= ~((ge - ge[rows, d][:, None] > spread + _DOMINANCE_TOL) & busy[:, None])
+        with np.errstate(invalid="ignore"):  # inf - inf in a class without lanes (not busy: masked out)
+            above = ge - ge[rows, d][:, None] > spread + _DOMINANCE_TOL
+        alive &= ~(above & busy[:, None])
         tried[rows[busy], d[busy]] = True
         if alive.shape[1] > 2 * alive.sum(axis=1).max():  # most are gone: carry on with the survivors' columns
             keep = np.argsort(~alive, axis=1, kind="stable")[:, : max(int(alive.sum(axis=1).max()), 1)]
