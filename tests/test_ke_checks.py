@@ -145,6 +145,10 @@ def test_a_whole_record_is_one_flexspline_turn(name):
     u = tab.z_g / (tab.z_b - tab.z_g)
     assert len(res.ke) == round(tab.N * tab.z_b * u)
     assert res.flex_turns_per_record == pytest.approx(1.0, rel=1e-12)
+    # the block search in its passes of 65 536 samples (D2's record takes two) finds the same first contacts
+    ref = K.kinematic_error(_drive(name), BIG, table=_table(name), reference=True)
+    for a, b in ((ref.delta_w, res.delta_w), (ref.delta_n, res.delta_n), (ref.ke, res.ke)):
+        np.testing.assert_allclose(a, b, rtol=0, atol=4 * SAME)
     # and it ends one sample short of where it started (the KE of a turn closes on itself)
     dw, _ = _brute(tab, tab.side_w, BIG, np.array([len(res.ke), len(res.ke) - 1]))
     assert dw[0] == pytest.approx(res.delta_w[0], abs=SAME) and dw[1] == pytest.approx(res.delta_w[-1], abs=SAME)
@@ -332,15 +336,18 @@ def test_fold_angle_wraps_into_the_half_open_turn():
 
 
 @pytest.mark.parametrize("lever", ["rigid", "flex"])
-def test_the_installation_angle_scan_is_the_ke_at_each_angle(lever):
-    tab = _table("d4_discrete")
+@pytest.mark.parametrize("name", NAMES)
+def test_the_installation_angle_scan_is_the_ke_at_each_angle(name, lever):
+    # D2 engages on both flanks in part of the turn (the non-working side's first contact counts there) and its
+    # record (80 800 samples) takes two passes of the scan; D4 interferes throughout
+    tab = _table(name)
     key = "rigid_install" if lever == "rigid" else "flex_install"
     angles = [0.0, 0.7, 2.9, 4.4, 6.0]
     pp = K.install_angle_scan(tab, BIG, angles, lever)
-    ref = [K.kinematic_error(_drive("d4_discrete"), BIG.replace(**{key: a}), table=tab).ke_pp for a in angles]
+    ref = [K.kinematic_error(_drive(name), BIG.replace(**{key: a}), table=tab).ke_pp for a in angles]
     np.testing.assert_allclose(pp, ref, rtol=1e-12, atol=0)
     assert np.ptp(pp) * AS > 1.0  # the angle matters (arcseconds)
-    with pytest.raises(DesignError, match="lever"):
+    with pytest.raises(DesignError, match=r"^lever: must be rigid or flex, got 'cam'$"):
         K.install_angle_scan(tab, BIG, angles, "cam")
 
 
@@ -440,3 +447,48 @@ def test_the_linear_ke_is_the_exact_poses_ke(imp):
     # and the errors move the KE (well above the tolerance)
     perfect = K.kinematic_error(d, Imperfections(), table=tab, samples=2000)
     assert np.abs(res.delta_w - perfect.delta_w).max() * AS > 1.0
+
+
+def _basins(step):
+    """A curve of the largest KE against the angle with four basins (grid index + offset in grid steps, true
+    minimum, value at the nearest grid angle): by their grid values the three best are A, B, C, and C is the
+    deepest of those; D is deeper still but its grid value is the worst; A's neighbours lie close above it."""
+    spec = [(0.95, 1.0, None), (5.3, 0.9, 1.1), (13.37, 0.5, 2.2), (9.2, 0.2, 2.3)]
+    out = []
+    for pos, low, at_grid in spec:
+        off = (pos - round(pos)) * step
+        out.append((pos * step, low, 0.02 if at_grid is None else (at_grid - low) / off**2))
+
+    def curve(angles):
+        a = np.atleast_1d(np.asarray(angles, dtype=float))
+        v = np.full(a.shape, 3.0)
+        for x0, low, c in out:
+            dx = L.fold_angle(a - x0)
+            v = np.minimum(v, np.where(np.abs(dx) < 1.5 * step, low + c * dx**2, np.inf))
+        return v
+
+    return curve
+
+
+def test_the_optimiser_refines_the_three_best_local_minima_of_its_grid(monkeypatch):
+    # docs: a grid of n_grid angles, then grids of 1/10 and 1/100 of its step around the three best local minima.
+    # On the curve above that finds C's minimum exactly (13.37 steps lies on the last grid), not A's or B's
+    # (shallower) nor D's (deeper, but its grid value is the fourth)
+    n = 18
+    step = 2 * math.pi / n
+    curve = _basins(step)
+    levers = []
+
+    def scan(tab, imp, angles, lever="rigid"):
+        levers.append(lever)
+        return curve(angles)
+
+    monkeypatch.setattr(K, "install_angle_scan", scan)
+    for lever in ("rigid", "flex"):
+        best, best_pp, grid, pp = K.optimize_install_angle(None, None, lever=lever, n_grid=n)
+        assert best == pytest.approx(13.37 * step, abs=1e-9) and best_pp == pytest.approx(0.5, abs=1e-12)
+        np.testing.assert_array_equal(pp, curve(grid))
+        assert set(levers) == {lever}
+        levers.clear()
+    # the default grid is 36 angles (10 deg)
+    assert len(K.optimize_install_angle(None, None)[2]) == 36
