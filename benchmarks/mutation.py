@@ -15,11 +15,17 @@ The checkout's working tree (uncommitted changes included) is copied to a tempor
 ``output/mutation/<set>.md`` (a Markdown report) and the counts to ``output/mutation/summary.json``. Survivors
 that change no behaviour (equivalent mutants) are listed in docs/mutation.md with the reason; the others are
 killed by tests that check behaviour.
+
+``--survivors`` runs only the last whole run's survivors of each set again (``output/mutation/<set>.json``), in a
+fresh copy with the set's tests as they are now, and counts each mutant once: after tests are added against
+survivors, minutes instead of the set's whole run. The modules must be unchanged (mutmut's mutant names are
+numbered in their sources; a digest guards it) and the set's tests should only have grown.
 """
 
 from __future__ import annotations
 
 import argparse
+import hashlib
 import json
 import os
 import re
@@ -96,8 +102,55 @@ def _copy(dst: Path) -> None:
 _LINE = re.compile(r"^\s*(\S+): (\w[\w ]*)$")
 
 
-def run_set(name: str, modules, tests, children: int, budget_min: float) -> dict:
-    """Run mutmut on one set in a temporary copy; the counts, the survivors' diffs and the run time."""
+def _digest(modules) -> str:
+    """A digest of the modules' sources: mutmut's mutant names hold only for the same sources."""
+    h = hashlib.sha256()
+    for m in modules:
+        h.update(m.encode() + b"\0" + (ROOT / m).read_bytes())
+    return h.hexdigest()[:16]
+
+
+def _previous(name: str, modules) -> dict:
+    """The last whole run of a set (``output/mutation/<set>.json``), to run its survivors again."""
+    path = OUT / f"{name}.json"
+    if not path.exists():
+        sys.exit(
+            f"benchmarks/mutation.py: --survivors: no earlier run of set '{name}' ({path}); run the whole set first"
+        )
+    prev = json.loads(path.read_text(encoding="utf-8"))
+    if prev.get("digest") != _digest(modules):
+        sys.exit(
+            f"benchmarks/mutation.py: --survivors: the modules of set '{name}' changed since its run (the mutants' "
+            "names no longer hold); run the whole set"
+        )
+    return prev
+
+
+_SURVIVING = ("survived", "no tests", "timeout", "suspicious")
+
+
+def _merge(prev: dict, rerun: dict) -> dict:
+    """The earlier run's figures with its survivors' new statuses (each mutant counted once)."""
+    counts = dict(prev["counts"])
+    for s in prev["survivors"]:
+        new = rerun["status"].get(s["mutant"], s["status"])
+        counts[s["status"]] -= 1
+        counts[new] = counts.get(new, 0) + 1
+    counts = {k: v for k, v in counts.items() if v}
+    killed = counts.get("killed", 0)
+    return prev | {
+        "counts": counts,
+        "score": round(killed / prev["mutants"], 4) if prev["mutants"] else None,
+        "tests": rerun["tests"],
+        "survivors": rerun["survivors"],
+        "rerun_seconds": rerun["seconds"],
+        "rerun_of": len(prev["survivors"]),
+    }
+
+
+def run_set(name: str, modules, tests, children: int, budget_min: float, names=()) -> dict:
+    """Run mutmut on one set in a temporary copy (only the mutants ``names`` if given); the counts, the
+    survivors' diffs and the run time."""
     mm = _mutmut()
     with tempfile.TemporaryDirectory(prefix=f"wgcad-mut-{name}-") as tmp:
         work = Path(tmp)
@@ -109,7 +162,7 @@ def run_set(name: str, modules, tests, children: int, budget_min: float) -> dict
         timed_out = False
         try:
             subprocess.run(
-                [*mm, "run", "--max-children", str(children)],
+                [*mm, "run", "--max-children", str(children), *names],
                 cwd=work,
                 env=env,
                 stdout=subprocess.DEVNULL,
@@ -125,9 +178,11 @@ def run_set(name: str, modules, tests, children: int, budget_min: float) -> dict
             m = _LINE.match(line)
             if m:
                 status[m.group(1)] = m.group(2)
+        if names:  # the others read "not checked" in this copy
+            status = {k: v for k, v in status.items() if k in set(names)}
         survivors = []
         for mutant, st in status.items():
-            if st in ("survived", "no tests", "timeout", "suspicious"):
+            if st in _SURVIVING:
                 diff = subprocess.run([*mm, "show", mutant], cwd=work, env=env, capture_output=True, text=True)
                 lines = [x for x in diff.stdout.splitlines() if x[:1] in "-+" and x[:3] not in ("---", "+++")]
                 survivors.append({"mutant": mutant, "status": st, "diff": lines})
@@ -145,6 +200,8 @@ def run_set(name: str, modules, tests, children: int, budget_min: float) -> dict
         "score": round(killed / total, 4) if total else None,
         "seconds": round(seconds, 1),
         "budget_exhausted": timed_out,
+        "digest": _digest(modules),
+        "status": status,
         "survivors": survivors,
     }
 
@@ -156,6 +213,11 @@ def _report(r: dict) -> str:
         f"Modules: {', '.join(r['modules'])}; tests: {', '.join(r['tests'])}.",
         f"{r['mutants']} mutants, {r['counts']}; score {r['score']} (killed / all) in {r['seconds']} s"
         + (" (budget exhausted: not every mutant was run)" if r["budget_exhausted"] else "")
+        + (
+            f"; its {r['rerun_of']} survivors run again with these tests in {r['rerun_seconds']} s"
+            if "rerun_of" in r
+            else ""
+        )
         + ".",
         "",
     ]
@@ -171,6 +233,11 @@ def main(argv=None) -> int:
     ap.add_argument("--tests", action="append", help="a test file that covers --module")
     ap.add_argument("--max-children", type=int, default=2, help="mutants run at once (default 2, one per core)")
     ap.add_argument("--budget-min", type=float, default=60.0, help="minutes a set may take (default 60)")
+    ap.add_argument(
+        "--survivors",
+        action="store_true",
+        help="run only the last whole run's survivors of each set again (the modules unchanged; new tests welcome)",
+    )
     args = ap.parse_args(argv)
     if args.module:
         if not args.tests:
@@ -186,11 +253,25 @@ def main(argv=None) -> int:
     summary_path = OUT / "summary.json"
     print("| set | mutants | killed | survived | other | score | s |\n|---|---|---|---|---|---|---|")
     for name, (modules, tests) in sets.items():
-        r = run_set(name, modules, tests, args.max_children, args.budget_min)
+        if args.survivors:
+            prev = _previous(name, modules)
+            r = _merge(
+                prev,
+                run_set(
+                    name, modules, tests, args.max_children, args.budget_min, [s["mutant"] for s in prev["survivors"]]
+                ),
+            )
+        else:
+            r = run_set(name, modules, tests, args.max_children, args.budget_min)
         (OUT / f"{name}.md").write_text(_report(r), encoding="utf-8")
+        (OUT / f"{name}.json").write_text(
+            json.dumps({k: v for k, v in r.items() if k != "status"}, indent=1), encoding="utf-8"
+        )
         # read again before each write: another run of this script (another set) may have written meanwhile
         summary = json.loads(summary_path.read_text()) if summary_path.exists() else {}
-        summary[name] = {k: v for k, v in r.items() if k != "survivors"} | {"survived": len(r["survivors"])}
+        summary[name] = {k: v for k, v in r.items() if k not in ("survivors", "status")} | {
+            "survived": len(r["survivors"])
+        }
         summary_path.write_text(json.dumps(summary, indent=1), encoding="utf-8")
         c = r["counts"]
         other = r["mutants"] - c.get("killed", 0) - c.get("survived", 0)
