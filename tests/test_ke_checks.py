@@ -171,6 +171,20 @@ def test_the_deep_overlaps_are_the_samples_whose_first_contact_overlaps_deeply()
         assert res.deep_overlap_fraction == pytest.approx(0.25, abs=1e-12)
 
 
+def test_the_first_contact_at_index_zero_is_flagged_when_it_overlaps_deeply():
+    # contact 0 alone lowered by three times the trusted depth: the first of its class at every sample of it
+    tab = _table("d4_discrete")
+    S = dict(tab.sides[tab.side_w])
+    S["g"] = S["g"].copy()
+    S["g"][0] -= 3 * K.DEEP_OVERLAP
+    tab.sides = {**tab.sides, tab.side_w: S}
+    I = 2 * tab.N * tab.z_b
+    share = np.mean(_class_of(tab, np.arange(I)) == S["m"][0] % tab.N)
+    for reference in (False, True):
+        res = K.kinematic_error(_drive("d4_discrete"), BIG, table=_copy_sides(tab), samples=I, reference=reference)
+        assert res.deep_overlap_fraction == pytest.approx(share, abs=1e-12)
+
+
 def _copy_sides(tab):
     out = copy.copy(tab)
     for key in _CACHES:
@@ -186,6 +200,8 @@ def test_the_harmonic_form_is_the_error_terms(name, group):
     for trial in range(3):
         ph = rng.uniform(-math.pi, math.pi, 8)
         imp = BIG.replace(
+            cam_cam=0.01 * trial,  # in the table exactly (the poses): in neither linear form
+            cam_cam_phase=ph[0],
             rigid_runout_phase=ph[0],
             flex_runout_phase=ph[1],
             rigid_ecc_phase=ph[2],
@@ -492,3 +508,29 @@ def test_the_optimiser_refines_the_three_best_local_minima_of_its_grid(monkeypat
         levers.clear()
     # the default grid is 36 angles (10 deg)
     assert len(K.optimize_install_angle(None, None)[2]) == 36
+
+
+@pytest.mark.parametrize("wave", range(3))
+def test_lane_minimum_keeps_a_lane_that_dips_below_another_between_a_block_s_ends(wave):
+    # per class a flat lane (g = 0), a lane far above it, and one of a single wave of amplitude a: where the wave's
+    # lane lies above the flat one at both ends of a block but dips below it between them (by up to
+    # a (1 - cos(theta / 2)) below its chord, theta the wave's turn over the block), only the bound on that dip keeps
+    # it (a block evaluates as many lanes as the busiest block keeps, the far lane filling in first); drawn at
+    # random offsets and phases, hundreds of blocks sit at that edge
+    rng = np.random.default_rng(100 + wave)
+    tab = _table("d4_discrete")
+    N, a = tab.N, 1e-3
+    lanes = np.arange(3 * N).reshape(N, 3)
+    i = np.arange(0, 64 * 16 * N)
+    plan = L.LanePlan(tab, lanes, i)
+    w = _waves(tab, i)[:, wave]
+    r = i % N
+    for _ in range(40):
+        g = np.zeros(3 * N)
+        g[1::3] = 10 * a
+        g[2::3] = rng.uniform(0.5 * a, 1.1 * a, N)
+        A = np.zeros((3 * N, 3), dtype=complex)
+        A[2::3, wave] = a * np.exp(1j * rng.uniform(-np.pi, np.pi, N))
+        val, _ = L.lane_minimum(tab, lanes, g, A, i, plan=plan)
+        ref = np.minimum(0.0, g[3 * r + 2] + (A[3 * r + 2, wave] * w).real)
+        np.testing.assert_allclose(val, ref, rtol=0, atol=SAME)
