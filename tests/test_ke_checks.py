@@ -409,8 +409,11 @@ def test_the_expected_orders_are_the_closed_forms():
 def test_a_table_for_another_cam_borne_offset_is_refused():
     tab = _table("d4_discrete")
     for change in ({"cam_cam": 0.001}, {"cam_cam_phase": 0.3}):
-        with pytest.raises(DesignError, match="cam_offset_cam_um"):
+        with pytest.raises(DesignError) as err:
             K.kinematic_error(_drive("d4_discrete"), BIG.replace(**change), table=tab, samples=10)
+        assert str(err.value) == (
+            "imperfections.cam_offset_cam_um: the contact table was built for another cam-borne offset"
+        )
 
 
 @pytest.mark.parametrize("which", ["working", "non-working"])
@@ -418,25 +421,73 @@ def test_a_side_without_contacts_is_refused(which):
     tab = _table("d4_discrete")
     side = tab.side_w if which == "working" else -tab.side_w
     tab.sides = {**tab.sides, side: {k: v[:0] for k, v in tab.sides[side].items()}}
-    with pytest.raises(ModelError, match=f"on its {which} side"):
-        K.kinematic_error(_drive("d4_discrete"), BIG, table=_copy_sides(tab), samples=10)
-    with pytest.raises(ModelError, match=f"on its {which} side"):
-        K.install_angle_scan(_copy_sides(tab), BIG, [0.0])
+    want = (
+        f"no tooth of the flexspline comes within reach of a rigid tooth on its {which} side at any generator "
+        "angle: the output is not driven and has no KE; check the tooth heights, the shifts and W0 (wgcad audit)"
+    )
+    for run in (
+        lambda t: K.kinematic_error(_drive("d4_discrete"), BIG, table=t, samples=10),
+        lambda t: K.install_angle_scan(t, BIG, [0.0]),
+    ):
+        with pytest.raises(ModelError) as err:
+            run(_copy_sides(tab))
+        assert str(err.value) == want
 
 
-def test_samples_without_a_contact_are_counted_and_refused():
-    # the working side's contacts of one class removed: its samples turn freely
+@pytest.mark.parametrize("which", ["working", "non-working"])
+def test_samples_without_a_contact_are_counted_and_refused(which):
+    # one side's contacts of one class removed: its samples turn freely
     tab = _table("d4_discrete")
-    S = tab.sides[tab.side_w]
+    side = tab.side_w if which == "working" else -tab.side_w
+    S = tab.sides[side]
     keep = S["m"] % tab.N != 3
-    tab.sides = {**tab.sides, tab.side_w: {k: v[keep] for k, v in S.items()}}
+    tab.sides = {**tab.sides, side: {k: v[keep] for k, v in S.items()}}
     I = 10 * tab.N + 3
     free = int(np.count_nonzero(_class_of(tab, np.arange(I)) == 3))
-    with pytest.raises(ModelError, match=f"turns freely at {free} of {I} generator angles"):
+    with pytest.raises(ModelError) as err:
         K.kinematic_error(_drive("d4_discrete"), BIG, table=_copy_sides(tab), samples=I)
+    assert str(err.value) == (
+        f"the flexspline turns freely at {free} of {I} generator angles (no tooth within reach of a rigid tooth "
+        "on one side): the output is not driven there and has no KE; check the tooth heights and W0 (wgcad audit)"
+    )
     # no sample at all: nothing to refuse, an empty record
     res = K.kinematic_error(_drive("d4_discrete"), BIG, table=_copy_sides(tab), samples=0)
-    assert len(res.ke) == 0 and res.deep_overlap_fraction == 0.0
+    assert len(res.ke) == 0 and res.deep_overlap_fraction == 0.0 and res.engagement == "none (no samples)"
+
+
+def test_without_a_table_the_ke_builds_its_own():
+    d = _drive("d4_discrete")
+    imp = _scaled(BIG, 0.5)
+    own = K.kinematic_error(d, imp, n_per_mesh=4, samples=700)
+    given = K.kinematic_error(d, imp, table=K.contact_table(d, imp, 4), samples=700)
+    np.testing.assert_array_equal(own.ke, given.ke)
+    assert own.n_per_mesh == 4
+    # on the coned D2 its own table reads the audit's three sections
+    d2 = _drive("d2_imperfect")
+    own = K.kinematic_error(d2, imp, n_per_mesh=2, samples=500)
+    given = K.kinematic_error(d2, imp, table=K.contact_table(d2, imp, 2, sections=d2.sections(3)), samples=500)
+    np.testing.assert_array_equal(own.ke, given.ke)
+
+
+def test_a_deep_first_contact_is_flagged_only_where_it_is_first():
+    # the two lowest contacts of a class set just either side of the trusted depth: the errors take turns at
+    # putting each first, and only the samples where the deep one is first count
+    tab = _table("d2_imperfect")
+    S = dict(tab.sides[tab.side_w])
+    g = S["g"].copy()
+    c = 1
+    e = np.nonzero(S["m"] % tab.N == c)[0]
+    p, q = e[np.argsort(g[e])[:2]]
+    g[p], g[q] = -K.DEEP_OVERLAP - 2e-6, -K.DEEP_OVERLAP + 2e-6
+    S["g"] = g
+    tab.sides = {**tab.sides, tab.side_w: S}
+    I = 40 * tab.N * tab.z_b
+    _, arg = _brute(tab, tab.side_w, BIG, np.arange(I))
+    deep = (arg >= 0) & (g[np.maximum(arg, 0)] < -K.DEEP_OVERLAP)
+    assert 0.0 < deep.mean() < 1.0 / tab.N  # the deep one is first in part of its class only
+    for reference in (False, True):
+        res = K.kinematic_error(_drive("d2_imperfect"), BIG, table=_copy_sides(tab), samples=I, reference=reference)
+        assert res.deep_overlap_fraction == pytest.approx(deep.mean(), abs=1e-15)
 
 
 @pytest.mark.parametrize(
