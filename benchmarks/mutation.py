@@ -56,9 +56,21 @@ SETS = {
         ["wgcad/placement/law.py", "wgcad/placement/deformed.py"],
         ["tests/test_placement.py", "tests/test_placement_checks.py", "tests/test_deformed_checks.py"],
     ),
+    # the fast checks only: a survivor runs every test that covers its function, and the whole of test_clearance,
+    # test_refine and test_apart takes 75 s (one test 24 s): with them a whole run of the set took hours
     "clearance": (
         ["wgcad/clearance/distance.py", "wgcad/clearance/refine.py", "wgcad/clearance/apart.py"],
-        ["tests/test_clearance.py", "tests/test_refine.py", "tests/test_apart.py"],
+        [
+            "tests/test_clearance_checks.py",
+            "tests/test_refine.py::test_refined_pairs_match_dense_polygons[d1_involute-12]",
+            "tests/test_refine.py::test_refined_pairs_match_dense_polygons[d4_discrete-12]",
+            "tests/test_refine.py::test_exact_backlash_approached_from_apart_equals_newton_on_the_signed_figure[d1_involute]",
+            "tests/test_refine.py::test_boundary_distance_matches_shapely",
+            "tests/test_apart.py::test_batched_distance_equals_the_general_refinement",
+            "tests/test_clearance.py::test_engine_equals_brute_force",
+            "tests/test_clearance.py::test_pair_distance_on_two_threads_equals_shapely",
+            "tests/test_clearance.py::test_deliberately_interfering_design_is_found_where_and_how_deep",
+        ],
     ),
     "ke": (["wgcad/accuracy/ke.py", "wgcad/accuracy/ke_lanes.py"], ["tests/test_ke_checks.py"]),
     "profiles": (
