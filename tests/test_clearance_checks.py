@@ -168,3 +168,23 @@ def test_the_refined_figure_is_the_exact_distance_of_its_point(name):
     apart = det.lower[sel] > 2 * scene.chord_gap
     again = scene.exact_to(rot, shift, j, apart=apart)[0]
     np.testing.assert_allclose(again, value, rtol=0, atol=1e-9)
+
+
+@pytest.mark.parametrize("name", ["d1_involute", "d4_discrete", "d2"])
+def test_teeth_within_a_micrometre_of_touching_match_the_dense_polygons(name):
+    # pairs apart moved towards each other along their common normal until they are 0.3 um apart or overlap by
+    # 0.3 um: the sign of the figure there comes from the exact curves (the polygons' answer is within their chord
+    # of zero), and the refinement must still match the dense polygons
+    scene = _scene(name)
+    rot, shift, j = _apart(scene)
+    dist, solved, pa, pb = scene.apart_to(rot, shift, j)
+    rot, shift, j, dist, pa, pb = rot[solved], shift[solved], j[solved], dist[solved], pa[solved], pb[solved]
+    n = (pb - pa) / dist[:, None]  # from A's point to B's, the rigid tooth's frame
+    fa, fb = _dense(name)
+    for eps in (3e-4, -3e-4):
+        moved = shift + rotate((dist - eps)[:, None] * n, scene.rigid_rot[j])  # to the global frame
+        value, side, point = scene.exact_to(rot, moved, j)
+        a, b = transform(fa, rot, moved), transform(fb, scene.rigid_rot[j], scene.rigid_shift[j])
+        ref = np.array([dense_pair(a[k], b[k]) for k in range(len(j))])
+        assert np.abs(value - ref).max() <= REFINE_TOL + DENSE_TOL, (1e3 * (value - ref)).round(5)
+        assert np.all(np.sign(value) == np.sign(eps))
