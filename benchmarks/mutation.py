@@ -140,6 +140,31 @@ def _previous(name: str, modules) -> dict:
 
 _SURVIVING = ("survived", "no tests", "timeout", "suspicious")
 
+#: the survivors judged equivalent (the behaviour does not change), per set: ``{set: {"digest": .., "mutants":
+#: {name: reason}}}``; read only while the set's modules are those the list was made on (the digest)
+EQUIVALENT = ROOT / "benchmarks" / "mutation_equivalent.json"
+
+
+def _equivalent(name: str, modules) -> dict:
+    """The set's listed equivalent mutants (name -> reason), empty if none are listed for these sources."""
+    if not EQUIVALENT.exists():
+        return {}
+    entry = json.loads(EQUIVALENT.read_text(encoding="utf-8")).get(name, {})
+    return entry.get("mutants", {}) if entry.get("digest") == _digest(modules) else {}
+
+
+def _with_equivalents(r: dict, equivalent: dict) -> dict:
+    """The figures with the listed equivalents among the survivors set apart, and the score without them."""
+    for s in r["survivors"]:
+        if s["mutant"] in equivalent:
+            s["equivalent"] = equivalent[s["mutant"]]
+    n = sum("equivalent" in s for s in r["survivors"])
+    killed = r["counts"].get("killed", 0)
+    return r | {
+        "equivalent": n,
+        "score_without_equivalent": round(killed / (r["mutants"] - n), 4) if r["mutants"] > n else None,
+    }
+
 
 def _merge(prev: dict, rerun: dict) -> dict:
     """The earlier run's figures with its survivors' new statuses (each mutant counted once)."""
@@ -150,11 +175,12 @@ def _merge(prev: dict, rerun: dict) -> dict:
         counts[new] = counts.get(new, 0) + 1
     counts = {k: v for k, v in counts.items() if v}
     killed = counts.get("killed", 0)
+    kept = prev.pop("kept", [])
     return prev | {
         "counts": counts,
         "score": round(killed / prev["mutants"], 4) if prev["mutants"] else None,
         "tests": rerun["tests"],
-        "survivors": rerun["survivors"],
+        "survivors": rerun["survivors"] + kept,
         "rerun_seconds": rerun["seconds"],
         "rerun_of": len(prev["survivors"]),
     }
@@ -233,8 +259,15 @@ def _report(r: dict) -> str:
         + ".",
         "",
     ]
+    if r.get("equivalent"):
+        lines += [
+            f"{r['equivalent']} of the survivors are listed as equivalent ({EQUIVALENT.name}, the reason under each); "
+            f"the score without them is {r['score_without_equivalent']}.",
+            "",
+        ]
     for s in r["survivors"]:
-        lines += [f"## {s['mutant']} ({s['status']})", "", "```diff", *s["diff"], "```", ""]
+        eq = f"; equivalent: {s['equivalent']}" if "equivalent" in s else ""
+        lines += [f"## {s['mutant']} ({s['status']}{eq})", "", "```diff", *s["diff"], "```", ""]
     return "\n".join(lines)
 
 
@@ -263,10 +296,20 @@ def main(argv=None) -> int:
         sets = {n: SETS[n] for n in names}
     OUT.mkdir(parents=True, exist_ok=True)
     summary_path = OUT / "summary.json"
-    print("| set | mutants | killed | survived | other | score | s |\n|---|---|---|---|---|---|---|")
+    print(
+        "| set | mutants | killed | survived | other | score | listed equivalent | score without them | s |\n"
+        "|---|---|---|---|---|---|---|---|---|"
+    )
     for name, (modules, tests) in sets.items():
+        equivalent = _equivalent(name, modules)
         if args.survivors:
             prev = _previous(name, modules)
+            # the listed equivalents are not run again: they survive whatever the tests
+            prev = (
+                prev
+                | {"survivors": [s for s in prev["survivors"] if s["mutant"] not in equivalent]}
+                | {"kept": [s for s in prev["survivors"] if s["mutant"] in equivalent]}
+            )
             r = _merge(
                 prev,
                 run_set(
@@ -275,6 +318,7 @@ def main(argv=None) -> int:
             )
         else:
             r = run_set(name, modules, tests, args.max_children, args.budget_min)
+        r = _with_equivalents(r, equivalent)
         (OUT / f"{name}.md").write_text(_report(r), encoding="utf-8")
         (OUT / f"{name}.json").write_text(
             json.dumps({k: v for k, v in r.items() if k != "status"}, indent=1), encoding="utf-8"
@@ -288,7 +332,8 @@ def main(argv=None) -> int:
         c = r["counts"]
         other = r["mutants"] - c.get("killed", 0) - c.get("survived", 0)
         print(
-            f"| {name} | {r['mutants']} | {c.get('killed', 0)} | {c.get('survived', 0)} | {other} | {r['score']} | {r['seconds']} |"
+            f"| {name} | {r['mutants']} | {c.get('killed', 0)} | {c.get('survived', 0)} | {other} | {r['score']} | "
+            f"{r['equivalent']} | {r['score_without_equivalent']} | {r['seconds']} |"
         )
         sys.stdout.flush()
     return 0
