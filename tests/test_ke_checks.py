@@ -599,3 +599,17 @@ def test_lane_minimum_keeps_a_lane_that_dips_below_another_between_a_block_s_end
         val, _ = L.lane_minimum(tab, lanes, g, A, i, plan=plan)
         ref = np.minimum(0.0, g[3 * r + 2] + (A[3 * r + 2, wave] * w).real)
         np.testing.assert_allclose(val, ref, rtol=0, atol=SAME)
+
+
+def test_the_class_waves_kept_with_a_table_are_the_last_two_records():
+    # a sweep's drives share one table: the waves of the last two record lengths are kept, the oldest dropped
+    tab = _table("d4_discrete")
+    for I in (100, 200, 300):
+        a = L.class_waves(tab, I)
+        assert a is L.class_waves(tab, I)  # kept, not built again
+        w = _waves(tab, np.arange(I))
+        for r in range(tab.N):
+            np.testing.assert_allclose(a[r][:3].T, w[r :: tab.N].real, rtol=0, atol=1e-15)
+            np.testing.assert_allclose(a[r][3:6].T, -w[r :: tab.N].imag, rtol=0, atol=1e-15)
+            assert np.all(a[r][6] == 1.0)
+    assert sorted(tab.__dict__["_class_waves"]) == [200, 300]
