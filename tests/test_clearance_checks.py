@@ -129,7 +129,9 @@ def test_the_distance_of_teeth_apart_is_the_dense_polygons_distance(name):
     rot, shift, j = _apart(scene)
     assert len(j) >= 10 and np.ptp(scene.rigid_rot[j]) > 0  # rigid teeth of several poses
     dist, solved, pa, pb = scene.apart_to(rot, shift, j)
-    assert solved.mean() > 0.5
+    # the batch solves every pair of these involute drives (tests/test_apart.py: 99-100 % over a mesh period); a
+    # pair it leaves goes to the general refinement, so only this count shows a batch that gives up too early
+    assert solved.all()
     fa, fb = _dense(name)
     a, b = transform(fa, rot, shift), transform(fb, scene.rigid_rot[j], scene.rigid_shift[j])
     ref = np.array([dense_pair(a[k], b[k]) for k in range(len(j))])
