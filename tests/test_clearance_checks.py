@@ -89,6 +89,7 @@ def test_the_nearest_edge_and_its_position_name_the_distance():
     np.testing.assert_allclose(np.hypot(*(pts - foot).T), d, rtol=0, atol=1e-12)
     # depth_of: how far each row's deepest point lies inside, 0 for a row wholly outside
     t = D.Template(outline)
+    assert not t.local.flags.writeable  # shared by every copy's query: read-only
     rows = np.stack([pts[:10], pts[10:20], np.full((10, 2), 5.0)])
     inside = shapely.contains_xy(t.polygon, rows[..., 0], rows[..., 1])
     want = np.where(inside, D.outline_distance(outline, rows.reshape(-1, 2))[0].reshape(3, 10), 0.0).max(axis=1)
