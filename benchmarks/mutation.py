@@ -171,6 +171,9 @@ def _merge(prev: dict, rerun: dict) -> dict:
     counts = dict(prev["counts"])
     for s in prev["survivors"]:
         new = rerun["status"].get(s["mutant"], s["status"])
+        if new == "not checked":  # not reached within the budget: as it was
+            new = s["status"]
+            rerun["survivors"].append(s)
         counts[s["status"]] -= 1
         counts[new] = counts.get(new, 0) + 1
     counts = {k: v for k, v in counts.items() if v}
