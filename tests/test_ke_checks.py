@@ -68,10 +68,7 @@ def _built(name):
 
 def _table(name):
     """A copy of the table without the caches (the arrays are shared, never written)."""
-    tab = copy.copy(_built(name))
-    for key in _CACHES:
-        tab.__dict__.pop(key, None)
-    return tab
+    return _copy_sides(_built(name))
 
 
 def _scaled(imp, f):
@@ -198,6 +195,7 @@ def test_the_first_contact_at_index_zero_is_flagged_when_it_overlaps_deeply():
 
 
 def _copy_sides(tab):
+    """A shallow copy of ``tab`` without the caches the KE's functions keep with a table."""
     out = copy.copy(tab)
     for key in _CACHES:
         out.__dict__.pop(key, None)
