@@ -24,7 +24,9 @@ refinement is:
 Every row's figure is the distance between two true curve points, so the
 smallest is an upper bound of the exact distance, and it is the exact
 distance once a seed lies in the basin of the true minimum - the premise
-of the general refinement too, from the same vertices. A pair is solved
+of the general refinement too, from the same vertices. The caller seeds
+from both teeth's vertices where the closest approach can be a corner of
+the other tooth (:func:`wgcad.clearance.refine.refine_pairs`). A pair is solved
 only if every one of its rows converged (its last step moved the points by
 less than 1e-7 mm at a point where F is convex along the free parameters),
 ended within two vertices of its seed along A's outline (a joint descent

@@ -15,7 +15,12 @@ stationary point or a corner (its figure is then only an upper bound).
 Pairs the polygons say are apart are measured first by one batch for all
 of them (:mod:`wgcad.clearance.apart`: the distance between the curves by a
 joint Newton iteration from the same seeds); the pairs it leaves unsolved,
-and those that can touch or overlap, by the iteration below.
+and those that can touch or overlap, by the iteration below. Both are
+seeded from B's vertices too wherever B's vertex distances come within the
+margin of A's (:func:`_b_side`): the polygons' distance is attained at a
+vertex of one of them, and where it is B's corner against the middle of a
+long edge of A, A's vertices there can lie farther than the margin above
+it and A's seeds miss the basin.
 
 How: every polygon vertex lies on a piece with a known parameter. The
 vertices whose polygon signed distance is within a margin of the polygon
@@ -332,35 +337,84 @@ def refine_pairs(
     # another is a vertex of one of them); the curves are within margin / 2 of it, so above margin / 2
     # the teeth are apart: their figure is the distance between the curves (wgcad.clearance.apart), and
     # the pairs it leaves unsolved are refined as those that can touch or overlap
-    sd2 = None
+    vsd2 = None
     if apart is None:
-        sd2 = _vertex_sd(B, polyB, polyA, geomA, r2, t2)[0]
-        apart = np.minimum(sd1.min(axis=1), sd2.min(axis=1)) > 0.5 * margin
+        vsd2 = _vertex_sd(B, polyB, polyA, geomA, r2, t2)
+        apart = np.minimum(sd1.min(axis=1), vsd2[0].min(axis=1)) > 0.5 * margin
     value = np.full(K, np.inf)
     side = np.zeros(K, dtype=int)
     point = np.full((K, 2), np.nan)
     apart = np.nonzero(apart)[0]
     if apart.size:
-        seeds = vertex_seeds(sd1[apart], margin, _NEAR)
-        dist, solved, pts, _ = apart_distance(A, B, r1[apart], t1[apart], seeds, edge1[apart], along1[apart])
+        v2 = tuple(x[apart] for x in vsd2) if vsd2 is not None else None
+        dist, solved, pts, _, sd_apart = _apart_both(
+            A, polyA, geomA, B, polyB, (r1[apart], t1[apart]), (r2[apart], t2[apart]), margin,
+            (sd1[apart], edge1[apart], along1[apart]), v2,
+        )  # fmt: skip
         ok = apart[solved]
-        value[ok], point[ok] = dist[solved], pts[solved]
+        value[ok], point[ok], side[ok] = dist[solved], pts[solved], sd_apart[solved]
     rest = np.nonzero(~np.isfinite(value))[0]
     if rest.size:
-        sd2r = sd2[rest] if sd2 is not None else _vertex_sd(B, polyB, polyA, geomA, r2[rest], t2[rest])[0]
+        sd2r = vsd2[0][rest] if vsd2 is not None else _vertex_sd(B, polyB, polyA, geomA, r2[rest], t2[rest])[0]
         value[rest], side[rest], point[rest] = _general(
             A, B, sd1[rest], sd2r, r1[rest], t1[rest], r2[rest], t2[rest], margin
         )
     return value, side, point
 
 
+def _b_side(sd1, sd2, margin):
+    """Pairs whose closest approach can be at a vertex of B's polygon: B's vertex distances within ``margin`` of A's.
+
+    The polygons' distance is attained at a vertex of one of them. Where it is B's (B's corner against the middle of
+    a long A edge: a root or tip corner of one tooth against the other's flank), A's vertices either side of the
+    point can be far more than the margin above the distance, and seeds taken from A's side alone miss that basin
+    (0.15 um too high, measured on D4's upper neighbours); from B's side the basin is seeded.
+    """
+    return sd2.min(axis=1) <= sd1.min(axis=1) + margin
+
+
+def _apart_both(A, polyA, geomA, B, polyB, pose1, pose2, margin, vsd1, vsd2=None):
+    """The batch's distance of pairs apart seeded from A's vertices and, where :func:`_b_side`, from B's too.
+
+    ``pose1``: A's poses in B's frames, ``pose2``: B's in A's; ``vsd1``/``vsd2``: :func:`_vertex_sd` of each side
+    (B's computed here when not given). Returns the distance, ``solved`` (every run of the pair solved), the point
+    of the side attaining it (A's in B's frame for side 0, B's in A's frame for side 1), the other curve's point in
+    the same frame, and the side.
+    """
+    (r1, t1), (r2, t2) = pose1, pose2
+    sd1, edge1, along1 = vsd1
+    dist, solved, pts, other = apart_distance(A, B, r1, t1, vertex_seeds(sd1, margin, _NEAR), edge1, along1)
+    side = np.zeros(len(r1), dtype=int)
+    if vsd2 is None:
+        vsd2 = _vertex_sd(B, polyB, polyA, geomA, r2, t2)
+    sd2, edge2, along2 = vsd2
+    two = np.nonzero(_b_side(sd1, sd2, margin))[0]
+    if two.size:
+        d2, s2, p2, o2 = apart_distance(
+            A=B, B=A, rot=r2[two], shift=t2[two], seeds=vertex_seeds(sd2[two], margin, _NEAR),
+            edge=edge2[two], along=along2[two],
+        )  # fmt: skip
+        solved[two] &= s2
+        lower = d2 < dist[two] - 1e-12  # B's side only where it finds more than the distance's rounding
+        w = two[lower]
+        dist[w], pts[w], other[w], side[w] = d2[lower], p2[lower], o2[lower], 1
+    return dist, solved, pts, other, side
+
+
 def apart_pairs(A: ExactTooth, polyA, rot_a, shift_a, B: ExactTooth, polyB, geomB, rot_b, shift_b, margin: float):
     """Distance between the curves of pairs of placed teeth known to be apart (:mod:`wgcad.clearance.apart`), seeded
     from A's polygon vertices as :func:`refine_pairs` is: ``(distance (K,), solved (K,), A's point, B's point)``, the
     points in B's frame."""
-    (r1, t1), _ = _relative(rot_a, shift_a, rot_b, shift_b)
-    sd1, edge1, along1 = _vertex_sd(A, polyA, polyB, geomB, r1, t1)
-    return apart_distance(A, B, r1, t1, vertex_seeds(sd1, margin, _NEAR), edge1, along1)
+    (r1, t1), (r2, t2) = _relative(rot_a, shift_a, rot_b, shift_b)
+    vsd1 = _vertex_sd(A, polyA, polyB, geomB, r1, t1)
+    dist, solved, pts, other, side = _apart_both(A, polyA, A.polygon, B, polyB, (r1, t1), (r2, t2), margin, vsd1)
+    # B's side measures in A's frame: its points carried to B's frame (A's pose in B's frame, inverted)
+    b = np.nonzero(side == 1)[0]
+    if b.size:
+        pa = rotate(other[b], r1[b]) + t1[b]
+        pb = rotate(pts[b], r1[b]) + t1[b]
+        pts[b], other[b] = pa, pb
+    return dist, solved, pts, other
 
 
 def _relative(rot_a, shift_a, rot_b, shift_b):
@@ -378,11 +432,13 @@ def _general(A: ExactTooth, B: ExactTooth, sd1, sd2, r1, t1, r2, t2, margin):
     K = len(r1)
     v1, _, _, p1, sure = _one_side(A, B, sd1, r1, t1, margin)
     # for teeth apart both sides' minima are the one distance between their boundaries: the second side is
-    # measured only for pairs that can touch or overlap, and for pairs whose first side has a row that stopped
-    # short of a stationary point (its figure only bounds)
+    # measured only for pairs that can touch or overlap, for pairs whose first side has a row that stopped
+    # short of a stationary point (its figure only bounds), and where the closest approach can be at one of B's
+    # vertices, whose basin A's seeds can miss (_b_side)
     v2 = np.full(K, np.inf)
     p2 = np.full((K, 2), np.nan)
-    two = np.nonzero((np.minimum(sd1.min(axis=1), sd2.min(axis=1)) <= 0.5 * margin) | ~sure)[0]
+    touch = np.minimum(sd1.min(axis=1), sd2.min(axis=1)) <= 0.5 * margin
+    two = np.nonzero(touch | ~sure | _b_side(sd1, sd2, margin))[0]
     if two.size:
         v2[two], _, _, p2[two], _ = _one_side(B, A, sd2[two], r2[two], t2[two], margin)
     side = (v2 < v1).astype(int)
