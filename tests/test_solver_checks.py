@@ -283,3 +283,44 @@ def test_supported_freedoms_free_sprung_and_held_equal_the_enumeration():
     warm = solve_supported(M, q, A, f, k, active=s.F > 0)
     assert warm.iterations == 1
     np.testing.assert_allclose(warm.F, s.F, rtol=0, atol=1e-10 * s.F.max())
+
+
+@pytest.mark.parametrize("n", [1, 2, 3, 5, 8])
+def test_the_least_norm_solve_from_a_cold_workspace_cache_is_lstsq_s(n, monkeypatch):
+    """``_least_norm`` asks LAPACK for its workspace once per system size and keeps it; a process's first solve of
+    each size (and mutmut's forks, which inherit a filled cache) must give ``numpy.linalg.lstsq``'s least-norm
+    solution with the same ``rcond``, for full-rank and rank-deficient systems, cold and warm."""
+    import wgcad.elastic.solve as S
+
+    monkeypatch.setattr(S, "_GELSD_WORK", {})
+    rng = np.random.default_rng(n)
+    B = rng.normal(size=(n, n))
+    full = B @ B.T + n * np.eye(n)
+    deficient = full.copy()
+    if n > 1:  # a free body the active contacts cannot hold: one direction without stiffness
+        u = rng.normal(size=n)
+        u /= np.linalg.norm(u)
+        P = np.eye(n) - np.outer(u, u)
+        deficient = P @ full @ P
+    for sys_ in (full, deficient, full):  # the first call fills the cache, the later ones read it
+        rhs = rng.normal(size=n)
+        want = np.linalg.lstsq(sys_, rhs, rcond=1e-12)[0]
+        got = S._least_norm(sys_, rhs)
+        np.testing.assert_allclose(got, want, rtol=1e-9, atol=1e-12 * np.abs(want).max())
+    assert list(S._GELSD_WORK) == [n]
+
+
+def test_integer_inputs_give_the_float_inputs_solution():
+    """Overlaps, directions, loads and stiffnesses given as integers (a user's plain lists): the same solution."""
+    M = np.array([[2, 1, 0], [1, 3, 1], [0, 1, 2]])
+    q = np.array([-1, -2, 9])
+    A = np.array([[1, 0], [1, 1], [1, -1]])
+    f = np.array([3, 1])
+    k = np.array([0, 2])
+    ref = solve_contact_qp(M.astype(float), q.astype(float), A.astype(float), f.astype(float), stiffness=k * 1.0)
+    got = solve_contact_qp(M, q, A, f, stiffness=k)
+    np.testing.assert_allclose(got.F, ref.F, rtol=1e-14, atol=1e-14)
+    np.testing.assert_allclose(got.a, ref.a, rtol=1e-14, atol=1e-14)
+    sup = solve_supported(M, q, A, f, k)
+    np.testing.assert_allclose(sup.F, ref.F, rtol=1e-12, atol=1e-12)
+    assert ref.F.max() > 0 and (ref.F == 0).any()  # contacts both carrying and open
