@@ -340,3 +340,13 @@ def test_integer_inputs_give_the_float_inputs_solution():
     sup = solve_supported(M, q, A, f, k)
     np.testing.assert_allclose(sup.F, ref.F, rtol=1e-12, atol=1e-12)
     assert ref.F.max() > 0 and (ref.F == 0).any()  # contacts both carrying and open
+
+
+def test_a_compliance_that_is_not_positive_definite_is_refused_by_name():
+    """``M`` must be positive definite (ring compliance plus positive contact compliances); one that is not is
+    refused with LAPACK's pivot named, not solved into negative energies."""
+    M = np.array([[1.0, 2.0], [2.0, 1.0]])  # eigenvalues 3 and -1
+    with pytest.raises(
+        np.linalg.LinAlgError, match=r"^the active contacts' compliance is not positive definite \(potrf 2\)$"
+    ):
+        solve_contact_qp(M, [-1.0, -1.0], [[1.0], [1.0]], [1.0])
