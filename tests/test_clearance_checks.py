@@ -219,3 +219,20 @@ def test_every_pair_of_a_wave_within_50_um_matches_the_dense_polygons(name):
         assert solved.any() and np.abs(dist - ref[far])[solved].max() <= REFINE_TOL + DENSE_TOL
         np.testing.assert_allclose(np.hypot(*(pa - pb)[solved].T), dist[solved], rtol=0, atol=1e-12)
         assert np.abs(point_signed_distance(scene.rigid_exact, pb[solved])).max() < 1e-9
+
+
+def test_integer_poses_give_the_float_poses_figures():
+    # poses given as integers (a user's plain lists): the same signed clearances and areas as the same poses in floats
+    a = D.Template(_star(5, 0.6, 1.5, 0.1))
+    b = D.Template(_star(3, 0.3, 1.0, 0.4) * [1.6, 0.7])
+    rot_a, rot_b = np.array([0, 1, 2, 3]), np.array([1, 0, 3, 2])
+    shift_a = np.array([[0, 0], [1, 0], [0, 1], [2, 2]])
+    shift_b = np.array([[2, 0], [1, 1], [0, 3], [2, 0]])
+    got, area = D.signed_clearance(a, rot_a, shift_a, b, rot_b, shift_b, area=True)
+    want, want_area = D.signed_clearance(a, rot_a * 1.0, shift_a * 1.0, b, rot_b * 1.0, shift_b * 1.0, area=True)
+    np.testing.assert_array_equal(got, want)
+    np.testing.assert_array_equal(area, want_area)
+    assert (want < 0).any() and (want > 0).any()
+    d, e, u = D.outline_distance(np.rint(a.local * 10).astype(int), np.array([[0.3, 0.2]]))
+    dw, ew, uw = D.outline_distance(np.rint(a.local * 10), np.array([[0.3, 0.2]]))
+    assert d == dw and e == ew and u == uw
