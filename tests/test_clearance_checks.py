@@ -216,7 +216,10 @@ def test_every_pair_of_a_wave_within_50_um_matches_the_dense_polygons(name):
             assert np.abs(value - ref).max() <= REFINE_TOL + DENSE_TOL, (1e3 * (value - ref)).round(5)
         far = ref > 2 * scene.chord_gap
         dist, solved, pa, pb = scene.apart_to(r[far], s[far], j[far])
-        assert solved.any() and np.abs(dist - ref[far])[solved].max() <= REFINE_TOL + DENSE_TOL
+        # the batch solves every one of them on these drives (measured: 17-31 pairs a flank, all solved); one it
+        # gave up on would still get its figure from the general refinement, so only this shows a batch that stops
+        assert far.sum() >= 10 and solved.all()
+        assert np.abs(dist - ref[far]).max() <= REFINE_TOL + DENSE_TOL
         np.testing.assert_allclose(np.hypot(*(pa - pb)[solved].T), dist[solved], rtol=0, atol=1e-12)
         assert np.abs(point_signed_distance(scene.rigid_exact, pb[solved])).max() < 1e-9
 
