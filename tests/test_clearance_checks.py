@@ -104,7 +104,8 @@ def _scene(name):
 
 @functools.cache
 def _dense(name):
-    d = build_drive(load_design(TEMPLATES / f"{name}.toml"), tol=DENSE_TOL / 2)
+    # the same exact curves sampled finely: a conjugate rigid gear's flank is not enveloped again (Drive.sampled_at)
+    d = _scene(name).drive.sampled_at(DENSE_TOL / 2)
     return d.flex.tooth_polygon(), d.rigid.tooth_polygon()
 
 
@@ -193,7 +194,7 @@ def test_teeth_within_a_micrometre_of_touching_match_the_dense_polygons(name):
         assert np.all(np.sign(value) == np.sign(eps))
 
 
-@pytest.mark.parametrize("name", ["d1_involute", "d4_discrete", "d2"])
+@pytest.mark.parametrize("name", ["d1_involute", "d4_discrete", "d2", "d1_double_arc", "d1_conjugate"])
 def test_every_pair_of_a_wave_within_50_um_matches_the_dense_polygons(name):
     # every flexspline tooth of half a wave against both rigid neighbours, not a sample of them: on D4 one upper
     # pair 4.6 um apart has its closest approach at a corner of the rigid tooth against the middle of a long
@@ -216,12 +217,15 @@ def test_every_pair_of_a_wave_within_50_um_matches_the_dense_polygons(name):
             assert np.abs(value - ref).max() <= REFINE_TOL + DENSE_TOL, (1e3 * (value - ref)).round(5)
         far = ref > 2 * scene.chord_gap
         dist, solved, pa, pb = scene.apart_to(r[far], s[far], j[far])
-        # the batch solves every one of them on these drives (measured: 17-31 pairs a flank, all solved); one it
-        # gave up on would still get its figure from the general refinement, so only this shows a batch that stops
-        assert far.sum() >= 10 and solved.all()
-        assert np.abs(dist - ref[far]).max() <= REFINE_TOL + DENSE_TOL
+        # the batch solves every one of them on the drives without splines (measured: 17-31 pairs a flank, all
+        # solved); one it gave up on would still get its figure from the general refinement, so only this shows a
+        # batch that stops. On a conjugate flank (a spline of hundreds of segments) it leaves many to the general
+        # refinement (measured: D1 double-arc none of 17 a flank solved, D1 conjugate 6 of 9)
+        if name in ("d1_involute", "d4_discrete", "d2"):
+            assert far.sum() >= 10 and solved.all()
+        assert np.abs(dist - ref[far])[solved].max(initial=0.0) <= REFINE_TOL + DENSE_TOL
         np.testing.assert_allclose(np.hypot(*(pa - pb)[solved].T), dist[solved], rtol=0, atol=1e-12)
-        assert np.abs(point_signed_distance(scene.rigid_exact, pb[solved])).max() < 1e-9
+        assert np.abs(point_signed_distance(scene.rigid_exact, pb[solved])).max(initial=0.0) < 1e-9
 
 
 def test_integer_poses_give_the_float_poses_figures():
