@@ -240,6 +240,14 @@ def test_integer_poses_give_the_float_poses_figures():
     np.testing.assert_array_equal(got, want)
     np.testing.assert_array_equal(area, want_area)
     assert (want < 0).any() and (want > 0).any()
+    # a template made from integer coordinates: the float template's figures
+    ai, af = D.Template(np.rint(a.local * 10).astype(int)), D.Template(np.rint(a.local * 10))
+    bi, bf = D.Template(np.rint(b.local * 10).astype(int)), D.Template(np.rint(b.local * 10))
+    got_i = D.signed_clearance(ai, rot_a, shift_a * 10, bi, rot_b, shift_b * 10, area=True)
+    got_f = D.signed_clearance(af, rot_a, shift_a * 10, bf, rot_b, shift_b * 10, area=True)
+    np.testing.assert_array_equal(got_i[0], got_f[0])
+    np.testing.assert_array_equal(got_i[1], got_f[1])
+    assert ai.local.dtype == float and not ai.local.flags.writeable
     d, e, u = D.outline_distance(np.rint(a.local * 10).astype(int), np.array([[0.3, 0.2]]))
     dw, ew, uw = D.outline_distance(np.rint(a.local * 10), np.array([[0.3, 0.2]]))
     assert d == dw and e == ew and u == uw
