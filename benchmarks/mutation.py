@@ -16,7 +16,8 @@ The checkout's working tree (uncommitted changes included) is copied to a tempor
 that change no behaviour (equivalent mutants) are listed in docs/mutation.md with the reason; the others are
 killed by tests that check behaviour.
 
-``--survivors`` runs only the last whole run's survivors of each set again (``output/mutation/<set>.json``), in a
+``--survivors`` runs only the last whole run's survivors of each set again (``output/mutation/<set>.json``), and
+the mutants a run's budget did not reach (kept in that file as ``unchecked``), in a
 fresh copy with the set's tests as they are now, and counts each mutant once: after tests are added against
 survivors, minutes instead of the set's whole run. The modules must be unchanged (mutmut's mutant names are
 numbered in their sources; a digest guards it) and the set's tests should only have grown.
@@ -176,6 +177,14 @@ def _merge(prev: dict, rerun: dict) -> dict:
             rerun["survivors"].append(s)
         counts[s["status"]] -= 1
         counts[new] = counts.get(new, 0) + 1
+    unchecked = []
+    for m in prev.get("unchecked", []):
+        new = rerun["status"].get(m, "not checked")
+        if new == "not checked":
+            unchecked.append(m)
+            continue
+        counts["not checked"] -= 1
+        counts[new] = counts.get(new, 0) + 1
     counts = {k: v for k, v in counts.items() if v}
     killed = counts.get("killed", 0)
     kept = prev.pop("kept", [])
@@ -185,7 +194,8 @@ def _merge(prev: dict, rerun: dict) -> dict:
         "tests": rerun["tests"],
         "survivors": rerun["survivors"] + kept,
         "rerun_seconds": rerun["seconds"],
-        "rerun_of": len(prev["survivors"]),
+        "rerun_of": len(prev["survivors"]) + len(prev.get("unchecked", [])),
+        "unchecked": unchecked,
     }
 
 
@@ -244,6 +254,8 @@ def run_set(name: str, modules, tests, children: int, budget_min: float, names=(
         "digest": _digest(modules),
         "status": status,
         "survivors": survivors,
+        # the mutants the budget did not reach: ``--survivors`` runs them too, so a run cut short can be finished
+        "unchecked": sorted(k for k, v in status.items() if v == "not checked"),
     }
 
 
@@ -316,7 +328,12 @@ def main(argv=None) -> int:
             r = _merge(
                 prev,
                 run_set(
-                    name, modules, tests, args.max_children, args.budget_min, [s["mutant"] for s in prev["survivors"]]
+                    name,
+                    modules,
+                    tests,
+                    args.max_children,
+                    args.budget_min,
+                    [s["mutant"] for s in prev["survivors"]] + list(prev.get("unchecked", [])),
                 ),
             )
         else:
