@@ -227,8 +227,15 @@ class _ConjugateSampler:
         ``P''`` linear on a cubic). The knots are the envelope's points, about 5e-6 mm of sagitta apart: below a
         tolerance of about 1e-5 mm their chords alone were up to 65 times the tolerance from the exact flank (D1
         double-arc at 5e-8 mm), so the polygon was not the tolerance's. Where no segment needs it (the default
-        tolerance) the points are the knots, as before."""
+        tolerance) the points are the knots, as before.
+
+        Only below twice the envelope's own sagitta (:attr:`sagitta_mm`): above it the knots' chords are within half
+        the tolerance of the envelope. A degenerate flank (a fuzz design whose envelope has a 0.54 mm gap between two
+        knots, where the spline loops back across the tooth) is left as its knots there: its looping segment is
+        sampled only when a tolerance that fine is asked for."""
         flank = np.asarray(self.flank, float)
+        if tol >= 2.0 * self.sagitta_mm:
+            return flank
         spl = [p for p in self.pieces if p.kind == "spline" and p.t0 == 0.0]
         for sp in spl:
             c = np.asarray(sp.params).reshape(-1, 4, 2)
